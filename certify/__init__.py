@@ -1,0 +1,26 @@
+"""qualgrasp.certify: convex certification of closure grasps with re-checkable certificates.
+
+Form closure and positive spanning are linear programmes; force closure is a linear programme in
+the plane (friction cones have exactly two edges) and a second-order-cone programme in space
+(exact Lorentz cones, no linearisation). Every verdict carries a certificate that
+:func:`verify` re-checks with exact rational arithmetic, without any solver.
+
+>>> from certify import Contact, Grasp, force_closure
+>>> g = Grasp((Contact((1, 0), (-1, 0), "point", 0.5), Contact((-1, 0), (1, 0), "point", 0.5)))
+>>> force_closure(g).status
+'closure'
+"""
+
+from .certificates import Certificate, Check, Tolerances, verify, verify_span
+from .closure import Verdict, force_closure, form_closure, positive_span
+from .errors import CertificateError, CertifyError, GraspError, GraspFileError, SolverError
+from .grasp import Contact, Grasp, grasp_from_dict, grasp_to_dict
+from .report import Report, certify_grasp
+
+__all__ = [
+    "Contact", "Grasp", "grasp_from_dict", "grasp_to_dict",
+    "Verdict", "force_closure", "form_closure", "positive_span",
+    "Certificate", "Check", "Tolerances", "verify", "verify_span",
+    "Report", "certify_grasp",
+    "CertifyError", "GraspError", "GraspFileError", "CertificateError", "SolverError",
+]

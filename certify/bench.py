@@ -1,0 +1,125 @@
+"""``qualgrasp bench``: time the certification routes on the same random grasps, in one run.
+
+For each kind of grasp, every route computes the force-closure verdict with its certificate on the
+same grasps; the table gives microseconds per grasp, grasps per second and each route's time as a
+multiple of the fast route's. The exact re-check (``verify``) is timed as its own row.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+from .certificates import verify
+from .closure import force_closure
+from .samples import random_grasps
+from .solvers import make_solver
+from .solvers.reference import CvxpySolver
+
+__all__ = ["KINDS", "BenchRow", "run_bench", "print_bench"]
+
+#: name -> keyword arguments of :func:`certify.samples.random_grasp`
+#: (sizes chosen so that both verdicts are frequent: 17 % to 40 % of the grasps are in closure)
+KINDS = {
+    "planar frictionless, 5 contacts": dict(dim=2, n_contacts=5, model="frictionless"),
+    "planar point, 3 contacts": dict(dim=2, n_contacts=3, model="point"),
+    "spatial frictionless, 10 contacts": dict(dim=3, n_contacts=10, model="frictionless"),
+    "spatial point, 3 contacts": dict(dim=3, n_contacts=3, model="point", spread=0.3),
+    "spatial soft, 2 contacts": dict(dim=3, n_contacts=2, model="soft", spread=0.15),
+}
+
+
+@dataclass(frozen=True)
+class BenchRow:
+    kind: str
+    route: str
+    grasps: int
+    seconds: float
+    ratio: float  # time per grasp relative to the fast route
+
+    @property
+    def us_per_grasp(self) -> float:
+        return 1e6 * self.seconds / self.grasps
+
+
+def _time(fn, items) -> float:
+    start = time.perf_counter()
+    for item in items:
+        fn(item)
+    return time.perf_counter() - start
+
+
+def run_bench(n: int = 2000, seed: int = 0, reference_n: int = 300) -> list[BenchRow]:
+    """Time fast, reference (cvxpy with Parameters), cvxpy rebuilt per grasp, and verify."""
+    rows = []
+    for kind, kwargs in KINDS.items():
+        grasps = random_grasps(seed, n, **kwargs)
+        few = grasps[:reference_n]
+        fast = make_solver("fast")
+        force_closure(grasps[0], solver=fast)  # build structure outside the timing
+        t_fast = _time(lambda g: force_closure(g, solver=fast), grasps) / len(grasps)
+        verdicts = [force_closure(g, solver=fast) for g in few]
+        routes = [("fast (qualgrasp)", len(grasps), t_fast * len(grasps))]
+        ref = CvxpySolver(parametric=True)
+        force_closure(grasps[0], solver=ref)
+        routes.append(("reference: cvxpy + Parameters", len(few),
+                       _time(lambda g: force_closure(g, solver=ref), few)))
+        naive = CvxpySolver(parametric=False)
+        routes.append(("cvxpy rebuilt per grasp", len(few),
+                       _time(lambda g: force_closure(g, solver=naive), few)))
+        pairs = list(zip(few, verdicts))
+        routes.append(("verify (exact, no solver)", len(few),
+                       _time(lambda gv: verify(gv[0], gv[1].certificate), pairs)))
+        for route, count, seconds in routes:
+            rows.append(BenchRow(kind, route, count, seconds, (seconds / count) / t_fast))
+    return rows
+
+
+def print_bench(rows: list[BenchRow]) -> None:
+    """Print the benchmark table with rich."""
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title="closure certification, time per grasp (same grasps, same run)")
+    for col in ("kind", "route", "grasps", "us/grasp", "grasps/s", "x fast"):
+        table.add_column(col, justify="left" if col in ("kind", "route") else "right")
+    for r in rows:
+        table.add_row(r.kind, r.route, str(r.grasps), f"{r.us_per_grasp:.1f}",
+                      f"{r.grasps / r.seconds:,.0f}", f"{r.ratio:.2f}")
+    Console().print(table)
+
+
+@dataclass(frozen=True)
+class Agreement:
+    """Verdicts of two routes on the same grasps."""
+
+    kind: str
+    grasps: int
+    same_status: int
+    statuses: dict
+    max_margin_diff: float
+    disagreements: tuple  # ids with different statuses
+
+    @property
+    def rate(self) -> float:
+        return self.same_status / self.grasps
+
+
+def compare_routes(grasps, kind: str = "", a: str = "fast", b: str = "reference",
+                   frictionless: bool = False) -> Agreement:
+    """Compare the verdicts of routes ``a`` and ``b`` on ``grasps`` (form closure if
+    ``frictionless``): status counts of ``a``, agreement count and largest margin difference."""
+    from .closure import form_closure
+
+    test = form_closure if frictionless else force_closure
+    sa, sb = make_solver(a), make_solver(b)
+    same, diff, statuses, bad = 0, 0.0, {}, []
+    for g in grasps:
+        va, vb = test(g, solver=sa), test(g, solver=sb)
+        statuses[va.status] = statuses.get(va.status, 0) + 1
+        if va.status == vb.status:
+            same += 1
+            diff = max(diff, abs(va.margin - vb.margin))
+        else:
+            bad.append(g.id)
+    return Agreement(kind, len(grasps), same, statuses, diff, tuple(bad))

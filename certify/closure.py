@@ -1,0 +1,173 @@
+"""Closure verdicts: form closure, force closure and positive spanning, each with a certificate.
+
+Every verdict follows the same steps on the closure programme of :mod:`certify.problem`:
+
+1. Solve for ``t*``. With full rank and ``t* >= tol.margin``: ``closure`` (interior certificate).
+   Otherwise, if the dual direction separates (strictly on every contact, or exactly orthogonal
+   to contacts that carry no force and strictly on the rest): ``no_closure`` with a Farkas
+   certificate, whatever the rank and even when ``t* = 0``: a separating direction is a proof.
+2. Rank. If the columns' smallest to largest singular value ratio is below ``tol.rank``, the exact
+   rank (rational arithmetic on the float data) decides: deficient gives ``no_closure`` with a
+   null-space Farkas direction, full gives ``degenerate`` (reason ``rank``): such a grasp could
+   resist some wrench only with unbounded forces, and rounding decides which.
+3. Otherwise ``degenerate`` (reason ``margin``): ``t*`` is below ``tol.margin`` and no exact
+   separating direction exists. A degenerate verdict is never turned into a guess.
+
+The margin reported is ``t*`` for closure and 0 otherwise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+
+from . import exact as ex
+from .certificates import Certificate, Tolerances, grasp_system, polar_value, span_system
+from .errors import GraspError, SolverError
+from .grasp import Grasp
+from .problem import ClosureProblem, grasp_problem, span_problem
+from .solvers import make_solver
+
+__all__ = ["Verdict", "force_closure", "form_closure", "positive_span", "decide", "farkas_certificate"]
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Outcome of a closure test.
+
+    Attributes
+    ----------
+    status : {'closure', 'no_closure', 'degenerate'}
+    margin : float
+        Min-weight margin ``t*`` when in closure, else 0.
+    certificate : Certificate
+        Evidence re-checkable by :func:`certify.certificates.verify`.
+    """
+
+    status: str
+    margin: float
+    certificate: Certificate
+
+    @property
+    def closure(self) -> bool | None:
+        """True, False, or None when degenerate."""
+        return None if self.status == "degenerate" else self.status == "closure"
+
+
+def _floats(a) -> tuple[float, ...]:
+    return tuple(float(v) for v in np.ravel(a))
+
+
+def decide(problem: ClosureProblem, system, exact_columns, solver,
+           tol: Tolerances = Tolerances()) -> Verdict:
+    """Verdict for ``problem`` whose certificate columns and blocks are ``system``.
+
+    ``exact_columns`` is a callable returning the exact certificate columns (only called for
+    numerically rank-deficient problems).
+    """
+    C, blocks, layout = system
+    d, k = C.shape
+    U, sv, _ = np.linalg.svd(C)
+    thin = k < d or sv[-1] <= tol.rank * sv[0]
+    sol = None
+    if k >= d:  # fewer columns than rows: rank-deficient, nothing to solve
+        try:
+            sol = solver.solve(problem)
+        except SolverError:
+            if not thin:
+                raise  # solvers may fail on rank-deficient data; there the rank decides below
+    if sol is not None and not thin and sol.status == "optimal" and sol.t >= tol.margin:
+        values = problem.to_values @ sol.x
+        basis = scipy.linalg.qr(C, pivoting=True, mode="r")[1][:d]
+        cert = Certificate("interior", layout, _floats(values), tuple(int(j) for j in basis))
+        return Verdict("closure", float(sol.t), cert)
+    if sol is not None and sol.y is not None and sol.t < tol.margin:
+        cert = farkas_certificate(C, blocks, layout, sol.y)
+        if cert is not None:
+            return Verdict("no_closure", 0.0, cert)
+    if thin:
+        if k < d or ex.rank([list(r) for r in exact_columns()]) < d:
+            cert = Certificate("farkas", layout, y=_floats(U[:, -1]),
+                               tight=tuple(range(len(blocks))), null_space=True)
+            return Verdict("no_closure", 0.0, cert)
+        return Verdict("degenerate", 0.0, Certificate("degenerate", layout, reason="rank"))
+    values = None if sol.x is None else _floats(problem.to_values @ sol.x)
+    y = None if sol.y is None else _floats(sol.y / np.linalg.norm(sol.y))
+    return Verdict("degenerate", 0.0,
+                   Certificate("degenerate", layout, values, y=y, reason="margin"))
+
+
+def farkas_certificate(C: np.ndarray, blocks, layout: str, y: np.ndarray,
+                       rel: float = 1e-7) -> Certificate | None:
+    """A Farkas certificate built from the dual direction ``y``, or None if ``y`` does not give one.
+
+    Blocks on which ``y`` vanishes (relative to ``rel``) are declared tight and ``y`` is projected
+    off their columns; every other block must then be strictly separated (float check with a
+    margin; the exact check is :func:`certify.certificates.verify`).
+    """
+    y = y / np.linalg.norm(y)
+    scale = np.abs(C).max()
+    tight = tuple(i for i, b in enumerate(blocks)
+                  if np.abs(C[:, list(b.cols)].T @ y).max() <= rel * scale)
+    if tight:
+        T = C[:, [j for i in tight for j in blocks[i].cols]]
+        Q, R = np.linalg.qr(T)
+        Q = Q[:, np.abs(np.diag(R)) > 1e-12 * scale] if R.size else Q[:, :0]
+        y = y - Q @ (Q.T @ y)
+        norm = np.linalg.norm(y)
+        if norm < 0.5:
+            return None
+        y = y / norm
+    others = [polar_value(b, C[:, list(b.cols)].T @ y) for i, b in enumerate(blocks) if i not in tight]
+    if others and max(others) >= -1e-9 * scale:
+        return None
+    return Certificate("farkas", layout, y=_floats(y), tight=tight,
+                       null_space=len(tight) == len(blocks))
+
+
+def force_closure(grasp: Grasp, *, method: str = "fast", solver=None, socp: bool = False,
+                  tol: Tolerances = Tolerances()) -> Verdict:
+    """Force closure of ``grasp`` under its declared contact models.
+
+    Planar friction cones are exact two-edge cones (an LP); spatial point and soft contacts use
+    exact second-order cones (an SOCP). ``method`` is ``'fast'`` or ``'reference'`` (cvxpy); pass a
+    ``solver`` from :func:`certify.solvers.make_solver` to reuse prebuilt structure across calls.
+    ``socp=True`` solves a planar grasp with 2-D second-order cones instead of edges (same
+    verdict, margin on the cone scale ``mu f_n - abs(f_t)``; a cross-check of the LP).
+    """
+    return _grasp_verdict(grasp, False, method, solver, tol, socp)
+
+
+def form_closure(grasp: Grasp, *, method: str = "fast", solver=None,
+                 tol: Tolerances = Tolerances()) -> Verdict:
+    """Form closure of ``grasp``: force closure with every contact treated as frictionless."""
+    return _grasp_verdict(grasp, True, method, solver, tol)
+
+
+def _grasp_verdict(grasp, frictionless, method, solver, tol, socp=False) -> Verdict:
+    solver = solver or make_solver(method)
+    kw = dict(frictionless=frictionless, socp=socp)
+    return decide(
+        grasp_problem(grasp, **kw),
+        grasp_system(grasp, **kw),
+        lambda: grasp_system(grasp, exact=True, **kw)[0],
+        solver,
+        tol,
+    )
+
+
+def positive_span(vectors, *, method: str = "fast", solver=None,
+                  tol: Tolerances = Tolerances()) -> Verdict:
+    """Do the rows of ``vectors`` (shape ``(k, d)``) positively span ``R^d``?
+
+    True iff they have rank ``d`` and a strictly positive combination of them is zero. In the
+    plane, unit normals positively span iff their largest angular gap is below pi.
+    """
+    V = np.asarray(vectors, dtype=float)
+    if V.ndim != 2 or not np.isfinite(V).all():
+        raise GraspError("vectors must be a finite (k, d) array")
+    solver = solver or make_solver(method)
+    return decide(span_problem(V), span_system(V), lambda: span_system(V, exact=True)[0],
+                  solver, tol)

@@ -1,0 +1,35 @@
+"""Exceptions raised by :mod:`certify`.
+
+Every error a user can cause derives from :class:`CertifyError`, so a caller can catch one class;
+the subclasses say which kind of input was wrong.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "CertifyError",
+    "GraspError",
+    "GraspFileError",
+    "CertificateError",
+    "SolverError",
+]
+
+
+class CertifyError(Exception):
+    """Base class of every error raised by :mod:`certify`."""
+
+
+class GraspError(CertifyError, ValueError):
+    """A grasp or contact is malformed (NaN coordinates, zero normal, negative friction, ...)."""
+
+
+class GraspFileError(CertifyError, ValueError):
+    """A grasp-set or results file cannot be read (malformed JSON, missing file, wrong schema)."""
+
+
+class CertificateError(CertifyError, ValueError):
+    """A certificate is structurally malformed (wrong keys, lengths or types)."""
+
+
+class SolverError(CertifyError, RuntimeError):
+    """A convex solver failed to return a usable answer."""

@@ -1,0 +1,73 @@
+"""Exact rational linear algebra for small dense matrices (d <= 6 rows).
+
+Matrices are sequences of rows of :class:`fractions.Fraction` (or numpy object arrays of them).
+Every float is a dyadic rational, so these routines decide ranks, solve systems and project
+vectors exactly on the float data, with no rounding and no tolerance.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from typing import Sequence
+
+__all__ = ["row_echelon", "rank", "solve", "independent_columns", "project_out"]
+
+Matrix = Sequence[Sequence[Fraction]]
+
+
+def row_echelon(A: Matrix) -> tuple[list[list[Fraction]], list[int]]:
+    """Reduced row echelon form of ``A`` and its pivot columns."""
+    R = [list(row) for row in A]
+    pivots: list[int] = []
+    r = 0
+    ncols = len(R[0]) if R else 0
+    for c in range(ncols):
+        p = next((i for i in range(r, len(R)) if R[i][c] != 0), None)
+        if p is None:
+            continue
+        R[r], R[p] = R[p], R[r]
+        inv = 1 / R[r][c]
+        R[r] = [v * inv for v in R[r]]
+        for i in range(len(R)):
+            if i != r and R[i][c] != 0:
+                f = R[i][c]
+                R[i] = [a - f * b for a, b in zip(R[i], R[r])]
+        pivots.append(c)
+        r += 1
+        if r == len(R):
+            break
+    return R, pivots
+
+
+def rank(A: Matrix) -> int:
+    """Exact rank of ``A``."""
+    return len(row_echelon(A)[1])
+
+
+def solve(A: Matrix, b: Sequence[Fraction]) -> list[Fraction] | None:
+    """Solution of the square system ``A x = b``, or None when ``A`` is singular."""
+    n = len(A)
+    aug = [list(row) + [bi] for row, bi in zip(A, b)]
+    R, pivots = row_echelon(aug)
+    if pivots != list(range(n)):
+        return None
+    return [R[i][n] for i in range(n)]
+
+
+def independent_columns(A: Matrix) -> list[int]:
+    """Indices of a maximal set of linearly independent columns of ``A`` (its pivot columns)."""
+    return row_echelon(A)[1]
+
+
+def project_out(y: Sequence[Fraction], A: Matrix) -> list[Fraction]:
+    """Component of ``y`` orthogonal to the column space of ``A``: ``y - B (B'B)^{-1} B'y``."""
+    cols = independent_columns(A)
+    if not cols:
+        return list(y)
+    B = [[row[j] for j in cols] for row in A]
+    k = len(cols)
+    BtB = [[sum(B[r][i] * B[r][j] for r in range(len(B))) for j in range(k)] for i in range(k)]
+    Bty = [sum(B[r][i] * y[r] for r in range(len(B))) for i in range(k)]
+    c = solve(BtB, Bty)
+    assert c is not None  # B has independent columns, so B'B is invertible
+    return [y[r] - sum(B[r][i] * c[i] for i in range(k)) for r in range(len(B))]

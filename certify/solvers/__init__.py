@@ -1,0 +1,90 @@
+"""Solver routes for the closure programme of :mod:`certify.problem`.
+
+Three routes solve the same programme and return a :class:`Solution`:
+
+* ``"reference"``: :class:`CvxpySolver`, the readable cvxpy formulation (CLARABEL backend).
+* ``"fast"``: exact vertex enumeration for small polyhedral problems (vectorised numpy, the
+  planar case) and :class:`ClarabelSolver`, clarabel's own API with prebuilt sparse structure,
+  for the rest.
+
+A solver instance caches prebuilt problems by sparsity structure, so reuse one instance across
+many grasps; nothing is cached globally.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..problem import ClosureProblem
+
+__all__ = ["Solution", "make_solver", "FastSolver"]
+
+
+@dataclass(frozen=True, eq=False)
+class Solution:
+    """Outcome of one closure programme.
+
+    Attributes
+    ----------
+    status : {'optimal', 'infeasible'}
+        ``infeasible`` when no equilibrium with unit total normal force exists at all.
+    t : float
+        Optimal margin ``t*`` (``-inf`` when infeasible).
+    x : ndarray or None
+        Optimal variables (solver coordinates).
+    y : ndarray or None
+        Dual direction of the equilibrium rows, oriented as a Farkas direction: every achievable
+        wrench ``w`` has ``y . w <= t* (sum of normal forces)``; when ``t* < 0`` (or infeasible)
+        ``y`` is a strict separating direction.
+    """
+
+    status: str
+    t: float
+    x: np.ndarray | None
+    y: np.ndarray | None
+
+
+class FastSolver:
+    """Exact enumeration for small polyhedral programmes, clarabel's API for the rest."""
+
+    #: Largest number of bases (``k choose d``) enumerated before handing over to clarabel.
+    max_bases = 512
+
+    def __init__(self) -> None:
+        from .clarabel_direct import ClarabelSolver
+
+        self._clarabel = ClarabelSolver()
+
+    def solve(self, problem: ClosureProblem) -> Solution:
+        from math import comb
+
+        from .enumeration import solve_enumeration
+
+        if not problem.cones and comb(problem.nvar, problem.d) <= self.max_bases:
+            sol = solve_enumeration(problem)
+            if sol.y is not None:
+                return sol
+            # No dual basis survived the feasibility tolerance (numerically tied bases): the
+            # interior-point route always returns a dual direction.
+        return self._clarabel.solve(problem)
+
+
+def make_solver(method: str = "fast"):
+    """A solver instance for ``method`` in ``{'fast', 'reference', 'clarabel', 'enumeration'}``."""
+    if method == "fast":
+        return FastSolver()
+    if method == "reference":
+        from .reference import CvxpySolver
+
+        return CvxpySolver()
+    if method == "clarabel":
+        from .clarabel_direct import ClarabelSolver
+
+        return ClarabelSolver()
+    if method == "enumeration":
+        from .enumeration import EnumerationSolver
+
+        return EnumerationSolver()
+    raise ValueError(f"unknown method {method!r}; use 'fast' or 'reference'")

@@ -1,0 +1,1 @@
+"""qualgrasp.experiments: paper-style figures, the qualitative-versus-quantitative study, the demo."""

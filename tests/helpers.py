@@ -1,0 +1,31 @@
+"""Independent geometry used by the tests."""
+
+import numpy as np
+
+
+def nguyen(grasp) -> tuple[bool, float]:
+    """Nguyen's two-finger condition and its distance to the boundary (radians).
+
+    Force closure iff the line through the contacts lies strictly inside both friction cones,
+    oriented the same way for both fingers: squeezing, angle(n1, p2 - p1) < atan(mu1) and
+    angle(n2, p1 - p2) < atan(mu2); or spreading (an internal grasp, fingers pushing apart),
+    angle(n1, p1 - p2) < atan(mu1) and angle(n2, p2 - p1) < atan(mu2).
+    """
+    a, b = grasp.contacts
+    p1, p2 = np.array(a.p), np.array(b.p)
+    d = (p2 - p1) / np.linalg.norm(p2 - p1)
+    angle = lambda n, v: np.arccos(np.clip(np.dot(n, v), -1, 1))
+    slack = max(
+        min(np.arctan(a.mu) - angle(a.n, s * d), np.arctan(b.mu) - angle(b.n, -s * d))
+        for s in (1, -1)
+    )
+    return bool(slack > 0), float(abs(slack))
+
+
+def rotation(rng, dim):
+    """A random proper rotation matrix."""
+    q, r = np.linalg.qr(rng.normal(size=(dim, dim)))
+    q = q * np.sign(np.diag(r))
+    if np.linalg.det(q) < 0:
+        q[:, 0] = -q[:, 0]
+    return q

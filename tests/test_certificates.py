@@ -1,0 +1,90 @@
+"""Certificates re-check without a solver; tampered ones are rejected."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from certify import Certificate, certify_grasp, force_closure, form_closure, verify
+from certify.bench import KINDS
+from certify.samples import random_grasps, textbook_grasps
+
+KIND_GRASPS = {kind: random_grasps(7, 150, **kw) for kind, kw in KINDS.items()}
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_every_certificate_verifies(kind):
+    for g in KIND_GRASPS[kind]:
+        report = certify_grasp(g)
+        assert report.verified, g
+
+
+def _verdicts(kind, status):
+    out = [(g, force_closure(g)) for g in KIND_GRASPS[kind]]
+    return [(g, v) for g, v in out if v.status == status]
+
+
+def _other(kind, g):
+    return next(h for h in KIND_GRASPS[kind] if h is not g)
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_tampered_interior_certificates_are_rejected(kind):
+    rng = np.random.default_rng(0)
+    closures = _verdicts(kind, "closure")
+    assert closures
+    for g, v in closures[:40]:
+        c = v.certificate
+        assert verify(g, c, status="closure", margin=v.margin)
+        x = np.array(c.values)
+        negated = dataclasses.replace(c, values=tuple(-x))
+        assert not verify(g, negated, status="closure")
+        noisy = dataclasses.replace(c, values=tuple(x + 1e-3 * rng.normal(size=x.size)))
+        assert not verify(g, noisy, status="closure")
+        # the same certificate on another grasp of the same size
+        other = _other(kind, g)
+        assert not verify(other, c, status="closure")
+        # claiming more margin than the forces show
+        assert not verify(g, c, status="closure", margin=2 * v.margin + 0.01)
+        # wrong status for the kind of evidence
+        assert not verify(g, c, status="no_closure")
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_tampered_farkas_certificates_are_rejected(kind):
+    rng = np.random.default_rng(1)
+    closures = [g for g, _ in _verdicts(kind, "closure")]
+    for g, v in _verdicts(kind, "no_closure")[:40]:
+        c = v.certificate
+        assert verify(g, c, status="no_closure")
+        y = np.array(c.y)
+        if not c.null_space:  # -y of a null-space direction is as valid as y
+            assert not verify(g, dataclasses.replace(c, y=tuple(-y)), status="no_closure")
+        noisy = dataclasses.replace(c, y=tuple(y + 1e-3 * rng.normal(size=y.size)))
+        if c.tight:  # the direction must stay exactly orthogonal to the tight contacts
+            assert not verify(g, noisy, status="no_closure")
+        # a grasp in closure has no separating direction at all: nothing may pass
+        for h in closures[:5]:
+            assert not verify(h, c, status="no_closure")
+
+
+def test_malformed_certificates_are_rejected_not_raised():
+    g = textbook_grasps()[0]
+    good = form_closure(g).certificate
+    for bad in (
+        dataclasses.replace(good, values=good.values[:-1]),
+        dataclasses.replace(good, basis=(0, 0, 1)),
+        dataclasses.replace(good, values=(float("nan"),) * len(good.values)),
+        dataclasses.replace(good, layout="forces"),
+        Certificate("farkas", "generators", y=(0.0, 0.0, 0.0)),
+        Certificate("farkas", "generators", y=(1.0, 0.0)),
+        Certificate("degenerate", "generators", reason="rank"),
+    ):
+        assert not verify(g, bad, frictionless=True)
+
+
+def test_certificate_json_round_trip():
+    for g in textbook_grasps():
+        for v in (force_closure(g), form_closure(g)):
+            c = Certificate.from_json(v.certificate.to_json())
+            assert c == v.certificate

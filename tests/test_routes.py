@@ -1,0 +1,21 @@
+"""Reference (cvxpy) and fast routes agree on 10,000 random grasps of each kind (fixed seeds)."""
+
+import pytest
+
+from certify.bench import KINDS, compare_routes
+from certify.samples import random_grasps
+
+N = 10_000
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_fast_and_reference_routes_agree(kind):
+    grasps = random_grasps(2024, N, **KINDS[kind])
+    agreement = compare_routes(grasps, kind)
+    print(kind, agreement.statuses, "agree", agreement.same_status, "max margin diff",
+          agreement.max_margin_diff)
+    assert agreement.same_status == N, agreement.disagreements[:10]
+    assert agreement.max_margin_diff < 1e-6
+    # Both verdicts must be well represented, or agreement would say little.
+    assert min(agreement.statuses.get("closure", 0), agreement.statuses.get("no_closure", 0)) > N // 20
