@@ -39,7 +39,7 @@ from . import exact as ex
 from .errors import CertificateError
 from .grasp import Grasp
 from .problem import is_polyhedral
-from .wrench import force_columns, generator_columns, to_exact
+from .wrench import force_columns, generator_columns, grasp_arrays, to_exact
 
 __all__ = [
     "Tolerances",
@@ -145,10 +145,12 @@ class Check:
 def grasp_system(grasp: Grasp, *, frictionless: bool = False, socp: bool = False,
                  exact: bool = False):
     """Certificate columns ``C`` (d x k), their cone blocks and the layout name of ``grasp``."""
+    P, N, mu, _, c, L = grasp_arrays(grasp, exact)
+    models = tuple(contact.model for contact in grasp.contacts)
     if is_polyhedral(grasp, frictionless, socp):
-        C, _ = generator_columns(grasp, frictionless=frictionless, exact=exact)
+        C, _ = generator_columns(P, N, mu, models, c, L, frictionless=frictionless)
         return C, tuple(Block("ray", (j,)) for j in range(C.shape[1])), "generators"
-    C, owner = force_columns(grasp, exact=exact)
+    C, owner = force_columns(P, N, models, c, L)
     conv = to_exact if exact else np.asarray
     num = Fraction if exact else float
     blocks = []

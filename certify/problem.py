@@ -21,10 +21,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import block_diag
 
 from .grasp import Grasp
-from .wrench import contact_frame, generator_columns, tangent, wrench
+from .wrench import contact_frame, generator_columns, grasp_arrays, tangent, wrench
 
 __all__ = ["ClosureProblem", "grasp_problem", "span_problem"]
 
@@ -107,29 +106,37 @@ def grasp_problem(grasp: Grasp, *, frictionless: bool = False, socp: bool = Fals
     planar friction cones as 2-D second-order cones ``abs(f_t) <= mu f_n`` instead of edges: the same
     verdict by another route (the margin's scale differs), used to cross-check the LP.
     """
+    P, N, mu, torsion, c, L = grasp_arrays(grasp)
+    models = tuple(contact.model for contact in grasp.contacts)
     if is_polyhedral(grasp, frictionless, socp):
-        W, _ = generator_columns(grasp, frictionless=frictionless)
+        W, _ = generator_columns(P, N, mu, models, c, L, frictionless=frictionless)
         k = W.shape[1]
         return ClosureProblem(W, tuple(range(k)), (), np.eye(k), "generators")
-    P, N = grasp.points, grasp.normals
     frames = _frames(N)
-    c, L = np.array(grasp.center), grasp.length
+    wrenches = wrench(P[:, None, :], frames, c, L)  # (m, dim, d): one per frame direction
     cols, rays, cones, blocks = [], [], [], []
-    for i, contact in enumerate(grasp.contacts):
+    for i, model in enumerate(models):
         start = len(cols)
-        if contact.model == "frictionless":
-            cols.append(wrench(P[i], N[i], c, L))
+        if model == "frictionless":
+            cols.append(wrenches[i, 0])
             rays.append(start)
             blocks.append(N[i][:, None])
             continue
-        cols += list(wrench(P[i], frames[i], c, L))
+        cols.extend(wrenches[i])
         frame = frames[i].T
-        if contact.model == "soft":
-            g = contact.torsion
+        if model == "soft":
+            g = torsion[i]
             cols.append(np.concatenate([np.zeros(3), g * N[i] / L]))
             frame = np.block([[frame, np.zeros((3, 1))], [np.zeros((1, 3)), np.array([[g]])]])
-        cones.append((start, len(cols) - start, contact.mu))
+        cones.append((start, len(cols) - start, float(mu[i])))
         blocks.append(frame)
-    to_values = block_diag(*blocks)
-    return ClosureProblem(np.array(cols).T, tuple(rays), tuple(cones), to_values, "forces")
+    return ClosureProblem(np.array(cols).T, tuple(rays), tuple(cones), _block_diag(blocks), "forces")
 
+
+def _block_diag(blocks: list[np.ndarray]) -> np.ndarray:
+    out = np.zeros((sum(b.shape[0] for b in blocks), sum(b.shape[1] for b in blocks)))
+    r = c = 0
+    for b in blocks:
+        out[r:r + b.shape[0], c:c + b.shape[1]] = b
+        r, c = r + b.shape[0], c + b.shape[1]
+    return out

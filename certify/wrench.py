@@ -24,6 +24,7 @@ __all__ = [
     "contact_frame",
     "generator_columns",
     "force_columns",
+    "grasp_arrays",
 ]
 
 
@@ -55,12 +56,13 @@ def torque(r: np.ndarray, f: np.ndarray) -> np.ndarray:
 def wrench(p: np.ndarray, f: np.ndarray, center: np.ndarray, length) -> np.ndarray:
     """Wrench(es) of force(s) ``f`` at point(s) ``p``, shape ``(..., 3)`` or ``(..., 6)``.
 
-    Torques are taken about ``center`` and divided by ``length`` so that every row is a force.
+    Torques are taken about ``center`` (broadcast against ``p``) and divided by ``length``
+    (broadcast against ``p.shape[:-1]``) so that every row is a force.
     """
     p, f = np.broadcast_arrays(p, f)
-    tau = torque(p - center, f) / length
-    if p.shape[-1] == 2:
-        tau = tau[..., None]
+    L = np.asarray(length)
+    tau = torque(p - center, f)
+    tau = (tau / L)[..., None] if p.shape[-1] == 2 else tau / L[..., None]
     return np.concatenate([f, tau], axis=-1)
 
 
@@ -75,63 +77,85 @@ def contact_frame(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return t1, torque(n, t1)
 
 
-def _arrays(grasp: Grasp, exact: bool):
+def grasp_arrays(grasp: Grasp, exact: bool = False):
+    """``(P, N, mu, torsion, center, length)`` of ``grasp`` as arrays (exact: Fraction objects)."""
     conv = to_exact if exact else (lambda a: np.asarray(a, dtype=float))
-    mu = np.array([c.mu for c in grasp.contacts], dtype=float)
-    return (conv(grasp.points), conv(grasp.normals), conv(mu), conv(grasp.center),
-            Fraction(grasp.length) if exact else grasp.length)
+    mu = [c.mu for c in grasp.contacts]
+    torsion = [c.torsion or 0.0 for c in grasp.contacts]
+    length = Fraction(grasp.length) if exact else grasp.length
+    return (conv(grasp.points), conv(grasp.normals), conv(mu), conv(torsion),
+            conv(grasp.center), length)
 
 
-def generator_columns(grasp: Grasp, *, frictionless: bool = False, exact: bool = False):
+def generator_columns(P, N, mu, models, center, length, *, frictionless: bool = False):
     """Generator wrenches of a polyhedral grasp wrench cone, as columns.
 
     A frictionless contact contributes ``n``; a planar point contact the two edges of its friction
     cone, ``n + mu t`` and ``n - mu t`` (exact in the plane). With ``frictionless=True`` every contact
     is treated as frictionless (form closure).
 
+    Parameters
+    ----------
+    P, N : array, shape (..., m, dim)
+        Contact points and inward unit normals (leading batch dimensions allowed).
+    mu : array, shape (..., m)
+    models : sequence of str, length m
+        Contact model of each contact (shared by the batch).
+    center : array, shape (..., dim)
+    length : scalar or array, shape (...)
+
     Returns
     -------
-    W : ndarray, shape (d, k)
+    W : array, shape (..., d, k)
         Generator wrenches (d = 3 planar, 6 spatial).
     owner : ndarray of int, shape (k,)
         Index of the contact each column belongs to.
     """
-    P, N, mu, c, L = _arrays(grasp, exact)
-    forces, owner = [], []
-    for i, contact in enumerate(grasp.contacts):
-        if frictionless or contact.model == "frictionless":
-            forces.append(N[i]), owner.append(i)
-        elif grasp.dim == 2 and contact.model == "point":
-            t = tangent(N[i])
-            forces += [N[i] + mu[i] * t, N[i] - mu[i] * t]
+    owner, sign = [], []
+    for i, model in enumerate(models):
+        if frictionless or model == "frictionless":
+            owner.append(i), sign.append(0)
+        elif P.shape[-1] == 2 and model == "point":
             owner += [i, i]
+            sign += [1, -1]
         else:
             raise ValueError("spatial friction cones have no finite generators; use force_columns")
     owner = np.array(owner, dtype=int)
-    return wrench(P[owner], np.array(forces), c, L).T, owner
+    Nk = N[..., owner, :]
+    F = Nk
+    if any(sign):
+        F = Nk + (np.array(sign) * mu[..., owner])[..., None] * tangent(Nk)
+    W = wrench(P[..., owner, :], F, np.asarray(center)[..., None, :], np.asarray(length)[..., None])
+    return np.swapaxes(W, -1, -2), owner
 
 
-def force_columns(grasp: Grasp, *, exact: bool = False):
+def force_columns(P, N, models, center, length):
     """Wrenches of unit contact-force components in world coordinates, as columns.
 
     Layout per contact: frictionless ``[n]``; point ``[e_1, ..., e_dim]`` (world axes); soft
     ``[e_1, e_2, e_3, tau]`` where ``tau = (0, n / L)`` is the wrench of a unit torsional moment
-    about the (stored, unit up to rounding) normal ``n``.
+    about the (stored, unit up to rounding) normal ``n``. Arguments as in
+    :func:`generator_columns`; no batch dimensions.
 
     Returns
     -------
-    C : ndarray, shape (d, k)
+    C : array, shape (d, k)
     owner : ndarray of int, shape (k,)
     """
-    P, N, _, c, L = _arrays(grasp, exact)
-    dim = grasp.dim
-    eye = to_exact(np.eye(dim)) if exact else np.eye(dim)
-    cols, owner = [], []
-    for i, contact in enumerate(grasp.contacts):
-        forces = [N[i]] if contact.model == "frictionless" else list(eye)
-        cols += list(wrench(P[i], np.array(forces), c, L))
-        if contact.model == "soft":
-            zero = N[i] * 0
-            cols.append(np.concatenate([zero, N[i] / L]))
-        owner += [i] * (len(cols) - len(owner))
-    return np.array(cols).T, np.array(owner, dtype=int)
+    dim = P.shape[-1]
+    eye = to_exact(np.eye(dim)) if N.dtype == object else np.eye(dim)
+    forces, owner = [], []
+    for i, model in enumerate(models):
+        rows = [N[i]] if model == "frictionless" else list(eye)
+        forces += rows
+        owner += [i] * len(rows)
+    owner = np.array(owner, dtype=int)
+    cols = list(wrench(P[owner], np.array(forces), center, length))
+    out, out_owner = [], []
+    for j, i in enumerate(owner):
+        out.append(cols[j]), out_owner.append(i)
+        last = j + 1 == len(owner) or owner[j + 1] != i
+        if last and models[i] == "soft":
+            out.append(np.concatenate([N[i] * 0, N[i] / length]))
+            out_owner.append(i)
+    return np.array(out).T, np.array(out_owner, dtype=int)

@@ -66,29 +66,58 @@ def _triplets(problem: ClosureProblem):
     return np.concatenate(rows), np.concatenate(cols), np.concatenate(vals), r, cones
 
 
+class _Built:
+    """A clarabel solver prebuilt for one structure, and how to refill its ``A`` values."""
+
+    def __init__(self, problem: ClosureProblem) -> None:
+        rows, cols, vals, m, cones = _triplets(problem)
+        n = problem.nvar + 1
+        # CSC order of the triplets: fill a matrix with their indices and read them back.
+        order = sp.csc_matrix((np.arange(len(vals), dtype=float), (rows, cols)), shape=(m, n))
+        self.perm = order.data.astype(int)
+        self.template = vals
+        self.ncol = problem.columns.size
+        self.kappa_at = np.array([np.flatnonzero((rows == r) & (cols == s))[0]
+                                  for r, s in _cone_rows(problem)], dtype=int)
+        A = sp.csc_matrix((vals[self.perm], order.indices, order.indptr), shape=(m, n))
+        b = np.zeros(m)
+        b[problem.d] = 1.0
+        q = np.zeros(n)
+        q[-1] = -1.0
+        self.solver = clarabel.DefaultSolver(sp.csc_matrix((n, n)), q, A, b, cones, settings())
+        self.fresh = True
+
+    def solve(self, problem: ClosureProblem):
+        if not self.fresh:
+            vals = self.template.copy()
+            vals[: self.ncol] = problem.columns.ravel()
+            vals[self.kappa_at] = [-mu for _, _, mu in problem.cones]
+            self.solver.update(A=vals[self.perm])
+        self.fresh = False
+        return self.solver.solve()
+
+
+def _cone_rows(problem: ClosureProblem):
+    """(row, column) of each cone's ``-kappa`` entry in ``A``, in cone order."""
+    r = problem.d + 1 + len(problem.rays)
+    out = []
+    for start, size, _ in problem.cones:
+        out.append((r, start))
+        r += size
+    return out
+
+
 class ClarabelSolver:
     """Solve closure programmes with clarabel directly; one prebuilt solver per structure."""
 
     def __init__(self) -> None:
-        self._built: dict[tuple, tuple] = {}
+        self._built: dict[tuple, _Built] = {}
 
     def solve(self, problem: ClosureProblem) -> Solution:
-        rows, cols, vals, m, cones = _triplets(problem)
-        n = problem.nvar + 1
-        A = sp.csc_matrix((vals, (rows, cols)), shape=(m, n))
         key = problem.structure
-        if key in self._built:
-            solver = self._built[key]
-            solver.update(A=A.data)
-        else:
-            b = np.zeros(m)
-            b[problem.d] = 1.0
-            q = np.zeros(n)
-            q[-1] = -1.0
-            P = sp.csc_matrix((n, n))
-            solver = clarabel.DefaultSolver(P, q, A, b, cones, settings())
-            self._built[key] = solver
-        sol = solver.solve()
+        if key not in self._built:
+            self._built[key] = _Built(problem)
+        sol = self._built[key].solve(problem)
         status = str(sol.status)
         z = np.asarray(sol.z)
         if status in ("Solved", "AlmostSolved"):
