@@ -86,7 +86,7 @@ def print_bench(rows: list[BenchRow]) -> None:
     for r in rows:
         table.add_row(r.kind, r.route, str(r.grasps), f"{r.us_per_grasp:.1f}",
                       f"{r.grasps / r.seconds:,.0f}", f"{r.ratio:.2f}")
-    Console().print(table)
+    Console(width=max(120, Console().width)).print(table)
 
 
 @dataclass(frozen=True)

@@ -38,16 +38,13 @@ import numpy as np
 from . import exact as ex
 from .errors import CertificateError
 from .grasp import Grasp
-from .problem import is_polyhedral
-from .wrench import force_columns, generator_columns, grasp_arrays, to_exact
+from .problem import Block, grasp_system, span_system
+from .wrench import to_exact
 
 __all__ = [
     "Tolerances",
     "Certificate",
-    "Block",
     "Check",
-    "grasp_system",
-    "span_system",
     "verify",
     "verify_span",
     "verify_system",
@@ -121,17 +118,6 @@ class Certificate:
 
 
 @dataclass(frozen=True)
-class Block:
-    """One contact cone over certificate columns ``cols``: ``ray``, ``point`` or ``soft``."""
-
-    kind: str
-    cols: tuple[int, ...]
-    n: tuple = ()
-    mu: Any = 0
-    torsion: Any = 0
-
-
-@dataclass(frozen=True)
 class Check:
     """Outcome of a verification; truthy when it passed."""
 
@@ -140,33 +126,6 @@ class Check:
 
     def __bool__(self) -> bool:
         return self.ok
-
-
-def grasp_system(grasp: Grasp, *, frictionless: bool = False, socp: bool = False,
-                 exact: bool = False):
-    """Certificate columns ``C`` (d x k), their cone blocks and the layout name of ``grasp``."""
-    P, N, mu, _, c, L = grasp_arrays(grasp, exact)
-    models = tuple(contact.model for contact in grasp.contacts)
-    if is_polyhedral(grasp, frictionless, socp):
-        C, _ = generator_columns(P, N, mu, models, c, L, frictionless=frictionless)
-        return C, tuple(Block("ray", (j,)) for j in range(C.shape[1])), "generators"
-    C, owner = force_columns(P, N, models, c, L)
-    conv = to_exact if exact else np.asarray
-    num = Fraction if exact else float
-    blocks = []
-    for i, c in enumerate(grasp.contacts):
-        cols = tuple(int(j) for j in np.flatnonzero(owner == i))
-        kind = "ray" if c.model == "frictionless" else c.model
-        blocks.append(Block(kind, cols, tuple(conv(np.array(c.n))), num(c.mu),
-                            num(c.torsion) if c.torsion else 0))
-    return C, tuple(blocks), "forces"
-
-
-def span_system(vectors, *, exact: bool = False):
-    """Certificate columns and blocks for positive spanning of the rows of ``vectors``."""
-    V = np.asarray(vectors, dtype=float)
-    C = (to_exact(V) if exact else V).T
-    return C, tuple(Block("ray", (j,)) for j in range(C.shape[1])), "generators"
 
 
 # --- cone tests, written once for exact (Fraction) and float numbers --------------------------

@@ -24,10 +24,10 @@ import numpy as np
 import scipy.linalg
 
 from . import exact as ex
-from .certificates import Certificate, Tolerances, grasp_system, polar_value, span_system
+from .certificates import Certificate, Tolerances, polar_value
 from .errors import GraspError, SolverError
 from .grasp import Grasp
-from .problem import ClosureProblem, grasp_problem, span_problem
+from .problem import ClosureProblem, grasp_problem, grasp_system, span_problem, span_system
 from .solvers import make_solver
 
 __all__ = ["Verdict", "force_closure", "form_closure", "positive_span", "decide", "farkas_certificate"]
@@ -60,14 +60,14 @@ def _floats(a) -> tuple[float, ...]:
     return tuple(float(v) for v in np.ravel(a))
 
 
-def decide(problem: ClosureProblem, system, exact_columns, solver,
+def decide(problem: ClosureProblem, exact_columns, solver,
            tol: Tolerances = Tolerances()) -> Verdict:
-    """Verdict for ``problem`` whose certificate columns and blocks are ``system``.
+    """Verdict for ``problem``, with a certificate over its certificate system.
 
     ``exact_columns`` is a callable returning the exact certificate columns (only called for
     numerically rank-deficient problems).
     """
-    C, blocks, layout = system
+    C, blocks, layout = problem.system
     d, k = C.shape
     U, sv, _ = np.linalg.svd(C)
     thin = k < d or sv[-1] <= tol.rank * sv[0]
@@ -151,8 +151,7 @@ def _grasp_verdict(grasp, frictionless, method, solver, tol, socp=False) -> Verd
     kw = dict(frictionless=frictionless, socp=socp)
     return decide(
         grasp_problem(grasp, **kw),
-        grasp_system(grasp, **kw),
-        lambda: grasp_system(grasp, exact=True, **kw)[0],
+        lambda: grasp_system(grasp, exact=True, **kw).columns,
         solver,
         tol,
     )
@@ -169,5 +168,4 @@ def positive_span(vectors, *, method: str = "fast", solver=None,
     if V.ndim != 2 or not np.isfinite(V).all():
         raise GraspError("vectors must be a finite (k, d) array")
     solver = solver or make_solver(method)
-    return decide(span_problem(V), span_system(V), lambda: span_system(V, exact=True)[0],
-                  solver, tol)
+    return decide(span_problem(V), lambda: span_system(V, exact=True).columns, solver, tol)

@@ -19,13 +19,37 @@ torsional term for soft contacts), and for a frictionless one ``f_n``.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from .grasp import Grasp
-from .wrench import contact_frame, generator_columns, grasp_arrays, tangent, wrench
+from .wrench import (contact_frame, force_columns, generator_columns, grasp_arrays, tangent,
+                     to_exact, wrench)
 
-__all__ = ["ClosureProblem", "grasp_problem", "span_problem"]
+__all__ = ["Block", "System", "ClosureProblem", "grasp_problem", "span_problem", "grasp_system",
+           "span_system", "is_polyhedral"]
+
+
+@dataclass(frozen=True)
+class Block:
+    """One contact cone over certificate columns ``cols``: ``ray``, ``point`` or ``soft``."""
+
+    kind: str
+    cols: tuple[int, ...]
+    n: tuple = ()
+    mu: Any = 0
+    torsion: Any = 0
+
+
+class System(NamedTuple):
+    """What a certificate is written over: columns ``C`` (d x k), their cone blocks, the layout
+    name (``generators`` or ``forces``). Float for the solvers, exact for the checker."""
+
+    columns: np.ndarray
+    blocks: tuple[Block, ...]
+    layout: str
 
 
 @dataclass(frozen=True, eq=False)
@@ -43,15 +67,15 @@ class ClosureProblem:
         the tangential forces (and the scaled torsional moment).
     to_values : ndarray, shape (ncert, nvar)
         Linear map from ``x`` to the certificate's values (world-frame forces).
-    layout : {'generators', 'forces'}
-        What the certificate's values are: generator weights or world-frame contact forces.
+    system : System
+        The float certificate system (for polyhedral problems its columns are ``columns``).
     """
 
     columns: np.ndarray
     rays: tuple[int, ...]
     cones: tuple[tuple[int, int, float], ...]
     to_values: np.ndarray
-    layout: str
+    system: System
 
     @property
     def d(self) -> int:
@@ -77,9 +101,9 @@ class ClosureProblem:
 
 def span_problem(vectors) -> ClosureProblem:
     """Positive spanning of the rows of ``vectors`` (shape ``(k, d)``): every row is a ray."""
-    V = np.asarray(vectors, dtype=float)
-    k = V.shape[0]
-    return ClosureProblem(V.T.copy(), tuple(range(k)), (), np.eye(k), "generators")
+    system = span_system(vectors)
+    k = system.columns.shape[1]
+    return ClosureProblem(system.columns, tuple(range(k)), (), np.eye(k), system)
 
 
 def is_polyhedral(grasp: Grasp, frictionless: bool = False, socp: bool = False) -> bool:
@@ -106,12 +130,12 @@ def grasp_problem(grasp: Grasp, *, frictionless: bool = False, socp: bool = Fals
     planar friction cones as 2-D second-order cones ``abs(f_t) <= mu f_n`` instead of edges: the same
     verdict by another route (the margin's scale differs), used to cross-check the LP.
     """
+    system = grasp_system(grasp, frictionless=frictionless, socp=socp)
+    if system.layout == "generators":
+        k = system.columns.shape[1]
+        return ClosureProblem(system.columns, tuple(range(k)), (), np.eye(k), system)
     P, N, mu, torsion, c, L = grasp_arrays(grasp)
     models = tuple(contact.model for contact in grasp.contacts)
-    if is_polyhedral(grasp, frictionless, socp):
-        W, _ = generator_columns(P, N, mu, models, c, L, frictionless=frictionless)
-        k = W.shape[1]
-        return ClosureProblem(W, tuple(range(k)), (), np.eye(k), "generators")
     frames = _frames(N)
     wrenches = wrench(P[:, None, :], frames, c, L)  # (m, dim, d): one per frame direction
     cols, rays, cones, blocks = [], [], [], []
@@ -130,7 +154,7 @@ def grasp_problem(grasp: Grasp, *, frictionless: bool = False, socp: bool = Fals
             frame = np.block([[frame, np.zeros((3, 1))], [np.zeros((1, 3)), np.array([[g]])]])
         cones.append((start, len(cols) - start, float(mu[i])))
         blocks.append(frame)
-    return ClosureProblem(np.array(cols).T, tuple(rays), tuple(cones), _block_diag(blocks), "forces")
+    return ClosureProblem(np.array(cols).T, tuple(rays), tuple(cones), _block_diag(blocks), system)
 
 
 def _block_diag(blocks: list[np.ndarray]) -> np.ndarray:
@@ -140,3 +164,30 @@ def _block_diag(blocks: list[np.ndarray]) -> np.ndarray:
         out[r:r + b.shape[0], c:c + b.shape[1]] = b
         r, c = r + b.shape[0], c + b.shape[1]
     return out
+
+
+def grasp_system(grasp: Grasp, *, frictionless: bool = False, socp: bool = False,
+                 exact: bool = False):
+    """The certificate :class:`System` of ``grasp`` (exact: Fraction entries)."""
+    P, N, mu, _, c, L = grasp_arrays(grasp, exact)
+    models = tuple(contact.model for contact in grasp.contacts)
+    if is_polyhedral(grasp, frictionless, socp):
+        C, _ = generator_columns(P, N, mu, models, c, L, frictionless=frictionless)
+        return System(C, tuple(Block("ray", (j,)) for j in range(C.shape[1])), "generators")
+    C, owner = force_columns(P, N, models, c, L)
+    conv = to_exact if exact else np.asarray
+    num = Fraction if exact else float
+    blocks = []
+    for i, c in enumerate(grasp.contacts):
+        cols = tuple(int(j) for j in np.flatnonzero(owner == i))
+        kind = "ray" if c.model == "frictionless" else c.model
+        blocks.append(Block(kind, cols, tuple(conv(np.array(c.n))), num(c.mu),
+                            num(c.torsion) if c.torsion else 0))
+    return System(C, tuple(blocks), "forces")
+
+
+def span_system(vectors, *, exact: bool = False):
+    """Certificate columns and blocks for positive spanning of the rows of ``vectors``."""
+    V = np.asarray(vectors, dtype=float)
+    C = (to_exact(V) if exact else V).T
+    return System(C, tuple(Block("ray", (j,)) for j in range(C.shape[1])), "generators")

@@ -50,7 +50,7 @@ class FastSolver:
     """Exact enumeration for small polyhedral programmes, clarabel's API for the rest."""
 
     #: Largest number of bases (``k choose d``) enumerated before handing over to clarabel.
-    max_bases = 512
+    max_bases = 64
 
     def __init__(self) -> None:
         from .clarabel_direct import ClarabelSolver
