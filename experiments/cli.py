@@ -10,10 +10,12 @@ from rich.console import Console
 from rich.table import Table
 
 import certify.cli
+import qualitative.cli
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="Qualitative grasp synthesis and convex certification of closure grasps.")
 certify.cli.register(app)
+qualitative.cli.register(app)
 console = Console()
 
 

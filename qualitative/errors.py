@@ -1,0 +1,50 @@
+"""Exceptions raised by :mod:`qualitative`.
+
+Every error a user can cause derives from :class:`QualitativeError`; the subclasses say which kind
+of input was wrong. Messages name the problem and, where there is one, the fix.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "QualitativeError",
+    "ImageError",
+    "SegmentationError",
+    "ContourError",
+    "OutlineError",
+    "FormulaError",
+    "TraceError",
+    "NetworkError",
+]
+
+
+class QualitativeError(Exception):
+    """Base class of every error raised by :mod:`qualitative`."""
+
+
+class ImageError(QualitativeError, ValueError):
+    """An image cannot be read or holds nothing usable (unreadable file, empty, constant)."""
+
+
+class SegmentationError(QualitativeError, ValueError):
+    """Segmentation did not give exactly one usable object (none, several, cut by the border)."""
+
+
+class ContourError(QualitativeError, ValueError):
+    """A contour is degenerate (too few points, zero area, self-intersecting, too small)."""
+
+
+class OutlineError(QualitativeError, ValueError):
+    """A qualitative outline string is not well formed (names the rule it breaks)."""
+
+
+class FormulaError(QualitativeError, ValueError):
+    """An ST0 formula does not parse (with the position of the problem)."""
+
+
+class TraceError(QualitativeError, ValueError):
+    """A spatio-temporal trace is malformed (unknown relation, bad pair, wrong type)."""
+
+
+class NetworkError(QualitativeError, ValueError):
+    """An RCC-8 network is malformed (unknown relation name, bad pair)."""
