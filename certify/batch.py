@@ -34,27 +34,31 @@ class Summary:
 
 
 def certify_rows(grasps_path: str | Path, *, method: str = "fast",
-                 tol: Tolerances = Tolerances()) -> Iterator[dict]:
-    """Yield one results row per grasp line of ``grasps_path`` (errors become ``error`` rows)."""
+                 tol: Tolerances = Tolerances(), **quality) -> Iterator[dict]:
+    """Yield one results row per grasp line of ``grasps_path`` (errors become ``error`` rows).
+
+    ``quality`` holds the epsilon options of :func:`certify.report.certify_grasp` (``quality``,
+    ``eps_gap``, ``eps_budget``)."""
     solver = make_solver(method)
     for number, gid, grasp in read_grasps(grasps_path):
         if isinstance(grasp, CertifyError):
             yield error_row(str(grasp), id=gid, line=number)
             continue
         try:
-            yield certify_grasp(grasp, solver=solver, tol=tol).row(line=number)
+            yield certify_grasp(grasp, solver=solver, tol=tol, **quality).row(line=number)
         except CertifyError as err:
             yield error_row(f"line {number}: {err}", id=gid, line=number)
 
 
 def certify_file(grasps_path: str | Path, results_path: str | Path, *, method: str = "fast",
                  tol: Tolerances = Tolerances(),
-                 progress: Callable[[dict], None] | None = None) -> Summary:
-    """Certify every grasp of a JSON Lines grasp set and write one results row per grasp."""
+                 progress: Callable[[dict], None] | None = None, **quality) -> Summary:
+    """Certify every grasp of a JSON Lines grasp set and write one results row per grasp
+    (``quality``: epsilon options, see :func:`certify_rows`)."""
     summary = Summary()
 
     def rows():
-        for row in certify_rows(grasps_path, method=method, tol=tol):
+        for row in certify_rows(grasps_path, method=method, tol=tol, **quality):
             summary.add(row["status"])
             summary.unverified += row["status"] != "error" and not row["verified"]
             if progress:

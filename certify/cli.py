@@ -34,6 +34,9 @@ def certify_command(
     output: Path = typer.Option(..., "-o", "--output", help="Results file, JSON Lines."),
     method: str = typer.Option("fast", help="'fast' (enumeration/clarabel) or 'reference' (cvxpy)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar or summary."),
+    quality: bool = typer.Option(True, help="Compute the epsilon columns (eps_l1_lo ... eps_linf_hi)."),
+    eps_gap: float = typer.Option(0.01, help="Spatial epsilon: stop when hi - lo <= gap * hi."),
+    eps_budget: float = typer.Option(5.0, help="Spatial epsilon: seconds per grasp and norm at most."),
 ) -> None:
     """Certify form and force closure of every grasp, one results line per grasp line.
 
@@ -45,7 +48,8 @@ def certify_command(
         task = bar.add_task("certify", total=total)
         try:
             summary = certify_file(grasps, output, method=method,
-                                   progress=lambda row: bar.advance(task))
+                                   progress=lambda row: bar.advance(task), quality=quality,
+                                   eps_gap=eps_gap, eps_budget=eps_budget)
         except CertifyError as err:
             console.print(f"[red]error:[/red] {err}")
             raise typer.Exit(2)

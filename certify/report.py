@@ -3,8 +3,11 @@
 :func:`certify_grasp` returns a :class:`Report`; :meth:`Report.row` is the results-file row
 (one JSON object per input grasp) with the keys ``id``, ``line``, ``dim``, ``status``,
 ``form_closure``, ``force_closure``, ``margin``, ``form_status``, ``form_margin``,
-``certificate`` (``{"force": ..., "form": ...}``), ``verified``, ``error``, ``center``, ``length``
-and ``n_contacts``. ``status`` refers to force closure under the declared contact models.
+``certificate`` (``{"force": ..., "form": ...}``), ``verified``, ``error``, ``center``, ``length``,
+``n_contacts``, and the Ferrari-Canny epsilon bounds ``eps_l1_lo``, ``eps_l1_hi``,
+``eps_linf_lo``, ``eps_linf_hi`` (equal in the plane; 0 when not in force closure; null when
+quality was not asked for), computed with the row's ``center`` and ``length``. ``status`` refers
+to force closure under the declared contact models.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ from .certificates import Certificate, Check, Tolerances, verify
 from .errors import CertificateError
 from .closure import Verdict, form_closure, force_closure
 from .grasp import Grasp
+from .quality import Epsilon, epsilon
 
 __all__ = ["Report", "certify_grasp", "error_row", "verify_row"]
 
@@ -28,9 +32,15 @@ class Report:
     force: Verdict
     form: Verdict
     verified: bool
+    epsilons: dict[str, Epsilon] | None = None
 
     def row(self, line: int | None = None) -> dict[str, Any]:
         g = self.grasp
+        eps = {}
+        for norm, key in (("L1", "l1"), ("Linf", "linf")):
+            e = self.epsilons.get(norm) if self.epsilons else None
+            eps[f"eps_{key}_lo"] = None if e is None else e.lo
+            eps[f"eps_{key}_hi"] = None if e is None else e.hi
         return {
             "id": g.id,
             "line": line,
@@ -48,19 +58,27 @@ class Report:
             "center": list(g.center),
             "length": g.length,
             "n_contacts": len(g.contacts),
+            **eps,
         }
 
 
 def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
-                  tol: Tolerances = Tolerances()) -> Report:
-    """Force closure, form closure and the re-check of both certificates for ``grasp``."""
+                  tol: Tolerances = Tolerances(), quality: bool = True, eps_gap: float = 0.01,
+                  eps_budget: float = 5.0) -> Report:
+    """Force closure, form closure, the re-check of both certificates and, with ``quality``,
+    the L1 and L-infinity epsilon of ``grasp`` (spatial bounds refined to ``eps_gap`` or
+    ``eps_budget`` seconds per norm)."""
     force = force_closure(grasp, method=method, solver=solver, tol=tol)
     form = force if grasp.frictionless else form_closure(grasp, method=method, solver=solver, tol=tol)
     ok = all(
         verify(grasp, v.certificate, status=v.status, margin=v.margin, frictionless=fl, tol=tol)
         for v, fl in ((force, False), (form, True))
     )
-    return Report(grasp, force, form, ok)
+    eps = None
+    if quality:
+        eps = {norm: epsilon(grasp, norm, rel_gap=eps_gap, time_budget=eps_budget, verdict=force)
+               for norm in ("L1", "Linf")}
+    return Report(grasp, force, form, ok, eps)
 
 
 def error_row(message: str, *, id: Any = None, line: int | None = None) -> dict[str, Any]:
@@ -69,7 +87,8 @@ def error_row(message: str, *, id: Any = None, line: int | None = None) -> dict[
         "id": id, "line": line, "dim": None, "status": "error", "form_closure": None,
         "force_closure": None, "margin": None, "form_status": "error", "form_margin": None,
         "certificate": None, "verified": False, "error": message, "center": None,
-        "length": None, "n_contacts": None,
+        "length": None, "n_contacts": None, "eps_l1_lo": None, "eps_l1_hi": None,
+        "eps_linf_lo": None, "eps_linf_hi": None,
     }
 
 

@@ -44,7 +44,7 @@ def _rows(path):
 
 def test_bad_lines_become_error_rows_and_the_run_goes_on(grasp_file, tmp_path):
     out = tmp_path / "results.jsonl"
-    summary = certify_file(grasp_file, out)
+    summary = certify_file(grasp_file, out, quality=False)
     rows = _rows(out)
     n_good = len(textbook_grasps()) + 20
     assert len(rows) == n_good + len(BAD_LINES) == summary.rows
@@ -63,7 +63,7 @@ def test_bad_lines_become_error_rows_and_the_run_goes_on(grasp_file, tmp_path):
 
 def test_cli_certify_exit_code_and_verify(grasp_file, tmp_path):
     out = tmp_path / "results.jsonl"
-    result = runner.invoke(app, ["certify", str(grasp_file), "-o", str(out), "-q"])
+    result = runner.invoke(app, ["certify", str(grasp_file), "-o", str(out), "-q", "--no-quality"])
     assert result.exit_code == 1  # some rows are errors
     result = runner.invoke(app, ["verify", str(out), "--grasps", str(grasp_file)])
     assert result.exit_code == 0, result.output
@@ -77,11 +77,16 @@ def test_cli_clean_file_exits_zero(tmp_path):
     assert by_id["antipodal-2d"]["force_closure"] is True
     assert by_id["antipodal-2d"]["form_closure"] is False
     assert by_id["cube-7"]["center"] == [0.0, 0.0, 0.0]
+    for row in by_id.values():  # epsilon columns: equal bounds in the plane, 0 without closure
+        assert 0 <= row["eps_l1_lo"] <= row["eps_l1_hi"] and 0 <= row["eps_linf_lo"] <= row["eps_linf_hi"]
+        assert (row["eps_l1_hi"] > 0) == (row["status"] == "closure")
+        if row["dim"] == 2:
+            assert row["eps_l1_lo"] == row["eps_l1_hi"]
 
 
 def test_verify_reports_tampered_rows(grasp_file, tmp_path):
     out = tmp_path / "results.jsonl"
-    certify_file(grasp_file, out)
+    certify_file(grasp_file, out, quality=False)
     rows = _rows(out)
     tampered = {}
     for row in rows:

@@ -1,0 +1,235 @@
+"""Ferrari-Canny epsilon: planar exact against qhull and closed forms, spatial bounds against
+independent fine linearisations, torque scaling, degenerate inputs, Steinitz efficiency."""
+
+import math
+from itertools import product
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.spatial import ConvexHull
+
+from certify import Contact, Grasp, force_closure
+from certify.quality import epsilon, epsilon_linearised
+from certify.samples import random_grasp, random_grasps
+from certify.steinitz import boundary_epsilon, efficiency, steinitz_bound
+from helpers import rotation
+
+
+def _square(s, L):
+    """Four frictionless contacts on the sides of [-1, 1]^2 whose torques cancel pairwise."""
+    contacts = (Contact((1, s), (-1, 0)), Contact((s, 1), (0, -1)),
+                Contact((-1, -s), (1, 0)), Contact((-s, -1), (0, 1)))
+    return Grasp(contacts, center=(0, 0), length=L)
+
+
+@pytest.mark.parametrize("s, L", [(0.5, 1.0), (0.5, 2.0), (0.3, 0.7), (0.8, math.sqrt(2))])
+def test_square_closed_forms(s, L):
+    """With tau = s / L the wrenches are w = (-1, 0, tau), (0, -1, -tau), (1, 0, tau),
+    (0, 1, -tau).
+
+    L1: the GWS is the tetrahedron on these points (the origin is their centroid). Its facet
+    through (+-1, 0, tau) and (0, 1, -tau) has normal (0, 2 tau, 1) up to sign and passes at
+    distance tau / sqrt(1 + 4 tau^2); by symmetry all four facets do, so
+    epsilon_L1 = tau / sqrt(1 + 4 tau^2).
+
+    Linf: the Minkowski sum of the segments [0, w_i] is a zonotope centred at sum(w)/2 = 0; its
+    facet normals are w_i x w_j and the support is sum_k |u . w_k| / 2. Pairs (1, 3) and (2, 4)
+    give unit normals e_y, e_x and support 1; the other pairs give (tau, tau, -1) up to signs,
+    with sum |u . w_k| = 4 tau, hence epsilon_Linf = min(1, 2 tau / sqrt(1 + 2 tau^2)).
+    """
+    g = _square(s, L)
+    tau = s / L
+    e1, einf = epsilon(g, "L1"), epsilon(g, "Linf")
+    assert e1.lo == e1.hi == pytest.approx(tau / math.sqrt(1 + 4 * tau**2), rel=1e-12)
+    assert einf.lo == pytest.approx(min(1.0, 2 * tau / math.sqrt(1 + 2 * tau**2)), rel=1e-12)
+    assert e1.center == (0.0, 0.0) and e1.length == L
+
+
+@pytest.mark.parametrize("mu", [0.2, 0.5, 1.0])
+@pytest.mark.parametrize("L", [0.5, 1.0, 3.0])
+def test_antipodal_closed_form_and_length_dependence(mu, L):
+    """Two opposite point contacts at (+-1, 0) with normals -+x, center 0. The four edge wrenches
+    are (-1, -mu, -mu/L), (-1, mu, mu/L), (1, mu, -mu/L), (1, -mu, mu/L): alternate corners of
+    the box [+-1] x [+-mu] x [+-mu/L], a tetrahedron centred at the origin whose facets are the
+    planes x + y / mu + z L / mu = 1 (with the other sign patterns), at distance
+    1 / sqrt(1 + 1/mu^2 + L^2/mu^2). So epsilon_L1 = mu / sqrt(mu^2 + 1 + L^2): it falls as the
+    length dividing torques grows, as documented (torque coordinates scale by 1/L)."""
+    g = Grasp((Contact((1, 0), (-1, 0), "point", mu), Contact((-1, 0), (1, 0), "point", mu)),
+              center=(0, 0), length=L)
+    assert epsilon(g).hi == pytest.approx(mu / math.sqrt(mu * mu + 1 + L * L), rel=1e-12)
+
+
+def _qhull_eps(points):
+    eq = ConvexHull(points).equations
+    return max(0.0, float((-eq[:, -1]).min()))
+
+
+def test_planar_epsilon_equals_qhull():
+    """Exact planar epsilon (facet-normal enumeration) against scipy's ConvexHull of the
+    generators (L1) and of all sums of per-contact vertices (Linf)."""
+    worst = 0.0
+    count = 0
+    for kw in (dict(n_contacts=3, model="point"), dict(n_contacts=2, model="point", spread=0.4),
+               dict(n_contacts=5, model="frictionless"), dict(n_contacts=4, model="point")):
+        for g in random_grasps(21, 150, dim=2, **kw):
+            if force_closure(g).status != "closure":
+                continue
+            from certify.wrench import generator_columns, grasp_arrays
+
+            P, N, mu, _, c, L = grasp_arrays(g)
+            W, owner = generator_columns(P, N, mu, tuple(x.model for x in g.contacts), c, L)
+            gens = W.T
+            l1 = _qhull_eps(np.vstack([np.zeros(3), gens]))
+            parts = [np.vstack([np.zeros(3), gens[owner == i]]) for i in range(len(g.contacts))]
+            sums = [sum(choice) for choice in product(*parts)]
+            linf = _qhull_eps(np.array(sums))
+            worst = max(worst, abs(epsilon(g, "L1").hi - l1), abs(epsilon(g, "Linf").hi - linf))
+            count += 1
+    assert count > 100
+    assert worst < 1e-12
+
+
+def _support_direct(g, u, norm):
+    """Exact support function written from first principles: for each contact the largest
+    u . w over wrenches of forces with unit normal component, a_n + mu norm(a_t) (plus the
+    torsional term), where a is the force-space functional of u."""
+    c = np.array(g.center)
+    vals = []
+    for ct in g.contacts:
+        n = np.array(ct.n)
+        r = np.array(ct.p) - c
+        uf, ut = u[:3], u[3:]
+        a = uf + np.cross(ut, r) / g.length  # u . (f, r x f / L) = f . (uf + (ut x r) / L)
+        an = a @ n
+        at = a - an * n
+        extra = 0.0
+        if ct.model == "soft":
+            extra = (ct.torsion * (ut @ n) / g.length) ** 2
+        v = an + ct.mu * math.sqrt(at @ at + extra) if ct.model != "frictionless" else an
+        vals.append(max(0.0, v))
+    return max(vals) if norm == "L1" else sum(vals)
+
+
+def _fine_lower(g, norm, edges=48):
+    """Epsilon of inscribed cones with many edges (qhull); a lower bound of the exact value."""
+    return epsilon_linearised(g, norm, edges)
+
+
+SPATIAL = [g for g in random_grasps(33, 60, dim=3, n_contacts=3, model="point", spread=0.3)
+           if force_closure(g).status == "closure"][:3]
+
+
+@pytest.mark.parametrize("norm", ["L1", "Linf"])
+def test_spatial_bounds_bracket_independent_estimates(norm):
+    from scipy.optimize import minimize
+
+    rng = np.random.default_rng(5)
+    for g in SPATIAL:
+        e = epsilon(g, norm)
+        assert 0 < e.lo <= e.hi
+        assert e.gap <= 0.0101
+        # upper bound: the exact support function (written independently) at sampled directions,
+        # polished locally; any direction's value is >= epsilon >= lo
+        U = rng.normal(size=(1000, 6))
+        U /= np.linalg.norm(U, axis=1, keepdims=True)
+        f = lambda x: _support_direct(g, x / np.linalg.norm(x), norm)
+        best = min(U, key=f)
+        ub = minimize(f, best, method="Nelder-Mead", options=dict(maxiter=3000)).fun
+        assert e.lo <= ub * (1 + 1e-9)
+        assert f(np.array(e.direction)) == pytest.approx(e.hi, rel=1e-9)  # hi is attained there
+        # lower bound: inscribed cones with many edges are inside the exact GWS
+        lower = _fine_lower(g, norm, edges=48 if norm == "L1" else 8)
+        assert lower <= e.hi * (1 + 1e-9)
+        if norm == "L1":
+            assert lower >= 0.97 * e.lo  # 48 edges lose little; the bracket is tight
+
+
+@given(st.integers(0, 2**32 - 1), st.floats(0.3, 3.0), st.integers(0, 2**32 - 1))
+@settings(max_examples=25)
+def test_scaling_everything_together_leaves_epsilon_unchanged(seed, scale, rseed):
+    rng = np.random.default_rng(seed)
+    g = random_grasp(rng, dim=2, n_contacts=3, model="point")
+    R = rotation(np.random.default_rng(rseed), 2)
+    moved = Grasp(tuple(Contact(scale * R @ np.array(c.p) + 5, R @ np.array(c.n), c.model, c.mu)
+                        for c in g.contacts),
+                  center=scale * R @ np.array(g.center) + 5, length=scale * g.length)
+    for norm in ("L1", "Linf"):
+        assert epsilon(moved, norm).hi == pytest.approx(epsilon(g, norm).hi, rel=1e-9, abs=1e-12)
+
+
+def test_spatial_scaling_leaves_bounds_consistent():
+    g = SPATIAL[0]
+    s = 2.5
+    big = Grasp(tuple(Contact(s * np.array(c.p), c.n, c.model, c.mu) for c in g.contacts),
+                center=s * np.array(g.center), length=s * g.length)
+    a, b = epsilon(g), epsilon(big)
+    assert a.lo <= b.hi * (1 + 1e-9) and b.lo <= a.hi * (1 + 1e-9)
+
+
+def test_margin_does_not_depend_on_center_or_length_but_epsilon_does():
+    g = _square(0.5, 1.0)
+    h = Grasp(g.contacts, center=(0.3, -0.2), length=4.0)
+    assert force_closure(g).margin == pytest.approx(force_closure(h).margin, rel=1e-12)
+    assert epsilon(g).hi != pytest.approx(epsilon(h).hi, rel=1e-3)
+
+
+degenerate = st.sampled_from(["duplicate", "collinear", "single", "antipodal-frictionless",
+                              "spatial-point-pair", "spatial-flat"])
+
+
+@given(degenerate, st.integers(0, 2**32 - 1))
+def test_degenerate_grasps_give_zero_without_raising(kind, seed):
+    rng = np.random.default_rng(seed)
+    p = rng.normal(size=2)
+    if kind == "duplicate":
+        contacts = (Contact(p, -p, "point", 0.5),) * 3
+    elif kind == "collinear":
+        contacts = tuple(Contact((x, 0.0), (0, 1), "point", 0.3) for x in rng.normal(size=4))
+    elif kind == "single":
+        contacts = (Contact(p, -p, "point", 0.5),)
+    elif kind == "antipodal-frictionless":
+        contacts = (Contact((1, 0), (-1, 0)), Contact((-1, 0), (1, 0)))
+    elif kind == "spatial-point-pair":
+        contacts = (Contact((0, 0, 1), (0, 0, -1), "point", 0.5),
+                    Contact((0, 0, -1), (0, 0, 1), "point", 0.5))
+    else:
+        contacts = tuple(Contact((x, y, 0.0), (0, 0, 1), "point", 0.2)
+                         for x, y in rng.normal(size=(4, 2)))
+    g = Grasp(contacts)
+    for norm in ("L1", "Linf"):
+        e = epsilon(g, norm)
+        assert e.lo == e.hi == 0.0
+    assert epsilon_linearised(g, "L1") >= 0.0
+
+
+def test_steinitz_square():
+    """Frictionless boundary wrenches of [-1, 1]^2 with center 0 and length sqrt(2) fill the
+    hull of the segments (+-1, 0, [-1, 1]/L) and (0, +-1, [-1, 1]/L): facets z = +-1/L and
+    +-x +- y = 1, so epsilon(S) = min(1/L, 1/sqrt(2)) = 1/sqrt(2). The square grasp above with
+    s = 0.5 has epsilon tau / sqrt(1 + 4 tau^2), tau = 0.5 / sqrt(2)."""
+    square = [(-1, -1), (1, -1), (1, 1), (-1, 1)]
+    eff = efficiency(_square(0.5, 1.0), square)
+    tau = 0.5 / math.sqrt(2)
+    assert eff.length == pytest.approx(math.sqrt(2))
+    assert eff.boundary_epsilon == pytest.approx(1 / math.sqrt(2), rel=1e-9)
+    assert eff.epsilon == pytest.approx(tau / math.sqrt(1 + 4 * tau**2), rel=1e-9)
+    assert eff.ratio == pytest.approx(eff.epsilon / eff.boundary_epsilon)
+    assert eff.bound is None  # 4 fingers < 2d = 6: no guarantee from the theorems
+    assert steinitz_bound(6, 3) == pytest.approx(1 / 45)
+
+
+@given(st.integers(0, 2**32 - 1))
+@settings(max_examples=20)
+def test_efficiency_never_exceeds_one(seed):
+    """A grasp's wrenches are a subset of the boundary's, so its efficiency is at most 1."""
+    rng = np.random.default_rng(seed)
+    angles = np.sort(rng.uniform(0, 2 * np.pi, 7))
+    poly = np.column_stack([np.cos(angles), np.sin(angles)]) * rng.uniform(0.5, 2.0)
+    from certify.steinitz import boundary_contacts
+
+    cs = boundary_contacts(poly, 0.05, model="point", mu=0.4)
+    pick = rng.choice(len(cs), 3, replace=False)
+    eff = efficiency(Grasp(tuple(cs[i] for i in pick)), poly, spacing=0.01)
+    assert 0.0 <= eff.ratio <= 1.0 + 1e-9
