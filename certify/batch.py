@@ -1,106 +1,178 @@
-"""Certify and re-verify whole grasp-set files."""
+"""Certify and re-verify whole grasp-set files (JSON Lines or Parquet, chosen by extension).
+
+:func:`certify_file` streams the input in chunks through :mod:`certify.engine` (parallel,
+resumable); :func:`certify_values` is what happens to one chunk; :func:`verify_file` re-checks a
+results file against its grasps, in parallel, without any solver.
+"""
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Iterator
+from typing import Any, Callable, Iterable, Iterator
 
 from .certificates import Tolerances
+from .engine import Options, RunSummary, _clean, run
 from .errors import CertifyError, GraspFileError
-from .io import read_grasps, read_rows, write_rows
+from .grasp import grasp_from_dict
 from .report import certify_grasp, error_row, verify_row
 from .solvers import make_solver
+from .table import iter_chunks, table_to_rows
 
-__all__ = ["Summary", "certify_file", "verify_file", "certify_rows"]
+__all__ = ["Summary", "certify_values", "certify_file", "verify_file"]
+
+
+def certify_values(values: Iterable[Any], lines: Iterable[int], options: Options = Options(),
+                   tol: Tolerances = Tolerances()) -> Iterator[dict]:
+    """One results row per parsed grasp value (a dict in the grasp schema, or the error met while
+    reading it), in order; bad values become ``error`` rows naming the line."""
+    solver = make_solver(options.method)
+    for value, number in zip(values, lines):
+        gid = value.get("id") if isinstance(value, dict) else None
+        if isinstance(value, Exception):
+            yield error_row(f"line {number}: {value}", id=gid, line=number)
+            continue
+        try:
+            grasp = grasp_from_dict(value)
+            report = certify_grasp(grasp, solver=solver, tol=tol, quality=options.quality,
+                                   eps_gap=options.eps_gap, eps_budget=options.eps_budget)
+            yield report.row(line=number)
+        except CertifyError as err:
+            yield error_row(f"line {number}: {err}", id=gid, line=number)
+
+
+def certify_file(grasps_path: str | Path, results_path: str | Path, *, method: str = "fast",
+                 progress: Callable[[int], None] | None = None, workers: int | None = 1,
+                 dask: str | None = None, resume: bool = False, chunk_size: int = 4096,
+                 quality: bool = True, eps_gap: float = 0.01, eps_budget: int = 200_000) -> RunSummary:
+    """Certify every grasp of ``grasps_path`` into ``results_path``: one results row per grasp,
+    in input order. See :func:`certify.engine.run` for ``workers``, ``dask``, ``resume`` and
+    ``chunk_size`` (``workers=None`` uses every core)."""
+    options = Options(method=method, quality=quality, eps_gap=eps_gap, eps_budget=eps_budget)
+    return run(grasps_path, results_path, options=options, workers=workers, dask=dask,
+               resume=resume, chunk_size=chunk_size, progress=progress)
 
 
 @dataclass
 class Summary:
-    """Counts of a certification or verification run."""
+    """Counts of a verification run; ``failures`` lists ``(id, reason)`` of the rows that fail."""
 
     rows: int = 0
     statuses: dict[str, int] = field(default_factory=dict)
-    unverified: int = 0
     failures: list[tuple[object, str]] = field(default_factory=list)
 
     @property
     def errors(self) -> int:
         return self.statuses.get("error", 0)
 
-    def add(self, status: str) -> None:
-        self.rows += 1
-        self.statuses[status] = self.statuses.get(status, 0) + 1
+
+def _result_rows(path: Path, size: int) -> Iterator[list[tuple[int, Any]]]:
+    """Results rows in chunks of ``size``: ``(position, row dict or error)``."""
+    import json
+
+    for chunk in iter_chunks(path, size):
+        if isinstance(chunk.rows, list):
+            out = []
+            for _, text in chunk.rows:
+                try:
+                    out.append(json.loads(text))
+                except json.JSONDecodeError:
+                    out.append(GraspFileError("not a JSON object"))
+            yield out
+        else:
+            yield table_to_rows(chunk.rows)
 
 
-def certify_rows(grasps_path: str | Path, *, method: str = "fast",
-                 tol: Tolerances = Tolerances(), **quality) -> Iterator[dict]:
-    """Yield one results row per grasp line of ``grasps_path`` (errors become ``error`` rows).
-
-    ``quality`` holds the epsilon options of :func:`certify.report.certify_grasp` (``quality``,
-    ``eps_gap``, ``eps_budget``)."""
-    solver = make_solver(method)
-    for number, gid, grasp in read_grasps(grasps_path):
-        if isinstance(grasp, CertifyError):
-            yield error_row(str(grasp), id=gid, line=number)
-            continue
-        try:
-            yield certify_grasp(grasp, solver=solver, tol=tol, **quality).row(line=number)
-        except CertifyError as err:
-            yield error_row(f"line {number}: {err}", id=gid, line=number)
-
-
-def certify_file(grasps_path: str | Path, results_path: str | Path, *, method: str = "fast",
-                 tol: Tolerances = Tolerances(),
-                 progress: Callable[[dict], None] | None = None, **quality) -> Summary:
-    """Certify every grasp of a JSON Lines grasp set and write one results row per grasp
-    (``quality``: epsilon options, see :func:`certify_rows`)."""
-    summary = Summary()
-
-    def rows():
-        for row in certify_rows(grasps_path, method=method, tol=tol, **quality):
-            summary.add(row["status"])
-            summary.unverified += row["status"] != "error" and not row["verified"]
-            if progress:
-                progress(row)
-            yield row
-
-    write_rows(results_path, rows())
-    return summary
-
-
-def verify_file(results_path: str | Path, grasps_path: str | Path,
-                tol: Tolerances = Tolerances()) -> Summary:
-    """Re-check every certificate of ``results_path`` against the grasps of ``grasps_path``.
-
-    Rows are matched to grasp lines by line number (falling back to order when a row has none) and
-    their ids must agree. Rows with status ``error`` have no certificate and are only counted.
-    Every row that fails is listed in ``summary.failures`` as ``(id, reason)``.
-    """
-    grasps = {number: (gid, g) for number, gid, g in read_grasps(grasps_path)}
-    order = sorted(grasps)
-    summary = Summary()
-    for i, (number, row) in enumerate(read_rows(results_path)):
-        if isinstance(row, GraspFileError) or not isinstance(row, dict):
-            summary.add("error")
-            summary.failures.append((None, f"results line {number}: not a JSON object"))
+def _verify_chunk(grasp_values: list, lines: list[int], rows: list, tol: Tolerances):
+    """Verify one chunk of aligned (grasp, results row) pairs; return counts and failures."""
+    statuses: dict[str, int] = {}
+    failures = []
+    for value, line, row in zip(grasp_values, lines, rows):
+        if not isinstance(row, dict):
+            statuses["error"] = statuses.get("error", 0) + 1
+            failures.append((None, f"results row for line {line}: not a JSON object"))
             continue
         status = str(row.get("status"))
-        summary.add(status)
-        line = row.get("line") if isinstance(row.get("line"), int) else (order[i] if i < len(order) else None)
-        if line not in grasps:
-            summary.failures.append((row.get("id"), f"no grasp on line {line} of {grasps_path}"))
+        statuses[status] = statuses.get(status, 0) + 1
+        gid = value.get("id") if isinstance(value, dict) else None
+        if row.get("line") not in (None, line):
+            failures.append((row.get("id"), f"results row is for line {row.get('line')}, grasp is line {line}"))
             continue
-        gid, grasp = grasps[line]
-        if row.get("id") != gid:
-            summary.failures.append((row.get("id"), f"id does not match grasp line {line} ({gid!r})"))
-        elif status == "error":
-            if not isinstance(grasp, CertifyError):
-                summary.failures.append((gid, "row says error but the grasp is valid"))
-        elif isinstance(grasp, CertifyError):
-            summary.failures.append((gid, f"grasp is invalid: {grasp}"))
+        if row.get("id") != gid and str(row.get("id")) != str(gid):
+            failures.append((row.get("id"), f"id does not match grasp line {line} ({gid!r})"))
+            continue
+        try:
+            grasp = grasp_from_dict(value) if isinstance(value, dict) else value
+        except CertifyError as err:
+            grasp = err
+        if status == "error":
+            if not isinstance(grasp, Exception):
+                failures.append((gid, "row says error but the grasp is valid"))
+        elif isinstance(grasp, Exception):
+            failures.append((gid, f"grasp is invalid: {grasp}"))
         else:
             check = verify_row(grasp, row, tol)
             if not check:
-                summary.failures.append((gid, check.reason))
+                failures.append((gid, check.reason))
+    return statuses, failures
+
+
+def _grasp_values(chunk) -> list:
+    import json
+
+    if isinstance(chunk.rows, list):
+        out = []
+        for _, text in chunk.rows:
+            try:
+                out.append(json.loads(text))
+            except json.JSONDecodeError as err:
+                out.append(GraspFileError(f"malformed JSON ({err.msg})"))
+        return out
+    return [_clean(d) for d in chunk.rows.to_pylist()]
+
+
+def verify_file(results_path: str | Path, grasps_path: str | Path,
+                tol: Tolerances = Tolerances(), workers: int | None = 1,
+                chunk_size: int = 4096) -> Summary:
+    """Re-check every certificate of ``results_path`` against the grasps of ``grasps_path``.
+
+    Rows and grasps are matched by position (a row's ``line`` and ``id`` must agree with its
+    grasp's). Rows with status ``error`` have no certificate; their grasp must indeed be invalid.
+    Chunks are verified in ``workers`` processes (``None``: every core).
+    """
+    results_path, grasps_path = Path(results_path), Path(grasps_path)
+    workers = workers or os.cpu_count() or 1
+    summary = Summary()
+    pool = ProcessPoolExecutor(workers) if workers > 1 else None
+    futures = []
+    try:
+        pairs = zip(iter_chunks(grasps_path, chunk_size), _result_rows(results_path, chunk_size))
+        for chunk, rows in pairs:
+            args = (_grasp_values(chunk), chunk.lines, rows, tol)
+            if pool is None:
+                _merge(summary, _verify_chunk(*args))
+                continue
+            futures.append(pool.submit(_verify_chunk, *args))
+            if len(futures) > 2 * workers:  # bounded memory: few chunks in flight
+                _merge(summary, futures.pop(0).result())
+        for f in futures:
+            _merge(summary, f.result())
+    finally:
+        if pool is not None:
+            pool.shutdown()
+    from .table import count_grasps
+
+    n_grasps, n_rows = count_grasps(grasps_path), count_grasps(results_path)
+    if n_rows != n_grasps:
+        summary.failures.append((None, f"{n_rows} results rows for {n_grasps} grasps"))
     return summary
+
+
+def _merge(summary: Summary, result) -> None:
+    statuses, failures = result
+    for status, n in statuses.items():
+        summary.statuses[status] = summary.statuses.get(status, 0) + n
+        summary.rows += n
+    summary.failures.extend(failures)

@@ -123,3 +123,70 @@ def compare_routes(grasps, kind: str = "", a: str = "fast", b: str = "reference"
         else:
             bad.append(g.id)
     return Agreement(kind, len(grasps), same, statuses, diff, tuple(bad))
+
+
+@dataclass(frozen=True)
+class QualityRow:
+    kind: str
+    norm: str
+    grasps: int
+    median_gap: float
+    worst_gap: float
+    median_ms: float
+    worst_ms: float
+    lin8_median_err: float | None  # relative error of the 8-edge linearisation vs exact cones
+    lin8_worst_err: float | None
+
+
+QUALITY_KINDS = {
+    "planar point, 3 contacts": dict(dim=2, n_contacts=3, model="point"),
+    "spatial point, 3 contacts": dict(dim=3, n_contacts=3, model="point", spread=0.3),
+    "spatial point, 4 contacts": dict(dim=3, n_contacts=4, model="point", spread=0.3),
+    "spatial soft, 2 contacts": dict(dim=3, n_contacts=2, model="soft", spread=0.15),
+}
+
+
+def run_quality_bench(n: int = 30, seed: int = 0, budget: int = 200_000) -> list[QualityRow]:
+    """Epsilon on ``n`` random grasps in closure per kind: the relative gap ``(hi - lo) / hi``
+    reached and the time per grasp, and for point contacts how far the 8-edge linearisation's
+    epsilon falls below the exact-cone value (relative to ``hi``; the true error lies between
+    that and the same relative to ``lo``)."""
+    import numpy as np
+
+    from .quality import epsilon, epsilon_linearised
+
+    rows = []
+    for kind, kwargs in QUALITY_KINDS.items():
+        grasps = [g for g in random_grasps(seed, 40 * n, **kwargs)
+                  if force_closure(g).status == "closure"][:n]
+        for norm in ("L1", "Linf"):
+            gaps, times, errs = [], [], []
+            for g in grasps:
+                start = time.perf_counter()
+                e = epsilon(g, norm, budget=budget)
+                times.append(1e3 * (time.perf_counter() - start))
+                gaps.append(e.gap)
+                linear = kwargs["model"] == "point" and kwargs["dim"] == 3
+                if linear and (norm == "L1" or kwargs["n_contacts"] <= 3):
+                    errs.append((e.hi - epsilon_linearised(g, norm, 8)) / e.hi)
+            rows.append(QualityRow(kind, norm, len(grasps), float(np.median(gaps)), max(gaps),
+                                   float(np.median(times)), max(times),
+                                   float(np.median(errs)) if errs else None,
+                                   max(errs) if errs else None))
+    return rows
+
+
+def print_quality_bench(rows: list[QualityRow]) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title="Ferrari-Canny epsilon: bound gap, time per grasp, 8-edge linearisation error")
+    for col in ("kind", "norm", "grasps", "gap median", "gap worst", "ms median", "ms worst",
+                "8-edge err median", "8-edge err worst"):
+        table.add_column(col, justify="left" if col in ("kind", "norm") else "right")
+    pct = lambda v: "-" if v is None else f"{100 * v:.2f} %"
+    for r in rows:
+        table.add_row(r.kind, r.norm, str(r.grasps), pct(r.median_gap), pct(r.worst_gap),
+                      f"{r.median_ms:.0f}", f"{r.worst_ms:.0f}", pct(r.lin8_median_err),
+                      pct(r.lin8_worst_err))
+    Console(width=max(140, Console().width)).print(table)

@@ -21,35 +21,35 @@ __all__ = ["register"]
 console = Console(stderr=True)
 
 
-def _count_lines(path: Path) -> int | None:
-    try:
-        with path.open("rb") as fh:
-            return sum(1 for line in fh if line.strip())
-    except OSError:
-        return None
-
-
 def certify_command(
-    grasps: Path = typer.Argument(..., help="Grasp set, JSON Lines (one grasp per line)."),
-    output: Path = typer.Option(..., "-o", "--output", help="Results file, JSON Lines."),
+    grasps: Path = typer.Argument(..., help="Grasp set: .jsonl (JSON Lines) or .parquet."),
+    output: Path = typer.Option(..., "-o", "--output", help="Results file: .jsonl or .parquet."),
     method: str = typer.Option("fast", help="'fast' (enumeration/clarabel) or 'reference' (cvxpy)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar or summary."),
     quality: bool = typer.Option(True, help="Compute the epsilon columns (eps_l1_lo ... eps_linf_hi)."),
     eps_gap: float = typer.Option(0.01, help="Spatial epsilon: stop when hi - lo <= gap * hi."),
-    eps_budget: float = typer.Option(5.0, help="Spatial epsilon: seconds per grasp and norm at most."),
+    eps_budget: int = typer.Option(200_000, help="Spatial epsilon: most work per grasp and norm, in direction cells examined."),
+    workers: int = typer.Option(0, help="Local worker processes (0: all cores)."),
+    dask: str = typer.Option(None, "--dask", help="'local' for a dask LocalCluster, or a scheduler address."),
+    resume: bool = typer.Option(False, "--resume", help="Continue an interrupted run, keeping its complete chunks."),
+    chunk_size: int = typer.Option(4096, help="Grasps per chunk (unit of work and checkpoint)."),
 ) -> None:
     """Certify form and force closure of every grasp, one results line per grasp line.
 
-    Exit code 1 when some rows are errors or failed their own re-check.
+    Exit code 1 when some rows are errors or failed their own re-check, 2 when the run could not
+    start (unreadable input, resume refused).
     """
-    total = _count_lines(grasps)
+    from .table import count_grasps
+
+    total = count_grasps(grasps)
     with Progress(TextColumn("certify"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
                   console=console, disable=quiet) as bar:
         task = bar.add_task("certify", total=total)
         try:
             summary = certify_file(grasps, output, method=method,
-                                   progress=lambda row: bar.advance(task), quality=quality,
-                                   eps_gap=eps_gap, eps_budget=eps_budget)
+                                   progress=lambda n: bar.advance(task, n), quality=quality,
+                                   eps_gap=eps_gap, eps_budget=eps_budget, workers=workers or None,
+                                   dask=dask, resume=resume, chunk_size=chunk_size)
         except CertifyError as err:
             console.print(f"[red]error:[/red] {err}")
             raise typer.Exit(2)
@@ -60,6 +60,8 @@ def certify_command(
         for status, count in sorted(summary.statuses.items()):
             table.add_row(status, str(count))
         table.add_row("unverified", str(summary.unverified))
+        if summary.resumed_chunks:
+            table.add_row("chunks kept from the interrupted run", str(summary.resumed_chunks))
         console.print(table)
     if summary.errors or summary.unverified:
         raise typer.Exit(1)
@@ -68,10 +70,11 @@ def certify_command(
 def verify_command(
     results: Path = typer.Argument(..., help="Results file written by 'qualgrasp certify'."),
     grasps: Path = typer.Option(..., "--grasps", help="The grasp set the results came from."),
+    workers: int = typer.Option(0, help="Worker processes (0: all cores)."),
 ) -> None:
     """Re-check every certificate without a solver; print the id of each one that fails."""
     try:
-        summary = verify_file(results, grasps)
+        summary = verify_file(results, grasps, workers=workers or None)
     except CertifyError as err:
         console.print(f"[red]error:[/red] {err}")
         raise typer.Exit(2)
@@ -88,11 +91,19 @@ def bench_command(
     n: int = typer.Option(2000, "--n", help="Grasps per kind."),
     seed: int = typer.Option(0, help="Random seed of the grasps."),
     reference_n: int = typer.Option(300, "--reference-n", help="Grasps per kind for slow routes."),
+    quality: bool = typer.Option(False, "--quality", help="Benchmark epsilon instead: gaps, times, 8-edge error."),
 ) -> None:
-    """Time the reference (cvxpy) and fast routes on the same random grasps; print a table."""
-    from .bench import print_bench, run_bench
+    """Time the reference (cvxpy) and fast routes on the same random grasps; print a table.
 
-    print_bench(run_bench(n=n, seed=seed, reference_n=reference_n))
+    With --quality: epsilon bound gaps and time per grasp, and the error of the 8-edge cone
+    linearisation other toolkits use, on --n random grasps in closure per kind.
+    """
+    from .bench import print_bench, print_quality_bench, run_bench, run_quality_bench
+
+    if quality:
+        print_quality_bench(run_quality_bench(n=n, seed=seed))
+    else:
+        print_bench(run_bench(n=n, seed=seed, reference_n=reference_n))
 
 
 def register(app: typer.Typer) -> None:

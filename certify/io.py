@@ -1,8 +1,9 @@
-"""Grasp-set and results files in JSON Lines: one JSON object per line.
+"""Reading and writing grasp sets and results, JSON Lines or Parquet by file extension.
 
 Grasp line: ``{"id": "g1", "contacts": [{"p": [x, y], "n": [nx, ny], "model": "point", "mu": 0.5}],
-"center": [cx, cy], "length": 1.0}`` (see :func:`certify.grasp.grasp_from_dict`). Blank lines are
-skipped; line numbers count from 1 and include them.
+"center": [cx, cy], "length": 1.0}`` (see :func:`certify.grasp.grasp_from_dict`); Parquet holds
+the same fields (:data:`certify.table.GRASP_SCHEMA`). In JSON Lines, blank lines are skipped and
+line numbers count from 1 and include them; in Parquet the line number is the row number.
 """
 
 from __future__ import annotations
@@ -11,54 +12,67 @@ import json
 from pathlib import Path
 from typing import Any, Iterable, Iterator
 
+import pyarrow.parquet as pq
+
 from .errors import CertifyError, GraspFileError
-from .grasp import Grasp, grasp_from_dict
+from .grasp import Grasp, grasp_from_dict, grasp_to_dict
+from .table import grasps_table, is_parquet, iter_chunks, rows_to_table, table_to_rows
 
-__all__ = ["read_grasps", "read_rows", "write_rows", "write_grasps"]
+__all__ = ["read_grasps", "write_grasps", "read_results", "write_rows"]
 
 
-def read_rows(path: str | Path) -> Iterator[tuple[int, Any | GraspFileError]]:
-    """Yield ``(line number, parsed JSON value or GraspFileError)`` for each non-blank line."""
-    path = Path(path)
-    try:
-        fh = path.open("r", encoding="utf-8")
-    except OSError as err:
-        raise GraspFileError(f"cannot read {path}: {err.strerror}") from None
-    with fh:
-        for number, text in enumerate(fh, start=1):
-            if not text.strip():
+def _values(chunk) -> Iterator[Any]:
+    """Parsed grasp values of a chunk (dicts, or the JSON error of a malformed line)."""
+    from .engine import _clean
+
+    if isinstance(chunk.rows, list):
+        for _, text in chunk.rows:
+            try:
+                yield json.loads(text)
+            except json.JSONDecodeError as err:
+                yield GraspFileError(f"malformed JSON ({err.msg} at column {err.colno})")
+    else:
+        yield from (_clean(d) for d in chunk.rows.to_pylist())
+
+
+def read_grasps(path: str | Path, chunk_size: int = 4096) -> Iterator[tuple[int, Any, Grasp | CertifyError]]:
+    """Yield ``(line number, id or None, Grasp or the error that line raised)``."""
+    for chunk in iter_chunks(path, chunk_size):
+        for number, value in zip(chunk.lines, _values(chunk)):
+            gid = value.get("id") if isinstance(value, dict) else None
+            if isinstance(value, CertifyError):
+                yield number, gid, type(value)(f"line {number}: {value}")
                 continue
             try:
-                yield number, json.loads(text)
-            except json.JSONDecodeError as err:
-                yield number, GraspFileError(f"line {number}: malformed JSON ({err.msg} at column {err.colno})")
-
-
-def read_grasps(path: str | Path) -> Iterator[tuple[int, Any, Grasp | CertifyError]]:
-    """Yield ``(line number, id or None, Grasp or the error that line raised)``."""
-    for number, value in read_rows(path):
-        if isinstance(value, GraspFileError):
-            yield number, None, value
-            continue
-        gid = value.get("id") if isinstance(value, dict) else None
-        try:
-            yield number, gid, grasp_from_dict(value)
-        except CertifyError as err:
-            yield number, gid, type(err)(f"line {number}: {err}")
-
-
-def write_rows(path: str | Path, rows: Iterable[dict[str, Any]]) -> int:
-    """Write ``rows`` as JSON Lines; return how many were written."""
-    count = 0
-    with Path(path).open("w", encoding="utf-8") as fh:
-        for row in rows:
-            fh.write(json.dumps(row, allow_nan=False) + "\n")
-            count += 1
-    return count
+                yield number, gid, grasp_from_dict(value)
+            except CertifyError as err:
+                yield number, gid, type(err)(f"line {number}: {err}")
 
 
 def write_grasps(path: str | Path, grasps: Iterable[Grasp]) -> int:
-    """Write grasps in the grasp-set schema."""
-    from .grasp import grasp_to_dict
+    """Write grasps in the grasp-set schema; return how many were written."""
+    return _write(path, [grasp_to_dict(g) for g in grasps], grasps_table)
 
-    return write_rows(path, (grasp_to_dict(g) for g in grasps))
+
+def read_results(path: str | Path, chunk_size: int = 4096) -> Iterator[dict]:
+    """Yield the rows of a results file as dictionaries."""
+    for chunk in iter_chunks(path, chunk_size):
+        if isinstance(chunk.rows, list):
+            yield from (json.loads(text) for _, text in chunk.rows)
+        else:
+            yield from table_to_rows(chunk.rows)
+
+
+def write_rows(path: str | Path, rows: Iterable[dict[str, Any]]) -> int:
+    """Write results rows; return how many were written."""
+    return _write(path, list(rows), rows_to_table)
+
+
+def _write(path: str | Path, rows: list[dict], to_table) -> int:
+    if is_parquet(path):
+        pq.write_table(to_table(rows), path)
+    else:
+        with Path(path).open("w", encoding="utf-8") as fh:
+            for row in rows:
+                fh.write(json.dumps(row, allow_nan=False) + "\n")
+    return len(rows)

@@ -32,7 +32,6 @@ first, so flat hulls and rank-deficient sets never reach qhull.
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 from itertools import combinations
 
@@ -68,7 +67,7 @@ class Epsilon:
     exact : bool
         True when ``lo == hi`` by construction (planar grasps, grasps not in closure).
     rounds : int
-        Refinement rounds spent (spatial grasps).
+        Branch-and-bound rounds spent (spatial grasps).
     """
 
     norm: str
@@ -186,8 +185,8 @@ def _zero(grasp: Grasp, norm: str) -> Epsilon:
     return Epsilon(norm, 0.0, 0.0, None, tuple(grasp.center), grasp.length, True)
 
 
-def epsilon(grasp: Grasp, norm: str = "L1", *, rel_gap: float = 0.01, max_rounds: int = 200,
-            time_budget: float = 5.0, verdict: Verdict | None = None) -> Epsilon:
+def epsilon(grasp: Grasp, norm: str = "L1", *, rel_gap: float = 0.01, budget: int = 200_000,
+            verdict: Verdict | None = None) -> Epsilon:
     """Ferrari-Canny epsilon of ``grasp`` for the ``norm`` GWS (module docstring).
 
     Parameters
@@ -196,8 +195,10 @@ def epsilon(grasp: Grasp, norm: str = "L1", *, rel_gap: float = 0.01, max_rounds
     norm : {'L1', 'Linf'}
     rel_gap : float
         Spatial grasps: stop when ``hi - lo <= rel_gap * hi``.
-    max_rounds, time_budget : int, float
-        Spatial grasps: refinement budget (rounds, seconds); the gap reached is reported.
+    budget : int
+        Spatial grasps: the most work spent, in cells of the sphere of directions examined (an
+        exact cell bound, an SOCP, counts as :data:`EXACT_CELL_COST` cells); the gap reached is
+        reported. A count, not a time, so that results are reproducible on any machine.
     verdict : Verdict, optional
         The grasp's force-closure verdict, if already known.
 
@@ -217,7 +218,7 @@ def epsilon(grasp: Grasp, norm: str = "L1", *, rel_gap: float = 0.01, max_rounds
         i = int(np.argmin(h))
         return Epsilon(norm, float(h[i]), float(h[i]), tuple(U[i]), tuple(grasp.center),
                        grasp.length, True)
-    return _refine(grasp, system, norm, rel_gap, max_rounds, time_budget)
+    return _refine(grasp, system, norm, rel_gap, budget)
 
 
 class _Pieces:
@@ -390,8 +391,8 @@ class _Pieces:
         return u, h_u, grad
 
 
-#: Largest cube-face box side (of [-1, 1]) whose flat minimum is worth an exact solve.
-EXACT_CELL_SIDE = 2.0
+#: Work of one exact cell bound (an SOCP) in units of cheap cell bounds, for the budget.
+EXACT_CELL_COST = 25
 
 
 class _CellSolver:
@@ -512,19 +513,19 @@ def _initial_directions(d: int) -> np.ndarray:
     return np.vstack([np.eye(d), -np.eye(d), R / np.linalg.norm(R, axis=1, keepdims=True)])
 
 
-def _refine(grasp, system, norm, rel_gap, max_rounds, time_budget) -> Epsilon:
+def _refine(grasp, system, norm, rel_gap, budget) -> Epsilon:
     """Branch and bound over the sphere of wrench directions (see :func:`epsilon`)."""
-    start = time.perf_counter()
     pieces = _Pieces(system)
     d = system.columns.shape[0]
     U = _initial_directions(d)
     h = pieces.h(U, norm)
     u_best, hi, g_star = pieces.local_minimum(U[int(np.argmin(h))], norm)
-    faces, lo_box, hi_box = _face_cells(d, 4)
+    faces, lo_box, hi_box = _face_cells(d, 2)
     exact_cells = _CellSolver(pieces, 2 ** (d - 1), norm) if norm == "L1" else None
-    retired, rounds = np.inf, 0
+    retired, rounds, examined = np.inf, 0, 0
     while True:
         rounds += 1
+        examined += len(faces)
         V, centre = _cell_vertices(faces, lo_box, hi_box, d)
         hc = pieces.h(centre, norm)
         k = int(np.argmin(hc))
@@ -534,15 +535,14 @@ def _refine(grasp, system, norm, rel_gap, max_rounds, time_budget) -> Epsilon:
                 u_best, hi, g_star = u, h_u, g
         bound = np.maximum(pieces.cell_bound(V, centre, norm), (V @ g_star).min(axis=1))
         if exact_cells is not None:
-            # flat cells of wide angle lose up to 1 - cos(angle): split those without solving
-            small = (hi_box - lo_box).max(axis=1) <= EXACT_CELL_SIDE
-            for i in np.flatnonzero((bound < (1 - rel_gap) * hi) & small):
+            for i in np.flatnonzero(bound < (1 - rel_gap) * hi):
                 bound[i] = max(bound[i], exact_cells.bound(V[i]))
+                examined += EXACT_CELL_COST
         target = (1 - rel_gap) * hi
         done = bound >= target
         retired = min(retired, bound[done].min(initial=np.inf))
         lo = min(retired, bound[~done].min(initial=np.inf))
-        if done.all() or rounds >= max_rounds or time.perf_counter() - start > time_budget:
+        if done.all() or examined + 2 * np.count_nonzero(~done) > budget:
             break
         faces, lo_box, hi_box = faces[~done], lo_box[~done], hi_box[~done]
         # split every open cell in two across its longest side

@@ -64,10 +64,10 @@ class Report:
 
 def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
                   tol: Tolerances = Tolerances(), quality: bool = True, eps_gap: float = 0.01,
-                  eps_budget: float = 5.0) -> Report:
+                  eps_budget: int = 200_000) -> Report:
     """Force closure, form closure, the re-check of both certificates and, with ``quality``,
     the L1 and L-infinity epsilon of ``grasp`` (spatial bounds refined to ``eps_gap`` or
-    ``eps_budget`` seconds per norm)."""
+    ``eps_budget`` cells of directions per norm, see :func:`certify.quality.epsilon`)."""
     force = force_closure(grasp, method=method, solver=solver, tol=tol)
     form = force if grasp.frictionless else form_closure(grasp, method=method, solver=solver, tol=tol)
     ok = all(
@@ -76,7 +76,7 @@ def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
     )
     eps = None
     if quality:
-        eps = {norm: epsilon(grasp, norm, rel_gap=eps_gap, time_budget=eps_budget, verdict=force)
+        eps = {norm: epsilon(grasp, norm, rel_gap=eps_gap, budget=eps_budget, verdict=force)
                for norm in ("L1", "Linf")}
     return Report(grasp, force, form, ok, eps)
 

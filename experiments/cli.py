@@ -46,3 +46,7 @@ def demo_command(out: Path = typer.Option(Path("qualgrasp-demo"), "--out", help=
 
 def main() -> None:
     app()
+
+
+if __name__ == "__main__":
+    main()

@@ -69,7 +69,7 @@ def _triplets(problem: ClosureProblem):
 class _Built:
     """A clarabel solver prebuilt for one structure, and how to refill its ``A`` values."""
 
-    def __init__(self, problem: ClosureProblem) -> None:
+    def __init__(self, problem: ClosureProblem, equilibrate: bool = False) -> None:
         rows, cols, vals, m, cones = _triplets(problem)
         n = problem.nvar + 1
         # CSC order of the triplets: fill a matrix with their indices and read them back.
@@ -84,7 +84,9 @@ class _Built:
         b[problem.d] = 1.0
         q = np.zeros(n)
         q[-1] = -1.0
-        self.solver = clarabel.DefaultSolver(sp.csc_matrix((n, n)), q, A, b, cones, settings())
+        s = settings()
+        s.equilibrate_enable = equilibrate
+        self.solver = clarabel.DefaultSolver(sp.csc_matrix((n, n)), q, A, b, cones, s)
         self.fresh = True
 
     def solve(self, problem: ClosureProblem):
@@ -107,6 +109,9 @@ def _cone_rows(problem: ClosureProblem):
     return out
 
 
+_ANSWERS = ("Solved", "AlmostSolved", "PrimalInfeasible", "AlmostPrimalInfeasible")
+
+
 class ClarabelSolver:
     """Solve closure programmes with clarabel directly; one prebuilt solver per structure."""
 
@@ -114,11 +119,18 @@ class ClarabelSolver:
         self._built: dict[tuple, _Built] = {}
 
     def solve(self, problem: ClosureProblem) -> Solution:
+        # A prebuilt solver is refilled without equilibration: updating would reuse the scaling
+        # computed for the first problem, making results depend on which grasp came first.
+        # Closure data are well scaled (unit normals, torques divided by the length); the rare
+        # problem that needs equilibration gets a fresh, equilibrated solver of its own.
         key = problem.structure
         if key not in self._built:
             self._built[key] = _Built(problem)
         sol = self._built[key].solve(problem)
         status = str(sol.status)
+        if status not in _ANSWERS:
+            sol = _Built(problem, equilibrate=True).solve(problem)
+            status = str(sol.status)
         z = np.asarray(sol.z)
         if status in ("Solved", "AlmostSolved"):
             x = np.asarray(sol.x)

@@ -1,0 +1,291 @@
+"""Resumable, parallel certification of large grasp sets.
+
+The input is read in chunks of a fixed number of grasps (:func:`certify.table.iter_chunks`).
+Each chunk is certified by a worker (local processes by default, or a dask.distributed cluster)
+which writes its results to ``RESULTS.parts/part-NNNNNN.EXT`` under a temporary name and renames
+it atomically when complete. When every part exists they are concatenated, in chunk order, into a
+temporary file renamed to ``RESULTS``, and the parts folder is removed.
+
+A run killed at any moment leaves only complete parts (plus temporaries, discarded).
+``resume=True`` keeps the complete parts and certifies only the missing chunks, so every input
+grasp appears exactly once, with the same result as in an uninterrupted run (the computation of a
+chunk is deterministic). ``RESULTS.parts/manifest.json`` records the input and the options; a
+resume with a different input, chunk size or options is refused.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from .errors import CertifyError, GraspFileError
+from .table import Chunk, RESULT_SCHEMA, count_grasps, is_parquet, iter_chunks
+
+__all__ = ["Options", "RunSummary", "run", "certify_chunk"]
+
+
+@dataclass(frozen=True)
+class Options:
+    """What is computed for every grasp (recorded in the manifest; part of a chunk's identity)."""
+
+    method: str = "fast"
+    quality: bool = True
+    eps_gap: float = 0.01
+    eps_budget: int = 200_000
+
+
+@dataclass
+class RunSummary:
+    """Counts of a certification run."""
+
+    rows: int = 0
+    statuses: dict[str, int] = field(default_factory=dict)
+    unverified: int = 0
+    chunks: int = 0
+    resumed_chunks: int = 0
+
+    @property
+    def errors(self) -> int:
+        return self.statuses.get("error", 0)
+
+    def add(self, counts: dict[str, int], unverified: int) -> None:
+        for status, n in counts.items():
+            self.statuses[status] = self.statuses.get(status, 0) + n
+            self.rows += n
+        self.unverified += unverified
+
+
+def _clean(d: Any) -> Any:
+    """Drop null fields (Parquet's missing values) so that defaults apply as in JSON."""
+    if not isinstance(d, dict):
+        return d
+    out = {k: v for k, v in d.items() if v is not None}
+    if isinstance(out.get("contacts"), list):
+        out["contacts"] = [_clean(c) for c in out["contacts"]]
+    return out
+
+
+def _chunk_rows(chunk: Chunk, options: Options) -> list[dict]:
+    """Certify every grasp of ``chunk``; one results row each, in input order."""
+    from .batch import certify_values
+
+    if isinstance(chunk.rows, pa.Table):
+        values = [_clean(d) for d in chunk.rows.to_pylist()]
+        texts = None
+    else:
+        values, texts = [], [text for _, text in chunk.rows]
+        for _, text in chunk.rows:
+            try:
+                values.append(json.loads(text))
+            except json.JSONDecodeError as err:
+                values.append(GraspFileError(f"malformed JSON ({err.msg} at column {err.colno})"))
+    return list(certify_values(values, chunk.lines, options))
+
+
+def _write_part(rows: list[dict], path: Path) -> None:
+    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")  # writers never share a temporary
+    if is_parquet(path):
+        from .table import rows_to_table
+
+        pq.write_table(rows_to_table(rows), tmp)
+    else:
+        with tmp.open("w", encoding="utf-8") as fh:
+            for row in rows:
+                fh.write(json.dumps(row, allow_nan=False) + "\n")
+    os.replace(tmp, path)  # atomic: a part exists only when complete
+
+
+def certify_chunk(chunk: Chunk, options: Options, part: str) -> tuple[int, dict[str, int], int]:
+    """Certify ``chunk`` and write its results to ``part`` atomically.
+
+    Returns ``(chunk index, status counts, unverified count)``. This is the unit of work sent to
+    local processes or dask workers.
+    """
+    rows = _chunk_rows(chunk, options)
+    _write_part(rows, Path(part))
+    counts: dict[str, int] = {}
+    for r in rows:
+        counts[r["status"]] = counts.get(r["status"], 0) + 1
+    unverified = sum(1 for r in rows if r["status"] != "error" and not r["verified"])
+    return chunk.index, counts, unverified
+
+
+def _part_counts(part: Path) -> tuple[dict[str, int], int]:
+    if is_parquet(part):
+        t = pq.read_table(part, columns=["status", "verified"]).to_pydict()
+        statuses, verified = t["status"], t["verified"]
+    else:
+        rows = [json.loads(line) for line in part.read_text(encoding="utf-8").splitlines()]
+        statuses, verified = [r["status"] for r in rows], [r["verified"] for r in rows]
+    counts: dict[str, int] = {}
+    for s in statuses:
+        counts[s] = counts.get(s, 0) + 1
+    return counts, sum(1 for s, v in zip(statuses, verified) if s != "error" and not v)
+
+
+def _manifest(grasps: Path, results: Path, chunk_size: int, options: Options) -> dict:
+    st = grasps.stat()
+    return {"input": str(grasps.resolve()), "input_size": st.st_size, "input_mtime_ns": st.st_mtime_ns,
+            "output": str(results.resolve()), "chunk_size": chunk_size, "options": asdict(options)}
+
+
+def _prepare(grasps: Path, results: Path, chunk_size: int, options: Options, resume: bool) -> Path:
+    parts = results.with_name(results.name + ".parts")
+    manifest = _manifest(grasps, results, chunk_size, options)
+    if resume and parts.exists():
+        try:
+            old = json.loads((parts / "manifest.json").read_text())
+        except (OSError, json.JSONDecodeError):
+            old = None
+        if old != manifest:
+            raise CertifyError(f"cannot resume: {parts} was made from another input or with other "
+                               "options (chunk size, method, quality); run without --resume to start over")
+        for tmp in parts.glob("*.tmp"):
+            tmp.unlink()
+        return parts
+    if parts.exists():
+        shutil.rmtree(parts)
+    parts.mkdir(parents=True)
+    tmp = parts / "manifest.json.tmp"
+    tmp.write_text(json.dumps(manifest, indent=1))
+    os.replace(tmp, parts / "manifest.json")
+    return parts
+
+
+def _assemble(parts: Path, n_chunks: int, results: Path) -> None:
+    ext = results.suffix
+    tmp = results.with_name(results.name + ".tmp")
+    if is_parquet(results):
+        with pq.ParquetWriter(tmp, RESULT_SCHEMA) as writer:
+            for i in range(n_chunks):
+                writer.write_table(pq.read_table(parts / f"part-{i:06d}{ext}"))
+    else:
+        with tmp.open("wb") as out:
+            for i in range(n_chunks):
+                with (parts / f"part-{i:06d}{ext}").open("rb") as fh:
+                    shutil.copyfileobj(fh, out)
+    os.replace(tmp, results)
+    shutil.rmtree(parts)
+
+
+class _LocalPool:
+    def __init__(self, workers: int) -> None:
+        self.pool = ProcessPoolExecutor(max_workers=workers)
+        self.capacity = 2 * workers
+
+    def submit(self, *args):
+        return self.pool.submit(certify_chunk, *args)
+
+    @staticmethod
+    def wait_one(futures):
+        done, _ = wait(futures, return_when=FIRST_COMPLETED)
+        return done
+
+    def close(self) -> None:
+        self.pool.shutdown(cancel_futures=True)
+
+
+class _DaskPool:
+    def __init__(self, address: str, workers: int) -> None:
+        try:
+            from distributed import Client, LocalCluster
+        except ImportError:
+            raise CertifyError('dask is an optional extra: pip install "qualgrasp[dask]"') from None
+        if address == "local":
+            self.cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                        dashboard_address=None)
+            self.client = Client(self.cluster)
+        else:
+            self.cluster = None
+            self.client = Client(address)
+        self.capacity = 2 * max(1, len(self.client.scheduler_info()["workers"]))
+
+    def submit(self, *args):
+        return self.client.submit(certify_chunk, *args, pure=False)
+
+    @staticmethod
+    def wait_one(futures):
+        from distributed import wait as dwait
+
+        return dwait(list(futures), return_when="FIRST_COMPLETED").done
+
+    def close(self) -> None:
+        self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+
+def run(grasps: str | Path, results: str | Path, *, options: Options = Options(),
+        workers: int | None = None, dask: str | None = None, resume: bool = False,
+        chunk_size: int = 4096,
+        progress: Callable[[int], None] | None = None) -> RunSummary:
+    """Certify the grasp set ``grasps`` into ``results`` (formats by extension), in parallel.
+
+    Parameters
+    ----------
+    workers : int, optional
+        Local worker processes (default: all cores). With 1, chunks are certified in this process.
+    dask : str, optional
+        ``"local"`` for a dask LocalCluster of ``workers`` processes, or a scheduler address.
+    resume : bool
+        Keep the complete chunks of an interrupted run and certify only the rest.
+    chunk_size : int
+        Grasps per chunk (the unit of work, of checkpointing and of memory).
+    progress : callable, optional
+        Called with the number of grasps of each chunk as it completes (or is found complete).
+    """
+    grasps, results = Path(grasps), Path(results)
+    if count_grasps(grasps) is None:
+        raise GraspFileError(f"cannot read {grasps}")
+    workers = workers or os.cpu_count() or 1
+    parts = _prepare(grasps, results, chunk_size, options, resume)
+    ext = results.suffix
+    summary = RunSummary()
+    pool = _DaskPool(dask, workers) if dask else (_LocalPool(workers) if workers > 1 else None)
+    pending: dict[Any, int] = {}
+
+    def collect(future) -> None:
+        _, counts, unverified = future.result()
+        summary.add(counts, unverified)
+        size = pending.pop(future)
+        if progress:
+            progress(size)
+
+    try:
+        n_chunks = 0
+        for chunk in iter_chunks(grasps, chunk_size):
+            n_chunks += 1
+            part = parts / f"part-{chunk.index:06d}{ext}"
+            if part.exists():
+                summary.add(*_part_counts(part))
+                summary.resumed_chunks += 1
+                if progress:
+                    progress(len(chunk))
+                continue
+            if pool is None:
+                _, counts, unverified = certify_chunk(chunk, options, str(part))
+                summary.add(counts, unverified)
+                if progress:
+                    progress(len(chunk))
+                continue
+            while len(pending) >= pool.capacity:
+                for future in pool.wait_one(pending):
+                    collect(future)
+            pending[pool.submit(chunk, options, str(part))] = len(chunk)
+        while pending:
+            for future in pool.wait_one(pending):
+                collect(future)
+    finally:
+        if pool is not None:
+            pool.close()
+    summary.chunks = n_chunks
+    _assemble(parts, n_chunks, results)
+    return summary

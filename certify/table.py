@@ -1,0 +1,163 @@
+"""Grasp sets and results as Arrow tables: the Parquet schema, and streaming in fixed-size chunks.
+
+Parquet files hold the same schema as the JSON Lines files of :mod:`certify.io`:
+
+* grasps: ``id`` (string), ``contacts`` (list of struct ``p``, ``n`` (lists of float64),
+  ``model`` (string), ``mu``, ``torsion`` (float64, nullable)), ``center`` (list of float64,
+  nullable), ``length`` (float64, nullable);
+* results: the columns of :meth:`certify.report.Report.row`, with ``certificate`` a struct
+  ``{force, form}`` of certificate structs.
+
+The format of a file is chosen by its extension: ``.parquet`` / ``.pq`` for Parquet, anything
+else (``.jsonl``, ``.json``, ``.ndjson``) for JSON Lines. Both are read in chunks of a fixed number
+of grasps, so memory stays bounded whatever the file's size, and a chunk's boundaries do not
+depend on how the file was written (needed to resume an interrupted run).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Iterator
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from .errors import GraspFileError
+
+__all__ = ["CONTACT", "GRASP_SCHEMA", "CERTIFICATE", "RESULT_SCHEMA", "is_parquet", "Chunk",
+           "iter_chunks", "count_grasps", "grasps_table", "rows_to_table", "table_to_rows"]
+
+CONTACT = pa.struct([
+    ("p", pa.list_(pa.float64())), ("n", pa.list_(pa.float64())), ("model", pa.string()),
+    ("mu", pa.float64()), ("torsion", pa.float64()),
+])
+GRASP_SCHEMA = pa.schema([
+    ("id", pa.string()), ("contacts", pa.list_(CONTACT)), ("center", pa.list_(pa.float64())),
+    ("length", pa.float64()),
+])
+CERTIFICATE = pa.struct([
+    ("kind", pa.string()), ("layout", pa.string()), ("values", pa.list_(pa.float64())),
+    ("basis", pa.list_(pa.int32())), ("y", pa.list_(pa.float64())), ("tight", pa.list_(pa.int32())),
+    ("null_space", pa.bool_()), ("reason", pa.string()),
+])
+RESULT_SCHEMA = pa.schema([
+    ("id", pa.string()), ("line", pa.int64()), ("dim", pa.int8()), ("status", pa.string()),
+    ("form_closure", pa.bool_()), ("force_closure", pa.bool_()), ("margin", pa.float64()),
+    ("form_status", pa.string()), ("form_margin", pa.float64()),
+    ("certificate", pa.struct([("force", CERTIFICATE), ("form", CERTIFICATE)])),
+    ("verified", pa.bool_()), ("error", pa.string()), ("center", pa.list_(pa.float64())),
+    ("length", pa.float64()), ("n_contacts", pa.int32()),
+    ("eps_l1_lo", pa.float64()), ("eps_l1_hi", pa.float64()),
+    ("eps_linf_lo", pa.float64()), ("eps_linf_hi", pa.float64()),
+])
+
+
+def is_parquet(path: str | Path) -> bool:
+    """True for ``.parquet`` / ``.pq`` files (Parquet), False for JSON Lines."""
+    return Path(path).suffix.lower() in (".parquet", ".pq")
+
+
+@dataclass(frozen=True)
+class Chunk:
+    """``index``-th chunk of a grasp set: its rows with their line numbers (1-based; JSON Lines
+    count blank lines too, Parquet counts rows). ``rows`` is a list of ``(line, text)`` for JSON
+    Lines and an Arrow table for Parquet."""
+
+    index: int
+    lines: list[int]
+    rows: Any
+
+    def __len__(self) -> int:
+        return len(self.lines)
+
+
+def _open_error(path: Path, err: Exception) -> GraspFileError:
+    return GraspFileError(f"cannot read {path}: {getattr(err, 'strerror', None) or err}")
+
+
+def iter_chunks(path: str | Path, size: int) -> Iterator[Chunk]:
+    """Yield the grasp set at ``path`` in chunks of ``size`` grasps (the last may be shorter)."""
+    path = Path(path)
+    if is_parquet(path):
+        try:
+            reader = pq.ParquetFile(path)
+        except (OSError, pa.ArrowException) as err:
+            raise _open_error(path, err) from None
+        buffered, start, index = [], 0, 0
+        pending = 0
+        for batch in reader.iter_batches(batch_size=size):
+            buffered.append(batch)
+            pending += batch.num_rows
+            while pending >= size:
+                table = pa.Table.from_batches(buffered).combine_chunks()
+                yield Chunk(index, list(range(start + 1, start + size + 1)), table.slice(0, size))
+                rest = table.slice(size)
+                buffered, pending = rest.to_batches(), rest.num_rows
+                start, index = start + size, index + 1
+        if pending:
+            table = pa.Table.from_batches(buffered, schema=reader.schema_arrow)
+            yield Chunk(index, list(range(start + 1, start + pending + 1)), table)
+        return
+    try:
+        fh = path.open("r", encoding="utf-8")
+    except OSError as err:
+        raise _open_error(path, err) from None
+    with fh:
+        rows, index = [], 0
+        for number, text in enumerate(fh, start=1):
+            if text.strip():
+                rows.append((number, text))
+                if len(rows) == size:
+                    yield Chunk(index, [n for n, _ in rows], rows)
+                    rows, index = [], index + 1
+        if rows:
+            yield Chunk(index, [n for n, _ in rows], rows)
+
+
+def count_grasps(path: str | Path) -> int | None:
+    """Number of grasps in the file (Parquet metadata, or a scan of JSON Lines), None if unreadable."""
+    path = Path(path)
+    try:
+        if is_parquet(path):
+            return pq.ParquetFile(path).metadata.num_rows
+        with path.open("rb") as fh:
+            return sum(1 for line in fh if line.strip())
+    except (OSError, pa.ArrowException):
+        return None
+
+
+def grasps_table(dicts: list[dict]) -> pa.Table:
+    """Arrow table (grasp schema) of grasp dictionaries in the JSON schema; ids become strings."""
+    rows = []
+    for d in dicts:
+        contacts = [{"p": c["p"], "n": c["n"], "model": c.get("model"), "mu": c.get("mu"),
+                     "torsion": c.get("torsion")} for c in d["contacts"]]
+        gid = d.get("id")
+        rows.append({"id": None if gid is None else str(gid), "contacts": contacts,
+                     "center": d.get("center"), "length": d.get("length")})
+    return pa.Table.from_pylist(rows, schema=GRASP_SCHEMA)
+
+
+def rows_to_table(rows: list[dict]) -> pa.Table:
+    """Arrow table (results schema) of results rows; ids become strings."""
+    fixed = []
+    for r in rows:
+        r = dict(r)
+        if r.get("id") is not None and not isinstance(r["id"], str):
+            r["id"] = json.dumps(r["id"]) if not isinstance(r["id"], (int, float)) else str(r["id"])
+        fixed.append(r)
+    return pa.Table.from_pylist(fixed, schema=RESULT_SCHEMA)
+
+
+def table_to_rows(table: pa.Table) -> list[dict]:
+    """Results rows (dictionaries) of an Arrow results table; empty certificate fields dropped."""
+    rows = table.to_pylist()
+    for r in rows:
+        cert = r.get("certificate")
+        if cert:
+            for key in ("force", "form"):
+                if cert.get(key):
+                    cert[key] = {k: v for k, v in cert[key].items() if v is not None}
+    return rows

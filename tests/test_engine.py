@@ -1,0 +1,118 @@
+"""Chunked, parallel, resumable certification: Parquet and JSON Lines, kill -9 and resume, dask."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pyarrow.parquet as pq
+import pytest
+
+from certify import Grasp
+from certify.batch import certify_file, verify_file
+from certify.io import read_results, write_grasps
+from certify.samples import random_grasps, textbook_grasps
+
+BAD = '{"id": "bad", "contacts": [{"p": [0, 0], "n": [0, 0]}]}\n'
+
+
+@pytest.fixture(scope="module")
+def grasp_files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("grasps")
+    spatial = random_grasps(2, 60, dim=3, n_contacts=3, model="point", spread=0.3)
+    grasps = (textbook_grasps() + random_grasps(1, 300, dim=2, n_contacts=3)
+              + [Grasp(g.contacts, id=f"s{i}") for i, g in enumerate(spatial)])
+    jsonl, parquet = d / "g.jsonl", d / "g.parquet"
+    write_grasps(jsonl, grasps)
+    with jsonl.open("a") as fh:
+        fh.write(BAD)
+    write_grasps(parquet, grasps)
+    return jsonl, parquet, len(grasps)
+
+
+def _rows(path):
+    return list(read_results(path))
+
+
+def _comparable(rows):
+    return [{k: v for k, v in r.items() if k != "line"} for r in rows]
+
+
+def test_parquet_and_jsonl_give_the_same_results(grasp_files, tmp_path):
+    jsonl, parquet, n = grasp_files
+    a, b = tmp_path / "a.jsonl", tmp_path / "b.parquet"
+    sa = certify_file(jsonl, a, quality=False, chunk_size=64)
+    sb = certify_file(parquet, b, quality=False, chunk_size=50, workers=2)
+    assert sa.rows == n + 1 and sa.errors == 1 and sb.rows == n and sb.errors == 0
+    ra, rb = _rows(a)[:n], _rows(b)
+    assert pq.read_schema(b).names[:4] == ["id", "line", "dim", "status"]
+    for x, y in zip(ra, rb):
+        assert (x["id"], x["status"], x["form_status"], x["margin"]) == (y["id"], y["status"], y["form_status"], y["margin"])
+        assert x["certificate"] == y["certificate"]
+    assert not verify_file(b, parquet, workers=2).failures
+    assert not verify_file(a, jsonl).failures
+
+
+def _start(args, cwd):
+    return subprocess.Popen([sys.executable, "-m", "experiments.cli", *args], cwd=cwd,
+                            start_new_session=True, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE)
+
+
+@pytest.mark.parametrize("fmt", ["jsonl", "parquet"])
+def test_kill_9_and_resume_loses_and_duplicates_nothing(grasp_files, tmp_path, fmt):
+    jsonl, parquet, n = grasp_files
+    src = jsonl if fmt == "jsonl" else parquet
+    total = n + (fmt == "jsonl")
+    ref = tmp_path / f"ref.{fmt}"
+    certify_file(src, ref, quality=False, chunk_size=16)
+    out = tmp_path / f"out.{fmt}"
+    parts = tmp_path / f"out.{fmt}.parts"
+    args = ["certify", str(src), "-o", str(out), "--no-quality", "--chunk-size", "16", "-q",
+            "--workers", "2"]
+    kills = 0
+    proc = _start(args, os.getcwd())
+    for delay in (0.0, 0.4, 0.8):  # kill at several moments, resuming each time
+        deadline = time.time() + 60
+        while time.time() < deadline and proc.poll() is None:
+            done = len(list(parts.glob("part-*"))) if parts.exists() else 0
+            if done >= 2 + 4 * kills:
+                break
+            time.sleep(0.02)
+        time.sleep(delay)
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+            kills += 1
+        proc = _start(args + ["--resume"], os.getcwd())
+    assert proc.wait(timeout=300) in (0, 1), proc.stderr.read().decode()
+    assert kills >= 1
+    assert not parts.exists()
+    rows = _rows(out)
+    ids = [r["id"] for r in rows]
+    assert len(rows) == total and len(set(map(str, ids))) == len(ids)
+    assert _comparable(rows) == _comparable(_rows(ref))
+
+
+def test_resume_refuses_other_options(grasp_files, tmp_path):
+    jsonl, _, _ = grasp_files
+    out = tmp_path / "o.jsonl"
+    parts = tmp_path / "o.jsonl.parts"
+    parts.mkdir()
+    (parts / "manifest.json").write_text(json.dumps({"chunk_size": 3}))
+    from certify.errors import CertifyError
+
+    with pytest.raises(CertifyError, match="cannot resume"):
+        certify_file(jsonl, out, resume=True, quality=False)
+
+
+def test_dask_local_cluster_matches_local_processes(grasp_files, tmp_path):
+    pytest.importorskip("distributed")
+    _, parquet, _ = grasp_files
+    local, distributed = tmp_path / "local.parquet", tmp_path / "dask.parquet"
+    certify_file(parquet, local, quality=True, eps_budget=20_000, chunk_size=40, workers=2)
+    certify_file(parquet, distributed, quality=True, eps_budget=20_000, chunk_size=40, workers=2,
+                 dask="local")
+    assert pq.read_table(local).equals(pq.read_table(distributed))
