@@ -21,12 +21,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 
 from . import exact as ex
 from .certificates import Certificate, Tolerances, polar_value
 from .errors import GraspError, SolverError
 from .grasp import Grasp
+from .kernels import pivot_basis
 from .problem import ClosureProblem, grasp_problem, grasp_system, span_problem, span_system
 from .solvers import make_solver
 
@@ -80,7 +80,7 @@ def decide(problem: ClosureProblem, exact_columns, solver,
                 raise  # solvers may fail on rank-deficient data; there the rank decides below
     if sol is not None and not thin and sol.status == "optimal" and sol.t >= tol.margin:
         values = problem.to_values @ sol.x
-        basis = scipy.linalg.qr(C, pivoting=True, mode="r")[1][:d]
+        basis = pivot_basis(np.ascontiguousarray(C, dtype=float))
         cert = Certificate("interior", layout, _floats(values), tuple(int(j) for j in basis))
         return Verdict("closure", float(sol.t), cert)
     if sol is not None and sol.y is not None and sol.t < tol.margin:
@@ -107,7 +107,10 @@ def farkas_certificate(C: np.ndarray, blocks, layout: str, y: np.ndarray,
     off their columns; every other block must then be strictly separated (float check with a
     margin; the exact check is :func:`certify.certificates.verify`).
     """
-    y = y / np.linalg.norm(y)
+    norm = np.sqrt(np.sum(y * y))  # the columnar path normalises with the same operations
+    if not (np.isfinite(norm) and norm > 0):
+        return None
+    y = y / norm
     scale = np.abs(C).max()
     tight = tuple(i for i, b in enumerate(blocks)
                   if np.abs(C[:, list(b.cols)].T @ y).max() <= rel * scale)

@@ -73,30 +73,42 @@ def _clean(d: Any) -> Any:
     return out
 
 
-def _chunk_rows(chunk: Chunk, options: Options) -> list[dict]:
-    """Certify every grasp of ``chunk``; one results row each, in input order."""
+def _json_values(chunk: Chunk) -> list:
+    values = []
+    for _, text in chunk.rows:
+        try:
+            values.append(json.loads(text))
+        except json.JSONDecodeError as err:
+            values.append(GraspFileError(f"malformed JSON ({err.msg} at column {err.colno})"))
+    return values
+
+
+def certify_chunk_results(chunk: Chunk, options: Options):
+    """Results of ``chunk``: an Arrow table for Parquet input (columnar path), a list of rows
+    for JSON Lines input (per-grasp path)."""
     from .batch import certify_values
 
-    if isinstance(chunk.rows, pa.Table):
-        values = [_clean(d) for d in chunk.rows.to_pylist()]
-        texts = None
-    else:
-        values, texts = [], [text for _, text in chunk.rows]
-        for _, text in chunk.rows:
-            try:
-                values.append(json.loads(text))
-            except json.JSONDecodeError as err:
-                values.append(GraspFileError(f"malformed JSON ({err.msg} at column {err.colno})"))
-    return list(certify_values(values, chunk.lines, options))
+    if not isinstance(chunk.rows, pa.Table):
+        return list(certify_values(_json_values(chunk), chunk.lines, options))
+    from .fastpath import certify_table
+
+    table = chunk.rows
+
+    def slow(idx):
+        values = [_clean(d) for d in table.take(pa.array(idx)).to_pylist()]
+        return list(certify_values(values, [chunk.lines[i] for i in idx], options))
+
+    return certify_table(table, chunk.lines, options, slow=slow)
 
 
-def _write_part(rows: list[dict], path: Path) -> None:
+def _write_part(results, path: Path) -> None:
+    from .table import rows_to_table, table_to_rows
+
     tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")  # writers never share a temporary
     if is_parquet(path):
-        from .table import rows_to_table
-
-        pq.write_table(rows_to_table(rows), tmp)
+        pq.write_table(results if isinstance(results, pa.Table) else rows_to_table(results), tmp)
     else:
+        rows = table_to_rows(results) if isinstance(results, pa.Table) else results
         with tmp.open("w", encoding="utf-8") as fh:
             for row in rows:
                 fh.write(json.dumps(row, allow_nan=False) + "\n")
@@ -109,12 +121,18 @@ def certify_chunk(chunk: Chunk, options: Options, part: str) -> tuple[int, dict[
     Returns ``(chunk index, status counts, unverified count)``. This is the unit of work sent to
     local processes or dask workers.
     """
-    rows = _chunk_rows(chunk, options)
-    _write_part(rows, Path(part))
+    results = certify_chunk_results(chunk, options)
+    _write_part(results, Path(part))
+    if isinstance(results, pa.Table):
+        statuses = results.column("status").to_pylist()
+        verified = results.column("verified").to_pylist()
+    else:
+        statuses = [r["status"] for r in results]
+        verified = [r["verified"] for r in results]
     counts: dict[str, int] = {}
-    for r in rows:
-        counts[r["status"]] = counts.get(r["status"], 0) + 1
-    unverified = sum(1 for r in rows if r["status"] != "error" and not r["verified"])
+    for status in statuses:
+        counts[status] = counts.get(status, 0) + 1
+    unverified = sum(1 for s, v in zip(statuses, verified) if s != "error" and not v)
     return chunk.index, counts, unverified
 
 

@@ -33,7 +33,6 @@ first, so flat hulls and rank-deficient sets never reach qhull.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from itertools import combinations
 
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
@@ -163,22 +162,15 @@ def _unit(V: np.ndarray) -> np.ndarray:
     return np.concatenate([V, -V])
 
 
-def _planar_candidates(grasp: Grasp, norm: str) -> np.ndarray:
-    """Directions containing every facet normal of the planar GWS (both orientations)."""
+def planar_epsilon(grasp: Grasp, norm: str) -> tuple[float, np.ndarray]:
+    """Exact planar epsilon and its direction (compiled kernel, also used for whole batches)."""
+    from .kernels import planar_epsilon as kernel
+
     P, N, mu, _, c, L = grasp_arrays(grasp)
     models = tuple(contact.model for contact in grasp.contacts)
     W, owner = generator_columns(P, N, mu, models, c, L)
-    G = W.T
-    if norm == "L1":
-        pts = np.vstack([np.zeros(3), G])
-        tri = np.array(list(combinations(range(len(pts)), 3)))
-        a, b, e = pts[tri[:, 0]], pts[tri[:, 1]], pts[tri[:, 2]]
-        return _unit(np.cross(b - a, e - a))
-    edges = [G[owner == i] for i in range(len(grasp.contacts))]
-    edges = [np.vstack([g, g[:1] - g[1:]]) if len(g) > 1 else g for g in edges]
-    E = np.vstack(edges)
-    pairs = np.array(list(combinations(range(len(E)), 2)))
-    return _unit(np.cross(E[pairs[:, 0]], E[pairs[:, 1]]))
+    eps, arg = kernel(np.ascontiguousarray(W[None]), owner, len(models), norm == "Linf")
+    return float(eps[0]), arg[0]
 
 
 def _zero(grasp: Grasp, norm: str) -> Epsilon:
@@ -211,14 +203,11 @@ def epsilon(grasp: Grasp, norm: str = "L1", *, rel_gap: float = 0.01, budget: in
     verdict = verdict or force_closure(grasp)
     if verdict.status != "closure":
         return _zero(grasp, norm)
-    system = grasp_system(grasp, socp=True)
     if grasp.dim == 2:
-        U = _planar_candidates(grasp, norm)
-        h = support(system, U, norm)
-        i = int(np.argmin(h))
-        return Epsilon(norm, float(h[i]), float(h[i]), tuple(U[i]), tuple(grasp.center),
+        eps, u = planar_epsilon(grasp, norm)
+        return Epsilon(norm, eps, eps, tuple(float(v) for v in u), tuple(grasp.center),
                        grasp.length, True)
-    return _refine(grasp, system, norm, rel_gap, budget)
+    return _refine(grasp, grasp_system(grasp, socp=True), norm, rel_gap, budget)
 
 
 class _Pieces:

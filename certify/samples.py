@@ -97,3 +97,37 @@ def textbook_grasps() -> list[Grasp]:
         Grasp(CUBE_7, center=(0, 0, 0), id="cube-7"),
     ]
     return gs
+
+
+def random_grasp_table(seed: int, count: int, *, dim: int = 2, n_contacts: int = 3,
+                       model: str = "point", mu: tuple[float, float] = (0.2, 1.0),
+                       torsion: tuple[float, float] = (0.05, 0.5), spread: float = 0.7,
+                       start: int = 0):
+    """An Arrow grasp table (:data:`certify.table.GRASP_SCHEMA`) of ``count`` random grasps drawn
+    like :func:`random_grasp` (same distribution, vectorised; not the same draws), ids
+    ``r{start}, r{start+1}, ...``; ``center`` and ``length`` left to their defaults."""
+    import pyarrow as pa
+
+    from .table import CONTACT, GRASP_SCHEMA
+
+    rng = np.random.default_rng(seed)
+    m = n_contacts
+    u = rng.normal(size=(count, m, dim))
+    u /= np.linalg.norm(u, axis=2, keepdims=True)
+    p = u * rng.uniform(0.7, 1.3, size=(count, m, 1))
+    n = -u + spread * rng.normal(size=(count, m, dim))
+    total = count * m
+    lists = lambda a: pa.ListArray.from_arrays(pa.array(np.arange(0, total * dim + 1, dim, dtype=np.int32)),
+                                               pa.array(a.reshape(-1)))
+    if model == "frictionless":
+        mus = pa.nulls(total, pa.float64())
+    else:
+        mus = pa.array(rng.uniform(*mu, size=total))
+    tors = pa.array(rng.uniform(*torsion, size=total)) if model == "soft" else pa.nulls(total, pa.float64())
+    contacts = pa.StructArray.from_arrays(
+        [lists(p), lists(n), pa.array(np.full(total, model, dtype=object)), mus, tors],
+        fields=list(CONTACT))
+    per_row = pa.ListArray.from_arrays(pa.array(np.arange(0, total + 1, m, dtype=np.int32)), contacts)
+    ids = pa.array([f"r{i}" for i in range(start, start + count)])
+    return pa.table({"id": ids, "contacts": per_row, "center": pa.nulls(count, pa.list_(pa.float64())),
+                     "length": pa.nulls(count, pa.float64())}, schema=GRASP_SCHEMA)

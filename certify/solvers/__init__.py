@@ -64,10 +64,10 @@ class FastSolver:
 
         if not problem.cones and comb(problem.nvar, problem.d) <= self.max_bases:
             sol = solve_enumeration(problem)
-            if sol.y is not None:
+            if sol.y is not None or (sol.status == "optimal" and sol.t > 0):
                 return sol
-            # No dual basis survived the feasibility tolerance (numerically tied bases): the
-            # interior-point route always returns a dual direction.
+            # A verdict against closure needs a dual direction, and no dual basis survived the
+            # feasibility tolerance (numerically tied bases): the interior-point route has one.
         return self._clarabel.solve(problem)
 
 

@@ -23,6 +23,7 @@ from itertools import combinations
 
 import numpy as np
 
+from ..kernels import lp_enumerate, lp_planar
 from ..problem import ClosureProblem
 from . import Solution
 
@@ -31,8 +32,13 @@ __all__ = ["enumerate_lp", "solve_enumeration", "EnumerationSolver"]
 _FEAS = 1e-12  # feasibility slack on basic solutions, relative to their scale
 
 
+def bases(k: int, d: int) -> np.ndarray:
+    """All ``d``-subsets of ``range(k)`` as an int array (nS, d)."""
+    return np.array(list(combinations(range(k), d)), dtype=np.int64).reshape(-1, d)
+
+
 def enumerate_lp(W: np.ndarray):
-    """Solve a batch of min-weight LPs exactly.
+    """Solve a batch of min-weight LPs exactly (compiled kernels of :mod:`certify.kernels`).
 
     Parameters
     ----------
@@ -49,49 +55,11 @@ def enumerate_lp(W: np.ndarray):
         Dual direction with ``W' y <= t*`` (scaled so that ``k z - (W 1) . y = 1``); for
         infeasible problems ``W' y = -1``. NaN where no dual basis was found.
     """
-    W = np.asarray(W, dtype=float)
-    B, d, k = W.shape
-    S = np.array(list(combinations(range(k), d)), dtype=int)
-    M = np.empty((B, len(S), d + 1, d + 1))
-    M[:, :, :d, 0] = W.sum(axis=2)[:, None, :]
-    M[:, :, :d, 1:] = np.moveaxis(W[:, :, S], 1, 2)
-    M[:, :, d, 0] = k
-    M[:, :, d, 1:] = 1.0
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        det = np.linalg.det(M)  # singular bases are expected; they are masked next
-    hadamard = np.prod(np.linalg.norm(M, axis=-2), axis=-1)
-    ok = np.abs(det) > 1e-13 * hadamard
-    M[~ok] = np.eye(d + 1)
-    inv = np.linalg.inv(M)
-
-    t_all = inv[..., 0, d]
-    s_all = inv[..., 1:, d]
-    primal = ok & np.all(s_all >= -_FEAS * (1 + np.abs(t_all))[..., None], axis=-1)
-    y_all = -inv[..., 0, :d]
-    z_all = inv[..., 0, d]
-    Wy = np.einsum("bdk,bsd->bsk", W, y_all)
-    scale = 1 + np.abs(z_all) + np.linalg.norm(y_all, axis=-1) * np.abs(W).max(axis=(1, 2))[:, None]
-    dual = ok & np.all(Wy <= (z_all + _FEAS * scale)[..., None], axis=-1)
-
-    rows = np.arange(B)
-    tp = np.where(primal, t_all, -np.inf)
-    best = np.argmax(tp, axis=1)
-    t = tp[rows, best]
-    lam = np.full((B, k), np.nan)
-    feasible = np.isfinite(t)
-    lam[feasible] = t[feasible, None]
-    Sb = S[best]
-    sb = s_all[rows, best]
-    for j in range(d):
-        lam[rows[feasible], Sb[feasible, j]] += sb[feasible, j]
-
-    zd = np.where(dual, z_all, np.inf)
-    bestd = np.argmin(zd, axis=1)
-    y = np.where(np.isfinite(zd[rows, bestd])[:, None], y_all[rows, bestd], np.nan)
-    if not feasible.all():
-        # No equilibrium with unit weight: W' y = -1 is consistent; take its least-squares solution.
-        for b in np.flatnonzero(~feasible):
-            y[b] = np.linalg.lstsq(W[b].T, -np.ones(k), rcond=None)[0]
+    W = np.ascontiguousarray(W, dtype=float)
+    _, d, k = W.shape
+    kernel = lp_planar if d == 3 else lp_enumerate
+    t, lam, y, has_y = kernel(W, bases(k, d), _FEAS)
+    y[~has_y] = np.nan
     return t, lam, y
 
 
@@ -100,9 +68,10 @@ def solve_enumeration(problem: ClosureProblem) -> Solution:
     if problem.cones:
         raise ValueError("enumeration solves polyhedral programmes only")
     t, lam, y = enumerate_lp(problem.columns[None])
+    y = None if np.isnan(y[0]).any() else y[0]
     if not np.isfinite(t[0]):
-        return Solution("infeasible", -np.inf, None, y[0])
-    return Solution("optimal", float(t[0]), lam[0], None if np.isnan(y[0]).any() else y[0])
+        return Solution("infeasible", -np.inf, None, y)
+    return Solution("optimal", float(t[0]), lam[0], y)
 
 
 class EnumerationSolver:
