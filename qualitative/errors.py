@@ -15,6 +15,7 @@ __all__ = [
     "FormulaError",
     "TraceError",
     "NetworkError",
+    "RegionError",
 ]
 
 
@@ -48,3 +49,7 @@ class TraceError(QualitativeError, ValueError):
 
 class NetworkError(QualitativeError, ValueError):
     """An RCC-8 network is malformed (unknown relation name, bad pair)."""
+
+
+class RegionError(QualitativeError, ValueError):
+    """A region or grasp scene cannot be built (not polygonal, empty, invalid, bad scene parameters)."""

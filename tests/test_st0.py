@@ -1,0 +1,241 @@
+"""ST0: parsing, the fast evaluator against the naive one and the temporal identities, traces."""
+
+import json
+
+import numpy as np
+import pytest
+import typer
+from hypothesis import given, strategies as st
+from typer.testing import CliRunner
+
+from qualitative.cli import st0_command
+from qualitative.errors import FormulaError, TraceError
+from qualitative.rcc8 import RELATIONS
+from qualitative.st0 import (Always, And, Atom, Const, Historically, Implies, Next, Not, Once, Or,
+                             Previous, Since, Sometime, Until, evaluate_file, evaluate_reference,
+                             parse, read_trace, write_trace)
+
+CONV = {"DC": "DC", "EC": "EC", "PO": "PO", "EQ": "EQ",
+        "TPP": "TPPi", "TPPi": "TPP", "NTPP": "NTPPi", "NTPPi": "NTPP"}
+PAIRS = [("A", "B"), ("B", "A"), ("B", "C"), ("C", "B"), ("A", "C"), ("C", "A"), ("A", "A")]
+TRUE = Const(True)
+
+
+# ------------------------------------------------------------------------- strategies
+
+@st.composite
+def traces(draw, min_size=1, max_size=12):
+    """Frames over A, B, C; each pair stored one way or the other (or both, consistently)."""
+    frames = []
+    for _ in range(draw(st.integers(min_size, max_size))):
+        frame = {}
+        for x, y in (("A", "B"), ("B", "C"), ("A", "C")):
+            r = draw(st.sampled_from(RELATIONS))
+            how = draw(st.sampled_from(["forward", "backward", "both"]))
+            if how != "backward":
+                frame[(x, y)] = r
+            if how != "forward":
+                frame[(y, x)] = CONV[r]
+        frames.append(frame)
+    return frames
+
+
+atoms = st.builds(lambda rels, pair: Atom(frozenset(rels), *pair),
+                  st.sets(st.sampled_from(RELATIONS), min_size=1, max_size=3), st.sampled_from(PAIRS))
+leaves = st.one_of(atoms, atoms, st.builds(Const, st.booleans()))
+formulas = st.recursive(leaves, lambda kids: st.one_of(
+    *(st.builds(op, kids) for op in (Not, Next, Sometime, Always, Previous, Once, Historically)),
+    *(st.builds(op, kids, kids) for op in (Implies, Until, Since)),
+    st.builds(lambda a, b: And((a, b)), kids, kids),
+    st.builds(lambda a, b, c: Or((a, b, c)), kids, kids, kids),
+), max_leaves=8)
+
+
+# ---------------------------------------------------------------------------- semantics
+
+@given(formulas, traces(min_size=0))
+def test_fast_evaluator_agrees_with_the_naive_per_instant_one(f, trace):
+    assert np.array_equal(f.evaluate(trace), evaluate_reference(f, trace))
+
+
+@given(formulas, traces())
+def test_sometime_always_and_their_past_duals(p, trace):
+    ev = lambda f: f.evaluate(trace)
+    assert np.array_equal(ev(Sometime(p)), ev(Until(TRUE, p)))
+    assert np.array_equal(ev(Always(p)), ev(Not(Sometime(Not(p)))))
+    assert np.array_equal(ev(Once(p)), ev(Since(TRUE, p)))
+    assert np.array_equal(ev(Historically(p)), ev(Not(Once(Not(p)))))
+
+
+@given(formulas, formulas, traces())
+def test_until_and_since_unfold_one_step(p, q, trace):
+    ev = lambda f: f.evaluate(trace)
+    assert np.array_equal(ev(Until(p, q)), ev(Or((q, And((p, Next(Until(p, q))))))))
+    assert np.array_equal(ev(Since(p, q)), ev(Or((q, And((p, Previous(Since(p, q))))))))
+
+
+@given(formulas, traces())
+def test_strong_next_and_previous_at_the_ends(p, trace):
+    p_values = p.evaluate(trace)
+    assert not Next(p).evaluate(trace)[-1]
+    assert not Previous(p).evaluate(trace)[0]
+    assert np.array_equal(Next(p).evaluate(trace)[:-1], p_values[1:])
+    assert np.array_equal(Previous(Next(p)).evaluate(trace)[1:], p_values[1:])
+
+
+def test_hand_computed_trace():
+    trace = [{("A", "B"): "DC"}, {("B", "A"): "EC"}, {("A", "B"): "PO"}, {("B", "A"): "TPPi"}]
+    ev = lambda text: parse(text).evaluate(trace).tolist()
+    assert ev("EC(A,B)") == [False, True, False, False]
+    assert ev("TPP(A,B)") == [False, False, False, True]        # read from the converse
+    assert ev("{DC,EC}(A,B) U PO(A,B)") == [True, True, True, False]
+    assert ev("DC(A,B) U PO(A,B)") == [False, False, True, False]
+    assert ev("X EC(A,B)") == [True, False, False, False]
+    assert ev("Y EC(A,B)") == [False, False, True, False]
+    assert ev("!PO(A,B) S DC(A,B)") == [True, True, False, False]
+    assert ev("EC(A,B) S DC(A,B)") == [True, True, False, False]   # q where p fails counts
+    assert ev("PO(A,B) U EC(A,B)") == [False, True, False, False]
+    assert ev("G F TPPi(B,A)") == [True] * 4
+    assert ev("F TPP(B,A)") == [False] * 4
+    assert ev("EQ(A,A) & !DC(B,B)") == [True] * 4
+    assert parse("EC(A,B)").holds(trace) is False
+    assert parse("F PO(A,B)").holds(trace) is True
+
+
+def test_empty_trace():
+    assert parse("G EC(A,B)").evaluate([]).shape == (0,)
+    with pytest.raises(TraceError, match="empty"):
+        parse("true").holds([])
+
+
+# ------------------------------------------------------------------------------ parsing
+
+A, B = Atom(frozenset({"EC"}), "A", "B"), Atom(frozenset({"DC"}), "B", "C")
+C = Atom(frozenset({"PO"}), "A", "C")
+
+
+@pytest.mark.parametrize("text, tree", [
+    ("!EC(A,B) U DC(B,C)", Until(Not(A), B)),
+    ("EC(A,B) & DC(B,C) | PO(A,C)", Or((And((A, B)), C))),
+    ("EC(A,B) | DC(B,C) & PO(A,C)", Or((A, And((B, C))))),
+    ("EC(A,B) -> DC(B,C) -> PO(A,C)", Implies(A, Implies(B, C))),
+    ("EC(A,B) U DC(B,C) U PO(A,C)", Until(A, Until(B, C))),
+    ("EC(A,B) U DC(B,C) S PO(A,C)", Until(A, Since(B, C))),
+    ("EC(A,B) & DC(B,C) U PO(A,C)", And((A, Until(B, C)))),
+    ("G EC(A,B) -> DC(B,C)", Implies(Always(A), B)),
+    ("X Y O H F G !EC(A,B)", Next(Previous(Once(Historically(Sometime(Always(Not(A)))))))),
+    ("GF EC(A,B)", Always(Sometime(A))),
+    ("XEC(A,B)", Next(A)),
+    ("(EC(A,B) | DC(B,C)) & PO(A,C)", And((Or((A, B)), C))),
+    ("{PO,EC,PO}( A , B )", Atom(frozenset({"EC", "PO"}), "A", "B")),
+    ("true & !false", And((Const(True), Not(Const(False))))),
+    # operator letters are region names inside an atom
+    ("G(EC(F2,O) -> O(EC(F1,O)))", Always(Implies(Atom(frozenset({"EC"}), "F2", "O"),
+                                                  Once(Atom(frozenset({"EC"}), "F1", "O"))))),
+    ("EC(X,Y) U PO(U,S)", Until(Atom(frozenset({"EC"}), "X", "Y"), Atom(frozenset({"PO"}), "U", "S"))),
+])
+def test_precedence_and_associativity(text, tree):
+    assert parse(text) == tree
+
+
+@given(formulas)
+def test_printed_formulas_parse_back(f):
+    assert parse(str(f)) == f
+
+
+@pytest.mark.parametrize("text, column, expected", [
+    ("EC(A,B) &", 10, "a formula"),
+    ("EC(A,)", 6, "a region name"),
+    ("EC(A B)", 6, "','"),
+    ("EC A,B)", 4, "'('"),
+    ("tpp(A,B)", 1, "did you mean TPP"),
+    ("{DC,XX}(A,B)", 5, "a relation name"),
+    ("{DC EC}(A,B)", 5, "'}'"),
+    ("(EC(A,B)", 9, "')' closing the '(' at column 1"),
+    ("EC(A,B) EC(B,C)", 9, "an operator"),
+    ("U EC(A,B)", 1, "before the binary operator U"),
+    ("EC(A,B) # DC(A,B)", 9, "an operator"),
+    ("", 1, "a formula"),
+])
+def test_parse_errors_give_the_column_and_what_was_expected(text, column, expected):
+    with pytest.raises(FormulaError) as info:
+        parse(text)
+    assert info.value.column == column
+    assert expected in info.value.expected
+    assert f"column {column}" in str(info.value)
+
+
+# -------------------------------------------------------------------------------- traces
+
+def test_trace_errors_name_the_problem():
+    with pytest.raises(TraceError, match=r"frame 1 gives no relation for the pair \('A', 'C'\)"):
+        parse("EC(A,C)").evaluate([{("A", "C"): "EC"}, {("A", "B"): "EC"}])
+    with pytest.raises(TraceError, match="frame 0, pair.*unknown relation 'XX'"):
+        parse("EC(A,B)").evaluate([{("B", "A"): "XX"}])
+    with pytest.raises(TraceError, match="frame 1 is a list"):
+        parse("EC(A,B)").evaluate([{("A", "B"): "EC"}, ["EC"]])
+    with pytest.raises(TraceError, match="not its converse"):
+        parse("EC(A,B)").evaluate([{("A", "B"): "TPP", ("B", "A"): "TPP"}])
+    with pytest.raises(TraceError, match="sequence"):
+        parse("EC(A,B)").evaluate({("A", "B"): "EC"})
+
+
+def test_trace_files_round_trip(tmp_path):
+    trace = [{("A", "B"): "DC", ("B", "C"): "TPP"}, {("B", "A"): "EC", ("C", "B"): "NTPPi"}]
+    path = tmp_path / "trace.json"
+    write_trace(trace, path)
+    assert read_trace(path) == trace
+    assert json.loads(path.read_text())[0] == {"A,B": "DC", "B,C": "TPP"}
+    assert evaluate_file("EC(A,B) | NTPP(B,C)", path).tolist() == [False, True]
+
+
+@pytest.mark.parametrize("content, message", [
+    ("[{\"A,B\": \"DC\"", "not valid JSON"),
+    ("{\"A,B\": \"DC\"}", "expected a JSON list"),
+    ("[[\"A,B\", \"DC\"]]", "frame 0: expected an object"),
+    ("[{\"A,B\": \"DC\"}, {\"AB\": \"DC\"}]", "frame 1: key 'AB' is not two region names"),
+    ("[{\"A,B,C\": \"DC\"}]", "not two region names"),
+    ("[{\"A,B\": \"dc\"}]", "unknown relation 'dc'"),
+    ("[{\"A,B\": 3}]", "unknown relation 3"),
+    ("[{\"A,B\": \"DC\", \" A , B\": \"EC\"}]", "given twice"),
+])
+def test_malformed_trace_files(tmp_path, content, message):
+    path = tmp_path / "bad.json"
+    path.write_text(content)
+    with pytest.raises(TraceError, match=message):
+        read_trace(path)
+
+
+def test_missing_trace_file(tmp_path):
+    with pytest.raises(TraceError, match="cannot read"):
+        evaluate_file("true", tmp_path / "nope.json")
+
+
+# ----------------------------------------------------------------------------------- CLI
+
+def _app():
+    app = typer.Typer()
+    app.command("st0")(st0_command)
+    app.callback()(lambda: None)  # keep "st0" a subcommand
+    return app
+
+
+def test_st0_command_prints_one_line_per_instant(tmp_path):
+    path = tmp_path / "trace.json"
+    write_trace([{("A", "B"): "DC"}, {("A", "B"): "EC"}, {("A", "B"): "PO"}], path)
+    result = CliRunner().invoke(_app(), ["st0", "DC(A,B) U PO(A,B)", "--trace", str(path)])
+    assert result.exit_code == 0, result.output
+    assert result.stdout.splitlines() == ["0\tfalse", "1\tfalse", "2\ttrue"]
+
+
+@pytest.mark.parametrize("formula, content, message", [
+    ("EC(A,B", '[{"A,B": "DC"}]', "column 7"),
+    ("EC(A,B)", '[{"A,B": "XX"}]', "unknown relation 'XX'"),
+    ("EC(A,C)", '[{"A,B": "DC"}]', "no relation for the pair"),
+])
+def test_st0_command_exit_code_2_on_bad_input(tmp_path, formula, content, message):
+    path = tmp_path / "trace.json"
+    path.write_text(content)
+    result = CliRunner().invoke(_app(), ["st0", formula, "--trace", str(path)])
+    assert result.exit_code == 2
+    assert message in result.stderr
