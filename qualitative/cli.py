@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import typer
 
 __all__ = ["register"]
@@ -9,3 +11,99 @@ __all__ = ["register"]
 
 def register(app: typer.Typer) -> None:
     """Add the qualitative commands to the ``qualgrasp`` application."""
+    app.command("st0")(st0_command)
+    app.command("outline")(outline_command)
+    app.command("regions")(regions_command)
+
+
+def st0_command(
+    formula: str = typer.Argument(..., help="ST0 formula, e.g. 'G(EC(F2,O) -> O EC(F1,O))'."),
+    trace: Path = typer.Option(..., "--trace", help='Recorded trace: JSON list of {"X,Y": "REL"} frames.'),
+) -> None:
+    """Evaluate an ST0 formula on a recorded trace: one line per instant, index<TAB>true/false.
+
+    Exit code 2 when the formula does not parse or the trace file is malformed.
+    """
+    from .errors import FormulaError, TraceError
+    from .st0 import evaluate_file
+
+    try:
+        values = evaluate_file(formula, trace)
+    except (FormulaError, TraceError) as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(2)
+    for i, value in enumerate(values):
+        typer.echo(f"{i}\t{'true' if value else 'false'}")
+
+
+def outline_command(
+    image: Path = typer.Argument(..., help="Image file (PNG, JPEG, anything OpenCV reads)."),
+    as_json: bool = typer.Option(False, "--json", help="Print a JSON object with keys string and segments."),
+    largest: bool = typer.Option(False, "--largest",
+                                 help="With several objects, describe the largest whole one."),
+    threshold: float | None = typer.Option(None, "--threshold", help="Grey level separating object and "
+                                           "background, in the image's units (default: Otsu's)."),
+) -> None:
+    """Print the qualitative outline (canonical curvature-type string) of the object in an image.
+
+    Coordinates in the JSON are pixels of the input image, x = column, y = row. Exit code 2 when
+    the image cannot be read or does not hold exactly one whole object.
+    """
+    import json
+
+    from .errors import QualitativeError
+    from .outline import outline_image, outline_to_dict
+
+    try:
+        outline = outline_image(image, threshold=threshold, largest=largest)
+    except QualitativeError as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(2)
+    typer.echo(json.dumps(outline_to_dict(outline)) if as_json else outline.string)
+
+
+def regions_command(
+    image: Path = typer.Argument(..., help="Image file (PNG, JPEG, anything OpenCV reads)."),
+    alpha: float = typer.Option(0.5, "--alpha", help="Bounding-circle diameter threshold of curves, "
+                                "as a fraction of the object's size (its enclosing circle's diameter)."),
+    finger_width: float = typer.Option(0.08, "--finger-width",
+                                       help="Finger pad width, fraction of the object's size."),
+    margin: float = typer.Option(0.02, "--margin",
+                                 help="Distance kept from element ends, fraction of the object's size."),
+    as_json: bool = typer.Option(False, "--json", help="Print a JSON object with key regions."),
+    plot: Path | None = typer.Option(None, "--plot", help="Save a figure of the outline and regions (PNG)."),
+    largest: bool = typer.Option(False, "--largest",
+                                 help="With several objects, use the largest whole one."),
+    threshold: float | None = typer.Option(None, "--threshold", help="Grey level separating object and "
+                                           "background, in the image's units (default: Otsu's)."),
+) -> None:
+    """Print the feasible grasp regions (paper, definitions 1 and 2) of the object in an image.
+
+    One line per region: type, arc-length interval along the contour (pixels), number of points
+    and smallest bounding-circle diameter. With --json: points and inward unit normals as lists of
+    [x, y] in pixels of the input image (x = column, y = row). Exit code 2 on unusable input.
+    """
+    import json
+
+    from .errors import QualitativeError
+    from .outline import outline_image
+    from .regions import feasible_regions, regions_to_dict
+    from .vision import read_image
+
+    try:
+        outline = outline_image(image, threshold=threshold, largest=largest)
+        regions = feasible_regions(outline, alpha, finger_width, margin)
+    except (QualitativeError, ValueError) as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(2)
+    if plot is not None:
+        from .plot import outline_figure
+
+        outline_figure(outline, regions, read_image(image)).savefig(plot, dpi=120)
+    if as_json:
+        typer.echo(json.dumps(regions_to_dict(outline, regions, alpha, finger_width, margin)))
+        return
+    typer.echo(f"outline {outline.string}  size {outline.size:.1f} px  {len(regions)} feasible region(s)")
+    for r in regions:
+        rho = "inf" if r.rho == float("inf") else f"{r.rho:.1f}"
+        typer.echo(f"{r.type}\tarc {r.arc[0]:.1f}..{r.arc[1]:.1f} px\t{len(r.points)} points\trho {rho} px")

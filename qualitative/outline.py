@@ -1,0 +1,789 @@
+"""Qualitative outlines (Galton & Meathrel 1999): a contour as a cyclic string of curvature types.
+
+Alphabet (the project's ASCII rendering of the seven curvature types), in canonical order:
+
+======  ===========================================  ==========
+symbol  curvature type                               kind
+======  ===========================================  ==========
+``/``   straight line segment                        line-like
+``)``   convex curve segment                         line-like
+``(``   concave curve segment                        line-like
+``>``   outward-pointing angle (convex corner)       point-like
+``<``   inward-pointing angle (concave corner)       point-like
+``}``   outward-pointing cusp                        point-like
+``{``   inward-pointing cusp                         point-like
+======  ===========================================  ==========
+
+Conventions
+-----------
+* **Orientation.** Contours are traversed so that the shoelace area on the image's (x, y) values
+  (x = column, y = row, pixels) is positive; the object lies on the side of the tangent ``t``
+  turned by +90 degrees, so the inward unit normal is ``(-t_y, t_x)``. Turning in the positive
+  sense along this traversal is convex. On screen (y down) this traversal is clockwise, the
+  direction in which the paper reads its figure 3.
+* **Canonical rotation.** Any rotation of the cyclic string describes the same outline; the
+  canonical string is the lexicographically least rotation under the symbol order ``/)(><}{``
+  (straight first). A square is ``/>/>/>/>``, a disc ``)``. :attr:`Outline.segments` start at the
+  segment where the canonical string starts (for periodic strings, the first such segment along
+  the contour).
+* **Well-formedness** (paper section 4.1, project notes section 4): (1) the string contains ``)`` or
+  at least three convex points (``>`` or ``}``); (2) no two cyclically consecutive identical symbols
+  (a single symbol, such as a disc's ``)``, has no neighbour and is allowed); (3) no two cyclically
+  consecutive point-like symbols; (4) every cusp (``}`` or ``{``) is adjacent on at least one side to
+  a curve (``)`` or ``(``) -- the notes' reading of a garbled sentence of the paper; geometry
+  says more (an outward cusp's sides meet tangentially with the object between them, so one of
+  them must be concave; likewise an inward cusp needs a convex side), but only the notes' rule is
+  enforced; (5) the total turning is 2 pi: for a string, some choice of turning angles in the
+  ranges of its symbols (``/`` 0, ``)`` positive, ``(`` negative, ``>`` in (0, pi), ``<`` in
+  (-pi, 0), ``}`` pi, ``{`` -pi) must add up to 2 pi; for an extracted outline the measured
+  turnings must add up to 2 pi and each must have its symbol's sign.
+
+Extraction (curvature scale space style; every threshold is an angle or a fraction of the
+perimeter ``P``, so the string does not depend on position, rotation or scale):
+
+1. resample the contour at ``samples`` (1024) points evenly spaced by arc length (``h = P / samples``);
+2. smooth with a periodic Gaussian of ``smoothing * P`` (0.004 P); turning angle ``phi_i`` at every
+   sample (they add up to exactly 2 pi for a simple contour);
+3. corners: greedily, the window of ``corner_window * P`` (0.02 P) holding the largest absolute
+   turning, while that turning exceeds ``corner_angle`` (30 degrees), re-centred on its sharpest
+   sample; then widened by up to half a window on each side (keeping at least a third of each
+   piece between corners), because a corner's rounding by pixels, anti-aliasing and smoothing
+   spills past the window and belongs to the corner, not to its neighbours. A corner turning at
+   least ``cusp_angle`` (125 degrees) is a cusp, otherwise an angle: the thin tip of a cusp is lost
+   at image resolution and smoothing blunts it, so imaged cusps measure about 140 to 170 degrees,
+   while an angle of 125 degrees has an interior angle of 55 degrees. Corners closer than a
+   window merge (scale-space semantics: rounded corners and notches smaller than the window are
+   corners);
+4. between corners, a piece shorter than a window is a corner if it turns at least
+   ``corner_angle``, else a straight link. In longer pieces each sample is straight if
+   ``abs(kappa) * P / (2 pi) < straight`` (0.25: the curvature relative to that of a disc of the
+   same perimeter), else convex or concave by its sign; runs shorter than a window join their
+   longer neighbour; a run turning less than ``flat_angle`` (10 degrees) in total is straight,
+   one turning more is a curve of that sign;
+5. repair into a well-formed string: merge equal line-like neighbours; merge neighbouring corners
+   that turn the same way (summing their turning); separate neighbouring corners that turn
+   opposite ways (a step narrower than a window) by a short straight link where the turning
+   changes sign; a merged corner turning less than ``corner_angle`` joins the preceding element; a
+   cusp with no curve neighbour becomes an angle (two straight lines cannot meet in a cusp; its
+   turning may then exceed pi, e.g. the blunt tip of a leg narrower than the window); when neither
+   ``)`` nor three convex points remain, the line-like element turning most positively becomes
+   ``)``.
+
+Resolution: features need a few windows (0.02 P each) of contour; the built-in objects keep their
+strings from 0.5x to 2x (objects 100 to 450 pixels across) with pixel noise up to 20 grey levels
+for a contrast of 200.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Union
+
+import cv2
+import numpy as np
+from scipy import ndimage
+
+from .errors import ContourError, OutlineError
+from .vision import ImageSource, extract_contour, signed_area
+
+__all__ = [
+    "SYMBOLS",
+    "NAMES",
+    "LINE_LIKE",
+    "POINT_LIKE",
+    "Segment",
+    "Outline",
+    "canonical",
+    "validate",
+    "is_well_formed",
+    "resample",
+    "outline_contour",
+    "outline_image",
+    "outline_to_dict",
+]
+
+SYMBOLS = "/)(><}{"
+NAMES = {
+    "/": "straight line",
+    ")": "convex curve",
+    "(": "concave curve",
+    ">": "outward angle",
+    "<": "inward angle",
+    "}": "outward cusp",
+    "{": "inward cusp",
+}
+LINE_LIKE = "/)("
+POINT_LIKE = "><}{"
+CURVES = ")("
+CONVEX_POINTS = ">}"
+# Sets for membership tests ("" is a substring of every str, so `"" in POINT_LIKE` would be True).
+_LINES, _POINTS, _CURVES = frozenset(LINE_LIKE), frozenset(POINT_LIKE), frozenset(CURVES)
+_RANK = {s: i for i, s in enumerate(SYMBOLS)}
+_TURNING_TOLERANCE = 1e-6
+
+
+# --------------------------------------------------------------------------------------------------
+# Strings: canonical form and well-formedness
+
+
+def _check_alphabet(string: str) -> None:
+    if not isinstance(string, str) or not string:
+        raise OutlineError(f"an outline string must be a non-empty str, got {string!r}")
+    bad = sorted(set(string) - set(SYMBOLS))
+    if bad:
+        raise OutlineError(f"unknown symbol(s) {''.join(bad)!r} in {string!r}; the alphabet is {SYMBOLS!r}")
+
+
+def _least_rotation(string: str) -> int:
+    """Index where the lexicographically least rotation (in symbol order) starts; first if tied."""
+    ranks = [_RANK[s] for s in string]
+    n = len(ranks)
+    return min(range(n), key=lambda i: ranks[i:] + ranks[:i])
+
+
+def canonical(string: str) -> str:
+    """The canonical rotation of a cyclic outline string.
+
+    Parameters
+    ----------
+    string : str
+        Symbols from :data:`SYMBOLS`, read along the positively oriented contour.
+
+    Returns
+    -------
+    str
+        The lexicographically least rotation under the symbol order ``/)(><}{``.
+
+    Raises
+    ------
+    OutlineError
+        Empty string or unknown symbol.
+    """
+    _check_alphabet(string)
+    i = _least_rotation(string)
+    return string[i:] + string[:i]
+
+
+def _turning_range(string: str) -> tuple[float, bool, float, bool]:
+    """Infimum and supremum of the total turning a string allows, with whether each is attained."""
+    lo, lo_closed, hi, hi_closed = 0.0, True, 0.0, True
+    for s in string:
+        if s == "/":
+            continue
+        if s == "}" or s == "{":
+            v = math.pi if s == "}" else -math.pi
+            lo, hi = lo + v, hi + v
+        elif s == ")":
+            lo_closed, hi = False, math.inf
+        elif s == "(":
+            hi_closed, lo = False, -math.inf
+        elif s == ">":
+            lo_closed, hi_closed, hi = False, False, hi + math.pi
+        elif s == "<":
+            lo_closed, hi_closed, lo = False, False, lo - math.pi
+    return lo, lo_closed, hi, hi_closed
+
+
+def _check_rules(string: str) -> None:
+    n = len(string)
+    convex_points = sum(string.count(s) for s in CONVEX_POINTS)
+    if ")" not in string and convex_points < 3:
+        raise OutlineError(
+            f"rule 1 (bounded): {string!r} has no convex curve ')' and only {convex_points} convex "
+            "point(s) ('>' or '}'); at least three are needed")
+    if n > 1:
+        for i in range(n):
+            a, b = string[i], string[(i + 1) % n]
+            if a == b:
+                raise OutlineError(
+                    f"rule 2 (no repeated symbol): {string!r} has {a!r} twice in a row at positions "
+                    f"{i} and {(i + 1) % n} (cyclically)")
+            if a in _POINTS and b in _POINTS:
+                raise OutlineError(
+                    f"rule 3 (no consecutive points): {string!r} has point-like {a!r}{b!r} at positions "
+                    f"{i} and {(i + 1) % n} (cyclically)")
+    for i, s in enumerate(string):
+        if s in "}{" and string[i - 1] not in _CURVES and string[(i + 1) % n] not in _CURVES:
+            raise OutlineError(
+                f"rule 4 (cusp next to a curve): the cusp {s!r} at position {i} of {string!r} has no "
+                "curve ')' or '(' on either side")
+
+
+def _check_string_turning(string: str) -> None:
+    lo, lo_closed, hi, hi_closed = _turning_range(string)
+    target = 2 * math.pi
+    above = target > lo or (lo_closed and math.isclose(target, lo))
+    below = target < hi or (hi_closed and math.isclose(target, hi))
+    if not (above and below):
+        raise OutlineError(
+            f"turning (total 2 pi): the symbols of {string!r} allow a total turning between "
+            f"{lo / math.pi:g} pi and {hi / math.pi:g} pi, which excludes 2 pi")
+
+
+def _check_outline_turning(outline: "Outline") -> None:
+    total = sum(seg.turning for seg in outline.segments)
+    if abs(total - 2 * math.pi) > _TURNING_TOLERANCE:
+        raise OutlineError(f"turning (total 2 pi): the segments turn by {total / math.pi:.6g} pi in total")
+    for seg in outline.segments:
+        sign = {"/": 0, ")": 1, "(": -1, ">": 1, "<": -1, "}": 1, "{": -1}[seg.symbol]
+        if sign and np.sign(seg.turning) != sign:
+            raise OutlineError(
+                f"turning (sign): segment {seg.symbol!r} ({NAMES[seg.symbol]}) turns by "
+                f"{math.degrees(seg.turning):.3g} degrees, of the wrong sign")
+
+
+def validate(outline: Union[str, "Outline"]) -> None:
+    """Check that an outline string (or an extracted :class:`Outline`) is well formed.
+
+    Parameters
+    ----------
+    outline : str or Outline
+        A cyclic string over :data:`SYMBOLS`, or an extracted outline (its string and its measured
+        segment turnings are checked).
+
+    Raises
+    ------
+    OutlineError
+        Naming the first rule broken: ``rule 1 (bounded)``, ``rule 2 (no repeated symbol)``,
+        ``rule 3 (no consecutive points)``, ``rule 4 (cusp next to a curve)``,
+        ``turning (total 2 pi)`` or ``turning (sign)``; or an unknown symbol.
+    """
+    string = outline if isinstance(outline, str) else outline.raw_string
+    _check_alphabet(string)
+    _check_rules(string)
+    if isinstance(outline, str):
+        _check_string_turning(string)
+    else:
+        _check_outline_turning(outline)
+
+
+def is_well_formed(outline: Union[str, "Outline"]) -> bool:
+    """True when :func:`validate` accepts the outline."""
+    try:
+        validate(outline)
+    except OutlineError:
+        return False
+    return True
+
+
+# --------------------------------------------------------------------------------------------------
+# Outline data
+
+
+def _frozen(array) -> np.ndarray:
+    array = np.array(array, dtype=np.float64)
+    array.setflags(write=False)
+    return array
+
+
+@dataclass(frozen=True, eq=False)
+class Segment:
+    """One element of an outline.
+
+    Attributes
+    ----------
+    symbol : str
+        Curvature type, one of :data:`SYMBOLS`.
+    start, stop : int
+        Span ``[start, stop)`` of samples of :attr:`Outline.contour`; ``0 <= start < n`` and
+        ``start < stop <= start + n``: indices past ``n`` wrap around. Point-like elements span the
+        corner window of the extraction.
+    arc : (float, float)
+        The same span as arc length along the contour from ``contour[0]``, pixels
+        (``start * h``, ``stop * h``; may exceed the perimeter when the span wraps).
+    turning : float
+        Signed tangent turning over the span, radians (positive = convex).
+    points : numpy.ndarray
+        ``(k, 2)`` contour samples of the span (x, y), pixels.
+    position : numpy.ndarray or None
+        Point-like elements: the apex (x, y): intersection of the tangent lines fitted on either
+        side for an angle, the sharpest sample for a cusp. None for line-like ones.
+    endpoints : numpy.ndarray or None
+        Straight lines: ``(2, 2)`` end points of the total-least-squares line through the span,
+        in the direction of travel. None otherwise.
+    """
+
+    symbol: str
+    start: int
+    stop: int
+    arc: tuple[float, float]
+    turning: float
+    points: np.ndarray
+    position: np.ndarray | None = None
+    endpoints: np.ndarray | None = None
+
+    @property
+    def name(self) -> str:
+        """Name of the curvature type."""
+        return NAMES[self.symbol]
+
+    @property
+    def is_point(self) -> bool:
+        """True for point-like elements (angles and cusps)."""
+        return self.symbol in _POINTS
+
+    @property
+    def length(self) -> float:
+        """Arc length of the span, pixels."""
+        return self.arc[1] - self.arc[0]
+
+    @property
+    def radius(self) -> float:
+        """Mean radius of curvature over the span, ``length / abs(turning)``, pixels (inf if flat)."""
+        return self.length / abs(self.turning) if self.turning else math.inf
+
+
+@dataclass(frozen=True, eq=False)
+class Outline:
+    """A qualitative outline extracted from a contour.
+
+    Attributes
+    ----------
+    segments : tuple of Segment
+        The elements in contour order, starting where the canonical string starts.
+    contour : numpy.ndarray
+        ``(n, 2)`` contour resampled evenly by arc length, positive orientation, pixels.
+    smoothed : numpy.ndarray
+        ``(n, 2)`` the same smoothed at the outline's scale (source of tangents and turnings).
+    perimeter : float
+        Length of the contour, pixels.
+    size : float
+        Diameter of the contour's minimum enclosing circle, pixels (the object's size).
+    """
+
+    segments: tuple[Segment, ...]
+    contour: np.ndarray
+    smoothed: np.ndarray
+    perimeter: float
+    size: float
+
+    @property
+    def raw_string(self) -> str:
+        """Symbols of :attr:`segments` in order (equal to :attr:`string` for extracted outlines)."""
+        return "".join(seg.symbol for seg in self.segments)
+
+    @property
+    def string(self) -> str:
+        """The canonical cyclic string."""
+        return canonical(self.raw_string)
+
+    @property
+    def spacing(self) -> float:
+        """Arc length between consecutive contour samples, pixels."""
+        return self.perimeter / len(self.contour)
+
+    def tangents(self) -> np.ndarray:
+        """``(n, 2)`` unit tangents of the smoothed contour, in the direction of travel."""
+        return _unit_tangents(self.smoothed)
+
+    def normals(self) -> np.ndarray:
+        """``(n, 2)`` inward unit normals ``(-t_y, t_x)`` of the smoothed contour."""
+        t = self.tangents()
+        return np.column_stack([-t[:, 1], t[:, 0]])
+
+    def turning(self) -> np.ndarray:
+        """``(n,)`` turning angle of the smoothed contour at every sample, radians (sum 2 pi)."""
+        return _turning(self.smoothed)
+
+    def __str__(self) -> str:
+        return self.string
+
+
+# --------------------------------------------------------------------------------------------------
+# Extraction
+
+
+def _unit_tangents(points: np.ndarray) -> np.ndarray:
+    d = np.roll(points, -1, axis=0) - np.roll(points, 1, axis=0)
+    return d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-12)
+
+
+def resample(contour: np.ndarray, samples: int) -> tuple[np.ndarray, float]:
+    """Resample a closed contour at ``samples`` points evenly spaced by arc length.
+
+    Parameters
+    ----------
+    contour : numpy.ndarray
+        ``(m, 2)`` closed contour (closing point not repeated), pixels.
+    samples : int
+        Number of output points.
+
+    Returns
+    -------
+    points : numpy.ndarray
+        ``(samples, 2)``, starting at ``contour[0]``.
+    perimeter : float
+        Length of the closed polyline, pixels.
+    """
+    closed = np.vstack([contour, contour[:1]])
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(closed, axis=0), axis=1))])
+    perimeter = float(s[-1])
+    if perimeter <= 0:
+        raise ContourError("the contour has zero length")
+    t = np.arange(samples) * (perimeter / samples)
+    points = np.column_stack([np.interp(t, s, closed[:, 0]), np.interp(t, s, closed[:, 1])])
+    return points, perimeter
+
+
+def _turning(smoothed: np.ndarray) -> np.ndarray:
+    """Turning angle at every sample, between the chords arriving and leaving (radians)."""
+    chord = np.roll(smoothed, -1, axis=0) - smoothed
+    angle = np.arctan2(chord[:, 1], chord[:, 0])
+    return np.angle(np.exp(1j * (angle - np.roll(angle, 1))))
+
+
+def _window_sums(phi: np.ndarray, half: int) -> np.ndarray:
+    """Sum of ``phi`` over the cyclic window ``[i - half, i + half)`` for every ``i``."""
+    n = len(phi)
+    c = np.concatenate([[0.0], np.cumsum(np.concatenate([phi, phi, phi]))])
+    i = np.arange(n) + n
+    return c[i + half] - c[i - half]
+
+
+def _find_corners(phi: np.ndarray, half: int, threshold: float) -> list[tuple[int, int]]:
+    """Greedy corner windows ``[start, start + 2 half)`` (start may be negative: cyclic)."""
+    n = len(phi)
+    free = np.ones(n, bool)
+    corners = []
+    while True:
+        sums = np.abs(_window_sums(np.where(free, phi, 0.0), half))
+        blocked = _window_sums((~free).astype(float), half) > 0  # window overlaps a corner
+        sums[blocked] = 0.0
+        i = int(np.argmax(sums))
+        if sums[i] < threshold:
+            return sorted(corners)
+        # Centre the window on the sharpest sample when that window is still free.
+        span = np.arange(i - half, i + half) % n
+        c = int(span[np.argmax(np.abs(phi[span]))])
+        window = np.arange(c - half, c + half) % n
+        start = c - half if free[window].all() else i - half
+        free[np.arange(start, start + 2 * half) % n] = False
+        corners.append((start % n, start % n + 2 * half))
+
+
+def _label_runs(kappa: np.ndarray, straight: float) -> list[list]:
+    """Runs ``[label, start, stop)`` of curvature sign (0 straight, 1 convex, -1 concave)."""
+    labels = np.where(kappa > straight, 1, np.where(kappa < -straight, -1, 0))
+    edges = np.flatnonzero(np.diff(labels)) + 1
+    bounds = np.concatenate([[0], edges, [len(labels)]])
+    return [[int(labels[a]), int(a), int(b)] for a, b in zip(bounds[:-1], bounds[1:])]
+
+
+def _coalesce(runs: list[list]) -> list[list]:
+    out = []
+    for run in runs:
+        if out and out[-1][0] == run[0]:
+            out[-1][2] = run[2]
+        else:
+            out.append(list(run))
+    return out
+
+
+def _classify_piece(phi: np.ndarray, samples: int, straight: float, min_run: int,
+                    flat_angle: float) -> list[list]:
+    """Line-like runs ``[label, start, stop)`` of one piece (indices relative to the piece)."""
+    kappa = phi * samples / (2 * np.pi)  # curvature relative to a disc of the same perimeter
+    runs = _coalesce(_label_runs(kappa, straight))
+    while len(runs) > 1:
+        lengths = [b - a for _, a, b in runs]
+        j = int(np.argmin(lengths))
+        if lengths[j] >= min_run:
+            break
+        neighbours = [k for k in (j - 1, j + 1) if 0 <= k < len(runs)]
+        k = max(neighbours, key=lambda m: lengths[m])
+        runs[j][0] = runs[k][0]
+        runs = _coalesce(runs)
+    for run in runs:
+        run[0] = {"/": 0, ")": 1, "(": -1}[_line_symbol(float(phi[run[1]:run[2]].sum()), flat_angle)]
+    return _coalesce(runs)
+
+
+def _line_symbol(turning: float, flat_angle: float) -> str:
+    """Line-like symbol agreeing with a run's total turning: small turning is straight."""
+    if abs(turning) < flat_angle:
+        return "/"
+    return ")" if turning > 0 else "("
+
+
+def _point_symbol(turning: float, corner_angle: float, cusp_angle: float) -> str:
+    """Symbol of a concentrated turning; ``""`` when it is too small to be a corner."""
+    if abs(turning) < corner_angle:
+        return ""
+    if abs(turning) >= cusp_angle:
+        return "}" if turning > 0 else "{"
+    return ">" if turning > 0 else "<"
+
+
+def _repair(items: list[list], phi: np.ndarray, corner_angle: float, cusp_angle: float,
+            flat_angle: float) -> list[list]:
+    """Make a cyclic list of ``[symbol, start, stop, turning]`` well formed (see module notes)."""
+    n = len(phi)
+
+    def merge(i: int, symbol: str) -> None:  # items[i] absorbs its successor
+        j = (i + 1) % len(items)
+        a, b = items[i], items[j]
+        items[i] = [symbol, a[1], a[2] + (b[2] - b[1]), a[3] + b[3]]
+        del items[j]
+
+    def link(i: int) -> None:
+        # A short straight link between items[i] and its successor, centred where the turning
+        # changes sign (the extremum of the cumulative turning), so that it turns little itself.
+        a, b = items[i], items[(i + 1) % len(items)]
+        b_stop = a[2] + (b[2] - b[1])
+        cumulative = np.cumsum(phi[np.arange(a[1], b_stop) % n])
+        q = max(1, (b_stop - a[1]) // 16)
+        m = a[1] + 1 + int(np.argmax(cumulative) if a[3] > 0 else np.argmin(cumulative))
+        m = min(max(m, a[1] + q + 1), b_stop - q - 1)
+        turning = lambda lo, hi: float(phi[np.arange(lo, hi) % n].sum())  # noqa: E731
+        items[i] = [a[0], a[1], m - q, turning(a[1], m - q)]
+        middle = ["/", m - q, m + q, turning(m - q, m + q)]
+        items[(i + 1) % len(items)] = [b[0], m + q, b_stop, turning(m + q, b_stop)]
+        for item in (items[i], items[(i + 1) % len(items)]):
+            item[0] = _point_symbol(item[3], corner_angle, cusp_angle)
+        items.insert(i + 1, middle)
+
+    while len(items) > 1:
+        for i, a in enumerate(items):
+            prev, b = items[i - 1], items[(i + 1) % len(items)]
+            if a[0] in _LINES and a[0] == b[0]:
+                merge(i, a[0])
+            elif a[0] in _POINTS and b[0] in _POINTS and (a[3] > 0) == (b[3] > 0):
+                merge(i, _point_symbol(a[3] + b[3], corner_angle, cusp_angle))
+            elif a[0] in _POINTS and b[0] in _POINTS:
+                # Opposite turnings closer than a window (a step): keep both, with a link between;
+                # summing them would erase the feature.
+                link(i)
+            elif a[0] == "":  # a corner too weak to count: its span joins the preceding element
+                turning = prev[3] + a[3]
+                if prev[0] in _POINTS or prev[0] == "":
+                    symbol = _point_symbol(turning, corner_angle, cusp_angle)
+                else:
+                    symbol = _line_symbol(turning, flat_angle)
+                merge((i - 1) % len(items), symbol)
+            elif a[0] in "}{" and prev[0] not in _CURVES and b[0] not in _CURVES:
+                # Two straight lines cannot meet in a cusp: at this resolution it is a sharp angle.
+                a[0] = ">" if a[0] == "}" else "<"
+            else:
+                continue
+            break
+        else:
+            break
+    if len(items) == 1:  # a single smooth element (a disc)
+        items[0][0] = ")" if items[0][3] > 0 else "("
+    symbols = [item[0] for item in items]
+    if ")" not in symbols and sum(s in CONVEX_POINTS for s in symbols) < 3:
+        # Bounded outlines need a convex curve or three convex points; the turning must then be
+        # carried by some line-like element that was judged straight or concave.
+        best = max((item for item in items if item[0] in _LINES), key=lambda it: it[3], default=None)
+        if best is None or best[3] <= 0:
+            raise ContourError("the contour cannot be described by a well-formed outline at this scale "
+                               "(it is too thin or too small)")
+        best[0] = ")"
+        return _repair(items, phi, corner_angle, cusp_angle, flat_angle)
+    return items
+
+
+def _tls_line(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Total-least-squares line: a point on it and the unit direction (along the points' order)."""
+    mean = points.mean(axis=0)
+    direction = np.linalg.svd(points - mean, full_matrices=False)[2][0]
+    if np.dot(points[-1] - points[0], direction) < 0:
+        direction = -direction
+    return mean, direction
+
+
+def _apex(points: np.ndarray, phi: np.ndarray, item: list, half: int, spacing: float) -> np.ndarray:
+    """Position of a corner: tangent lines fitted on either side intersected, or the sharpest sample."""
+    n = len(points)
+    symbol, start, stop = item[0], item[1], item[2]
+    span = np.arange(start, stop) % n
+    sharpest = points[span[np.argmax(np.abs(phi[span]))]]
+    if symbol in "}{" or half < 2:
+        return sharpest
+    p1, u1 = _tls_line(points[np.arange(start - half, start) % n])
+    p2, u2 = _tls_line(points[np.arange(stop, stop + half) % n])
+    cross = u1[0] * u2[1] - u1[1] * u2[0]
+    if abs(cross) < math.sin(math.radians(10)):
+        return sharpest
+    # p1 + a u1 = p2 + b u2
+    d = p2 - p1
+    a = (d[0] * u2[1] - d[1] * u2[0]) / cross
+    apex = p1 + a * u1
+    if np.linalg.norm(apex - sharpest) > 2 * half * spacing:
+        return sharpest
+    return apex
+
+
+def _segment(item: list, points: np.ndarray, phi: np.ndarray, half: int, spacing: float) -> Segment:
+    n = len(points)
+    symbol, start, stop, turning = item
+    start, stop = start % n, start % n + (stop - start)
+    span = points[np.arange(start, stop) % n]
+    position = endpoints = None
+    if symbol in _POINTS:
+        position = _frozen(_apex(points, phi, [symbol, start, stop], half, spacing))
+    elif symbol == "/":
+        mean, direction = _tls_line(span)
+        ends = (span[[0, -1]] - mean) @ direction
+        endpoints = _frozen(mean + ends[:, None] * direction)
+    return Segment(symbol, int(start), int(stop), (start * spacing, stop * spacing), float(turning),
+                   _frozen(span), position, endpoints)
+
+
+def outline_contour(contour: np.ndarray, *, samples: int = 1024, smoothing: float = 0.004,
+                    corner_window: float = 0.02, corner_angle: float = math.radians(30),
+                    cusp_angle: float = math.radians(125), straight: float = 0.25,
+                    flat_angle: float = math.radians(10)) -> Outline:
+    """The qualitative outline of a closed contour.
+
+    Parameters
+    ----------
+    contour : numpy.ndarray
+        ``(m, 2)`` closed contour (x, y), pixels, closing point not repeated; either orientation
+        (it is reversed when its shoelace area is negative).
+    samples : int
+        Number of samples after resampling by arc length.
+    smoothing : float
+        Standard deviation of the Gaussian smoothing, as a fraction of the perimeter.
+    corner_window : float
+        Width of the window in which concentrated turning makes a corner, fraction of the perimeter.
+    corner_angle : float
+        Smallest turning (radians) within a window that makes an angle (default 30 degrees).
+    cusp_angle : float
+        Smallest turning (radians) that makes a cusp rather than an angle (default 125 degrees).
+    straight : float
+        Largest ``abs(curvature) * perimeter / (2 pi)`` of a straight sample (default 0.25: radius
+        of curvature above four times that of a disc of the same perimeter).
+    flat_angle : float
+        A curve run turning less than this (radians) in total is straight (default 10 degrees).
+
+    Returns
+    -------
+    Outline
+        Well formed (checked with :func:`validate`), segments in canonical order.
+
+    Raises
+    ------
+    ContourError
+        Degenerate or self-intersecting contour, or one without a well-formed description.
+    """
+    contour = np.asarray(contour, dtype=np.float64)
+    if contour.ndim != 2 or contour.shape[1] != 2 or len(contour) < 3:
+        raise ContourError(f"expected an (m, 2) contour with m >= 3 points, got shape {contour.shape}")
+    if not np.all(np.isfinite(contour)):
+        raise ContourError("the contour has NaN or infinite coordinates")
+    area = signed_area(contour)
+    if area == 0:
+        raise ContourError("the contour encloses no area")
+    if area < 0:
+        contour = contour[::-1]
+    points, perimeter = resample(contour, samples)
+    smoothed = ndimage.gaussian_filter1d(points, smoothing * samples, axis=0, mode="wrap")
+    phi = _turning(smoothed)
+    winding = phi.sum() / (2 * np.pi)
+    if abs(winding - 1) > 1e-6:
+        raise ContourError(f"the contour is not a simple closed curve: its tangent turns {winding:.3g} times")
+    half = max(1, round(corner_window * samples / 2))
+    items = _items(phi, half, samples, corner_angle, cusp_angle, straight, flat_angle)
+    items = _repair(items, phi, corner_angle, cusp_angle, flat_angle)
+    string = "".join(item[0] for item in items)
+    r = _least_rotation(string)
+    items = items[r:] + items[:r]
+    spacing = perimeter / samples
+    segments = tuple(_segment(item, points, phi, half, spacing) for item in items)
+    size = 2.0 * cv2.minEnclosingCircle(points.astype(np.float32))[1]
+    outline = Outline(segments, _frozen(points), _frozen(smoothed), perimeter, float(size))
+    validate(outline)
+    return outline
+
+
+def _corner_spans(corners: list[tuple[int, int]], half: int, n: int) -> list[tuple[int, int]]:
+    """Corner windows widened by up to ``half`` samples on each side, into the pieces between them.
+
+    A corner's rounding (pixels, anti-aliasing, smoothing) spills past its detection window; that
+    turning belongs to the corner, not to the line-like neighbours it would otherwise bend. Each
+    piece keeps at least a third of its length.
+    """
+    m = len(corners)
+    spans = []
+    for k, (start, stop) in enumerate(corners):
+        before = start - (corners[k - 1][1] - (n if k == 0 else 0))
+        after = corners[(k + 1) % m][0] + (n if k + 1 == m else 0) - stop
+        spans.append((start - min(half, before // 3), stop + min(half, after // 3)))
+    return spans
+
+
+def _items(phi: np.ndarray, half: int, samples: int, corner_angle: float, cusp_angle: float,
+           straight: float, flat_angle: float) -> list[list]:
+    """Corners and classified runs between them, ``[symbol, start, stop, turning]`` in contour order."""
+    n = len(phi)
+    symbol_of = {0: "/", 1: ")", -1: "("}
+    corners = _find_corners(phi, half, corner_angle)
+    if not corners:
+        runs = _classify_piece(phi, samples, straight, 2 * half, flat_angle)
+        if len(runs) > 1 and runs[0][0] == runs[-1][0]:  # the first run continues the last one
+            runs[-1][2] = n + runs[0][2]
+            runs = runs[1:]
+        return [[symbol_of[lab], a, b, float(phi[np.arange(a, b) % n].sum())] for lab, a, b in runs]
+    spans = _corner_spans(corners, half, n)
+    items = []
+    for k, (start, stop) in enumerate(spans):
+        turning = float(phi[np.arange(start, stop) % n].sum())
+        items.append([_point_symbol(turning, corner_angle, cusp_angle), start, stop, turning])
+        nxt = spans[(k + 1) % len(spans)][0] + (n if k + 1 == len(spans) else 0)
+        if nxt - stop >= 2 * half:
+            idx = np.arange(stop, nxt) % n
+            for lab, a, b in _classify_piece(phi[idx], samples, straight, 2 * half, flat_angle):
+                items.append([symbol_of[lab], stop + a, stop + b, float(phi[idx[a:b]].sum())])
+        elif nxt > stop:  # shorter than a window: a corner if it turns enough, else a straight link
+            turning = float(phi[np.arange(stop, nxt) % n].sum())
+            items.append([_point_symbol(turning, corner_angle, cusp_angle) or "/", stop, nxt, turning])
+    return items
+
+
+def outline_image(src: ImageSource, *, threshold: float | None = None, largest: bool = False,
+                  subpixel: bool = True, **options) -> Outline:
+    """The qualitative outline of the object in an image.
+
+    Parameters
+    ----------
+    src : str, pathlib.Path or numpy.ndarray
+        Image file or array (see :func:`qualitative.vision.read_image`).
+    threshold : float, optional
+        Grey level separating object and background, in the input's units; default Otsu's.
+    largest : bool
+        With several objects, describe the largest instead of raising.
+    subpixel : bool
+        Refine the contour to sub-pixel accuracy.
+    **options
+        Extraction parameters of :func:`outline_contour`.
+
+    Returns
+    -------
+    Outline
+        Coordinates in pixels of the input image (x = column, y = row).
+    """
+    contour = extract_contour(src, threshold=threshold, largest=largest, subpixel=subpixel)
+    return outline_contour(contour, **options)
+
+
+def outline_to_dict(outline: Outline) -> dict:
+    """JSON-ready description of an outline.
+
+    Keys: ``string`` (canonical), ``size`` and ``perimeter`` (pixels) and ``segments``, in canonical
+    order, each with ``symbol``, ``name``, ``start``/``stop`` (samples of the resampled contour),
+    ``arc`` (pixels along the contour), ``turning`` (radians), ``points`` (list of [x, y]) and, for
+    point-like elements, ``position`` ([x, y]) or, for straight lines, ``endpoints``.
+    """
+    segments = []
+    for seg in outline.segments:
+        row = {"symbol": seg.symbol, "name": seg.name, "start": seg.start, "stop": seg.stop,
+               "arc": list(seg.arc), "turning": seg.turning, "points": seg.points.tolist()}
+        if seg.position is not None:
+            row["position"] = seg.position.tolist()
+        if seg.endpoints is not None:
+            row["endpoints"] = seg.endpoints.tolist()
+        segments.append(row)
+    return {"string": outline.string, "size": outline.size, "perimeter": outline.perimeter,
+            "segments": segments}
