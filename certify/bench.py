@@ -1,8 +1,20 @@
 """``qualgrasp bench``: time the certification routes on the same random grasps, in one run.
 
-For each kind of grasp, every route computes the force-closure verdict with its certificate on the
-same grasps; the table gives microseconds per grasp, grasps per second and each route's time as a
-multiple of the fast route's. The exact re-check (``verify``) is timed as its own row.
+For each kind of grasp every route answers force closure, with its certificate, on the same
+grasps (a prefix of them for the slow routes):
+
+* **qualgrasp batch**: :func:`certify.fastpath.certify_table` on an Arrow table of the grasps,
+  the path ``qualgrasp certify`` takes on Parquet input, per worker process. It does more than the
+  others: force *and* form closure, both certificates and their rigorous re-check (epsilon off).
+* **per-grasp fast route**: :func:`certify.closure.force_closure` with the fast solver.
+* **clarabel direct**: the same programme through clarabel's API with prebuilt structure.
+* **scipy linprog (HiGHS)**: polyhedral kinds only.
+* **cvxpy + Parameters** (the reference route) and **cvxpy rebuilt per grasp**.
+* **exact verify**: the rational-arithmetic checker on the per-grasp certificates.
+
+The table gives microseconds per grasp, grasps per second and each route's time per grasp as a
+multiple of the batch path's. Speeds are single-process; ``qualgrasp certify --workers N`` runs N
+such processes.
 """
 
 from __future__ import annotations
@@ -35,43 +47,75 @@ class BenchRow:
     route: str
     grasps: int
     seconds: float
-    ratio: float  # time per grasp relative to the fast route
+    ratio: float  # time per grasp relative to the batch path
 
     @property
     def us_per_grasp(self) -> float:
         return 1e6 * self.seconds / self.grasps
 
 
-def _time(fn, items) -> float:
+def _time(fn, items, progress=None) -> float:
     start = time.perf_counter()
     for item in items:
         fn(item)
+        if progress:
+            progress()
     return time.perf_counter() - start
 
 
-def run_bench(n: int = 2000, seed: int = 0, reference_n: int = 300) -> list[BenchRow]:
-    """Time fast, reference (cvxpy with Parameters), cvxpy rebuilt per grasp, and verify."""
+def _batch_seconds(grasps) -> float:
+    """Seconds of the columnar batch path on ``grasps`` (table built outside the timing)."""
+    from .engine import Options
+    from .fastpath import certify_table
+    from .grasp import grasp_to_dict
+    from .report import certify_grasp
+    from .table import grasps_table
+
+    table = grasps_table([grasp_to_dict(g) for g in grasps])
+    lines = list(range(1, len(grasps) + 1))
+    options = Options(quality=False)
+
+    def slow(idx):
+        return [certify_grasp(grasps[i], quality=False).row(line=lines[i]) for i in idx]
+
+    certify_table(table.slice(0, 8), lines[:8], options, slow=slow)  # compile outside the timing
+    start = time.perf_counter()
+    certify_table(table, lines, options, slow=slow)
+    return time.perf_counter() - start
+
+
+def run_bench(n: int = 20000, seed: int = 0, reference_n: int = 300,
+              progress: bool = True) -> list[BenchRow]:
+    """Time every route of the module docstring on ``n`` grasps per kind (``reference_n`` for the
+    routes slower than a millisecond per grasp)."""
+    from rich.progress import Progress
+
     rows = []
-    for kind, kwargs in KINDS.items():
-        grasps = random_grasps(seed, n, **kwargs)
-        few = grasps[:reference_n]
-        fast = make_solver("fast")
-        force_closure(grasps[0], solver=fast)  # build structure outside the timing
-        t_fast = _time(lambda g: force_closure(g, solver=fast), grasps) / len(grasps)
-        verdicts = [force_closure(g, solver=fast) for g in few]
-        routes = [("fast (qualgrasp)", len(grasps), t_fast * len(grasps))]
-        ref = CvxpySolver(parametric=True)
-        force_closure(grasps[0], solver=ref)
-        routes.append(("reference: cvxpy + Parameters", len(few),
-                       _time(lambda g: force_closure(g, solver=ref), few)))
-        naive = CvxpySolver(parametric=False)
-        routes.append(("cvxpy rebuilt per grasp", len(few),
-                       _time(lambda g: force_closure(g, solver=naive), few)))
-        pairs = list(zip(few, verdicts))
-        routes.append(("verify (exact, no solver)", len(few),
-                       _time(lambda gv: verify(gv[0], gv[1].certificate), pairs)))
-        for route, count, seconds in routes:
-            rows.append(BenchRow(kind, route, count, seconds, (seconds / count) / t_fast))
+    with Progress(transient=True, disable=not progress) as bar:
+        for kind, kwargs in KINDS.items():
+            task = bar.add_task(kind, total=None)
+            grasps = random_grasps(seed, n, **kwargs)
+            few = grasps[:reference_n]
+            t_batch = _batch_seconds(grasps) / len(grasps)
+            routes = [("qualgrasp batch (force + form, certified)", len(grasps), t_batch * len(grasps))]
+            tick = lambda: bar.advance(task)
+            solvers = [("per-grasp fast route", make_solver("fast"), grasps[: max(reference_n, n // 10)]),
+                       ("clarabel direct", make_solver("clarabel"), few)]
+            if kwargs["dim"] == 2 or kwargs["model"] == "frictionless":
+                solvers.append(("scipy linprog (HiGHS)", make_solver("linprog"), few))
+            solvers += [("cvxpy + Parameters (reference)", CvxpySolver(parametric=True), few),
+                        ("cvxpy rebuilt per grasp", CvxpySolver(parametric=False), few)]
+            for name, solver, items in solvers:
+                force_closure(grasps[0], solver=solver)  # build structure outside the timing
+                routes.append((name, len(items),
+                               _time(lambda g: force_closure(g, solver=solver), items, tick)))
+            fast = make_solver("fast")
+            pairs = [(g, force_closure(g, solver=fast)) for g in few]
+            routes.append(("exact verify (rationals, no solver)", len(pairs),
+                           _time(lambda gv: verify(gv[0], gv[1].certificate), pairs, tick)))
+            for route, count, seconds in routes:
+                rows.append(BenchRow(kind, route, count, seconds, (seconds / count) / t_batch))
+            bar.remove_task(task)
     return rows
 
 
@@ -80,8 +124,8 @@ def print_bench(rows: list[BenchRow]) -> None:
     from rich.console import Console
     from rich.table import Table
 
-    table = Table(title="closure certification, time per grasp (same grasps, same run)")
-    for col in ("kind", "route", "grasps", "us/grasp", "grasps/s", "x fast"):
+    table = Table(title="closure certification, time per grasp (same grasps, same run, one process)")
+    for col in ("kind", "route", "grasps", "us/grasp", "grasps/s", "x batch"):
         table.add_column(col, justify="left" if col in ("kind", "route") else "right")
     for r in rows:
         table.add_row(r.kind, r.route, str(r.grasps), f"{r.us_per_grasp:.1f}",

@@ -173,17 +173,15 @@ def slack(block: Block, v: Sequence[float]) -> tuple[float, float]:
     return float(block.mu) * fn - float(np.linalg.norm(ft)), fn
 
 
-def polar_value(block: Block, a: Sequence[float]) -> float:
-    """Float ``a_n + mu norm(a_t)``: the largest ``y . w`` over unit-normal-force wrenches."""
-    if block.kind == "ray":
-        return float(a[0])
-    n = np.array(block.n, dtype=float) / math.sqrt(_dot(block.n, block.n))
-    av = np.array(a[: len(n)], dtype=float)
-    an = float(av @ n)
-    at = list(av - an * n)
-    if block.kind == "soft":
-        at.append(float(a[len(n)]) * float(block.torsion))
-    return an + float(block.mu) * float(np.linalg.norm(at))
+def polar_values(C, blocks, y) -> np.ndarray:
+    """Float ``a_n + mu norm(a_t)`` of every block for ``a = C_b' y``: the largest ``y . w`` over
+    the block's unit-normal-force wrenches (compiled; shared by every route)."""
+    from .kernels import polar_values as kernel
+    from .problem import block_arrays
+
+    C = np.ascontiguousarray(C, dtype=float)
+    dim = max((len(b.n) for b in blocks), default=2) or 2
+    return kernel(C, *block_arrays(blocks, dim), np.ascontiguousarray(y, dtype=float))
 
 
 def margin_of(blocks, x) -> float:
@@ -321,6 +319,6 @@ def _verify_degenerate(Cx, blocks, cert: Certificate, tol: Tolerances) -> Check:
     if np.abs(C @ x).max() > tol.near or margin_of(blocks, x) < -tol.near:
         return Check(False, "values are not a near-interior equilibrium")
     y = y / np.linalg.norm(y)
-    if max(polar_value(b, C[:, list(b.cols)].T @ y) for b in blocks) > tol.near:
+    if polar_values(C, blocks, y).max() > tol.near:
         return Check(False, "y is not a near-separating direction")
     return Check(True)

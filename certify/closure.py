@@ -23,10 +23,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import exact as ex
-from .certificates import Certificate, Tolerances, polar_value
+from .certificates import Certificate, Tolerances, polar_values
 from .errors import GraspError, SolverError
 from .grasp import Grasp
-from .kernels import pivot_basis
+from .kernels import null_direction, pivot_basis, world_values
 from .problem import ClosureProblem, grasp_problem, grasp_system, span_problem, span_system
 from .solvers import make_solver
 
@@ -79,7 +79,7 @@ def decide(problem: ClosureProblem, exact_columns, solver,
             if not thin:
                 raise  # solvers may fail on rank-deficient data; there the rank decides below
     if sol is not None and not thin and sol.status == "optimal" and sol.t >= tol.margin:
-        values = problem.to_values @ sol.x
+        values = world_values(problem.to_values[None], sol.x[None])[0]
         basis = pivot_basis(np.ascontiguousarray(C, dtype=float))
         cert = Certificate("interior", layout, _floats(values), tuple(int(j) for j in basis))
         return Verdict("closure", float(sol.t), cert)
@@ -89,7 +89,8 @@ def decide(problem: ClosureProblem, exact_columns, solver,
             return Verdict("no_closure", 0.0, cert)
     if thin:
         if k < d or ex.rank([list(r) for r in exact_columns()]) < d:
-            cert = Certificate("farkas", layout, y=_floats(U[:, -1]),
+            y = null_direction(np.ascontiguousarray(C)) if d == 3 and k < d else U[:, -1]
+            cert = Certificate("farkas", layout, y=_floats(y),
                                tight=tuple(range(len(blocks))), null_space=True)
             return Verdict("no_closure", 0.0, cert)
         return Verdict("degenerate", 0.0, Certificate("degenerate", layout, reason="rank"))
@@ -123,7 +124,7 @@ def farkas_certificate(C: np.ndarray, blocks, layout: str, y: np.ndarray,
         if norm < 0.5:
             return None
         y = y / norm
-    others = [polar_value(b, C[:, list(b.cols)].T @ y) for i, b in enumerate(blocks) if i not in tight]
+    others = [v for i, v in enumerate(polar_values(C, blocks, y)) if i not in tight]
     if others and max(others) >= -1e-9 * scale:
         return None
     return Certificate("farkas", layout, y=_floats(y), tight=tight,

@@ -19,57 +19,27 @@ import numpy as np
 import pyarrow as pa
 
 from .certificates import Tolerances
-from .columns import FRICTIONLESS, POINT, GraspColumns, grasp_columns
-from .kernels import (lp_planar, pivot_bases, planar_epsilon, thin_planar, verify_null_planar,
-                      verify_planar)
+from .columns import FRICTIONLESS, POINT, SOFT, GraspColumns, grasp_columns
+from .kernels import planar_batch
 from .solvers.enumeration import _FEAS, bases
 from .table import CERTIFICATE, RESULT_SCHEMA
-from .wrench import generator_columns
 
-__all__ = ["certify_table", "generator_error"]
+__all__ = ["certify_table"]
 
-_U = 2.0**-53
 _MODEL_NAMES = {FRICTIONLESS: "frictionless", POINT: "point"}
 
 
-def _gamma(n: int) -> float:
-    return n * _U / (1 - n * _U)
+_STATUS = pa.array(["no_closure", "closure"])
+_KIND = pa.array(["farkas", "interior"])
 
 
-def generator_error(P, N, mu, models, center, length, *, frictionless: bool = False) -> np.ndarray:
-    """Bounds on the difference between the planar generator wrenches computed in floating point
-    by :func:`certify.wrench.generator_columns` and their exact values on the same float data.
-
-    A frictionless generator ``(n, ((p - c) x n) / L)``: forces exact, torque within
-    ``gamma_10 (|dx| |n_y| + |dy| |n_x|) / L``. A friction edge ``n +- mu t``: each force
-    component within ``gamma_2 (|n_x| + mu |n_y|)`` (resp. ``y``), torque as above with those
-    magnitudes. ``gamma_n = n u / (1 - n u)``, ``u = 2^-53`` (Higham); generous by a few units.
-    """
-    owner, edge = [], []
-    for i, model in enumerate(models):
-        if frictionless or model == "frictionless":
-            owner.append(i), edge.append(False)
-        else:
-            owner += [i, i]
-            edge += [True, True]
-    owner = np.array(owner)
-    edge = np.array(edge)
-    n = np.abs(N[..., owner, :])
-    m = np.where(edge, mu[..., owner], 0.0)
-    ax = n[..., 0] + m * n[..., 1]
-    ay = n[..., 1] + m * n[..., 0]
-    d = np.abs(P[..., owner, :] - np.asarray(center)[..., None, :])
-    L = np.asarray(length)[..., None]
-    E = np.zeros(P.shape[:-2] + (3, len(owner)))
-    E[..., 0, :] = np.where(edge, _gamma(2) * ax, 0.0)
-    E[..., 1, :] = np.where(edge, _gamma(2) * ay, 0.0)
-    E[..., 2, :] = _gamma(10) * (d[..., 0] * ay + d[..., 1] * ax) / L
-    return E
-
-
-def _list_array(values: np.ndarray, valid: np.ndarray, type_: pa.DataType) -> pa.Array:
-    """Arrow list array with ``values.shape[1]`` items per valid row and nulls elsewhere."""
+def _list_array(values: np.ndarray, valid: np.ndarray | None, type_: pa.DataType) -> pa.Array:
+    """Arrow list array with ``values.shape[1]`` items per valid row and nulls elsewhere
+    (``valid=None``: every row valid)."""
     n, w = values.shape
+    if valid is None:
+        offsets = np.arange(0, n * w + 1, w, dtype=np.int32)
+        return pa.ListArray.from_arrays(pa.array(offsets), pa.array(values.ravel(), type=type_.value_type))
     offsets = np.zeros(n + 1, dtype=np.int32)
     offsets[1:] = np.cumsum(np.where(valid, w, 0))
     flat = values[valid].ravel()
@@ -77,121 +47,274 @@ def _list_array(values: np.ndarray, valid: np.ndarray, type_: pa.DataType) -> pa
                                     mask=pa.array(~valid))
 
 
-def _certificates(interior: np.ndarray, lam: np.ndarray, basis: np.ndarray, y: np.ndarray,
-                  null_space: bool) -> pa.Array:
-    """Certificate structs (generators layout): interior rows carry weights and basis, the
-    others a Farkas direction: strict, or (``null_space``) orthogonal to every generator."""
+def _certificates(code: np.ndarray, lam: np.ndarray, basis: np.ndarray, y: np.ndarray,
+                  layout: str = "generators", blocks: int | None = None,
+                  tight: dict | None = None) -> pa.Array:
+    """Certificate structs from verdict codes: 1 interior (values, basis), 2 strict Farkas,
+    3 Farkas orthogonal to every one of the ``blocks`` cone blocks (null space), 4 Farkas with
+    the tight blocks ``tight[row]``."""
     n, k = lam.shape
+    nb = k if blocks is None else blocks
+    interior = code == 1
     far = ~interior
-    tight = np.tile(np.arange(k if null_space else 0, dtype=np.int32), (n, 1))
+    lists = [np.arange(nb) if c == 3 else (tight or {}).get(r, ()) if c == 4 else () for r, c in enumerate(code)]
+    lengths = np.array([len(t) if f else 0 for t, f in zip(lists, far)], dtype=np.int32)
+    offsets = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int32)
+    flat = np.concatenate([np.asarray(t, dtype=np.int32) for t, f in zip(lists, far) if f] or
+                          [np.zeros(0, np.int32)])
+    tight_arr = pa.ListArray.from_arrays(pa.array(offsets), pa.array(flat, type=pa.int32()),
+                                         mask=pa.array(interior))
     return pa.StructArray.from_arrays([
-        pa.array(np.where(interior, "interior", "farkas").astype(object)),
-        pa.array(np.full(n, "generators", dtype=object)),
+        _KIND.take(pa.array(interior.astype(np.int8))),
+        pa.array([layout]).take(pa.array(np.zeros(n, np.int8))),
         _list_array(lam, interior, CERTIFICATE.field("values").type),
         _list_array(basis.astype(np.int32), interior, CERTIFICATE.field("basis").type),
         _list_array(y, far, CERTIFICATE.field("y").type),
-        _list_array(tight, far, CERTIFICATE.field("tight").type),
-        pa.array(np.where(far, null_space, None).tolist(), type=pa.bool_()),
+        tight_arr,
+        pa.array(lengths == nb, mask=interior),
         pa.nulls(n, pa.string()),
     ], fields=list(CERTIFICATE))
 
 
-def _verdicts(W: np.ndarray, tol: Tolerances):
-    """Closure verdicts of a group of planar generator matrices (B, 3, k), as
-    :func:`certify.closure.decide` gives them; ``settled`` is False where that needs the per-grasp
-    path (thin, near-degenerate, tight Farkas directions)."""
-    B, d, k = W.shape
-    if k < d:  # fewer generators than wrench dimensions: a null-space direction, from the SVD
-        y = np.linalg.svd(W)[0][:, :, -1]
-        no = np.zeros(B, dtype=bool)
-        return no, ~no, np.full(B, -np.inf), np.zeros((B, k)), np.zeros((B, d), int), y
-    t, lam, y, has_y = lp_planar(W, bases(k, d), _FEAS)
-    thin = thin_planar(W)
-    closure = ~thin & (t >= tol.margin)
-    # strict Farkas direction exactly as farkas_certificate builds it (no tight contacts)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        yn = y / np.sqrt(np.sum(y * y, axis=1, keepdims=True))
-    funct = np.einsum("bdk,bd->bk", W, yn)
-    scale = np.abs(W).max(axis=(1, 2))
-    tight = (np.abs(funct) <= 1e-7 * scale[:, None]).any(axis=1)
-    strict = funct.max(axis=1) < -1e-9 * scale
-    farkas = ~thin & ~closure & has_y & (t < tol.margin) & ~tight & strict
-    basis = np.zeros((B, d), dtype=np.int64)
-    if closure.any():
-        basis[closure] = pivot_bases(np.ascontiguousarray(W[closure]))
-    return closure, farkas, t, lam, basis, yn
+def _layout(models, frictionless: bool):
+    """Owner contact and edge sign of each generator (as :func:`generator_columns` orders them)."""
+    owner, sign = [], []
+    for i, model in enumerate(models):
+        if frictionless or model == "frictionless":
+            owner.append(i), sign.append(0)
+        else:
+            owner += [i, i]
+            sign += [1, -1]
+    return np.array(owner, dtype=np.int64), np.array(sign, dtype=np.float64)
 
 
 def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances):
-    """Certify the planar grasps ``rows`` (one contact pattern); return the settled rows and
-    their result columns."""
+    """Certify the planar grasps ``rows`` (one contact pattern) with :func:`planar_batch`;
+    return the settled rows and their result columns."""
     m = int(cols.count[rows[0]])
     models = tuple(_MODEL_NAMES[int(c)] for c in cols.model[rows[0], :m])
-    P = np.ascontiguousarray(cols.P[rows, :m, :2])
-    N = np.ascontiguousarray(cols.N[rows, :m, :2])
-    mu = cols.mu[rows, :m]
-    c, L = cols.center[rows, :2], cols.length[rows]
-    out: dict[str, Any] = {}
-    settled = np.ones(len(rows), dtype=bool)
-    frictionless = all(name == "frictionless" for name in models)
-    for key, fl in (("force", False), ("form", True)):
-        if key == "form" and frictionless:
-            out["form"] = out["force"]
-            break
-        W, _ = generator_columns(P, N, mu, models, c, L, frictionless=fl)
-        W = np.ascontiguousarray(W)
-        closure, farkas, t, lam, basis, yn = _verdicts(W, tol)
-        E = np.ascontiguousarray(generator_error(P, N, mu, models, c, L, frictionless=fl))
-        if W.shape[2] < W.shape[1]:
-            proved = verify_null_planar(W, E, np.ascontiguousarray(yn))
-        else:
-            kind = np.where(closure, 1, np.where(farkas, 2, 0))
-            proved = verify_planar(W, E, kind, np.nan_to_num(lam), basis, np.nan_to_num(yn),
-                                   tol.residual)
-        settled &= (closure | farkas) & (proved == 1)
-        out[key] = (closure, t, lam, basis, yn, W.shape[2] < W.shape[1])
+    owner, sign = _layout(models, False)
+    owner_f, _ = _layout(models, True)
+    same = all(name == "frictionless" for name in models)
+    (code, t, lam, basis, y, code_f, t_f, lam_f, basis_f, y_f, eps) = planar_batch(
+        np.ascontiguousarray(cols.P[rows, :m, :2]), np.ascontiguousarray(cols.N[rows, :m, :2]),
+        np.ascontiguousarray(cols.mu[rows, :m]), np.ascontiguousarray(cols.center[rows, :2]),
+        np.ascontiguousarray(cols.length[rows]), owner, sign, bases(len(owner), 3), owner_f,
+        bases(m, 3), same, tol.margin, _FEAS, tol.residual, options.quality)
+    settled = (code > 0) & (code_f > 0)
+    out = {"force": (code, t, lam, basis, y), "form": (code_f, t_f, lam_f, basis_f, y_f)}
     if options.quality:
-        W, owner = generator_columns(P, N, mu, models, c, L)
-        W = np.ascontiguousarray(W)
-        closed = out["force"][0]
-        for norm in ("L1", "Linf"):
-            eps = np.zeros(len(rows))
-            if closed.any():
-                eps[closed] = planar_epsilon(np.ascontiguousarray(W[closed]), owner, m,
-                                             norm == "Linf")[0]
-            out[norm] = eps
+        out["L1"], out["Linf"] = eps[:, 0], eps[:, 1]
     return settled, out
 
 
+def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances):
+    """Certify the spatial grasps ``rows`` (one contact pattern with friction): force closure
+    by the compiled dual barrier method, form closure by the null-space direction (fewer than 6
+    contacts) or the enumerated LP, every certificate re-checked in floating point with error
+    bounds. Rows these rules do not settle (thin, near the boundary, tight contacts, unproved,
+    or needing the spatial epsilon) are left to the per-grasp path."""
+    from .certificates import verify
+    from .closure import decide
+    from .grasp import Contact, Grasp
+    from .problem import Block, ClosureProblem, System, grasp_system
+    from .kernels import (barrier_batch, certify_rows, null_rows, verify_farkas_general,
+                          verify_interior_general, world_values)
+    from .problem import conic_columns
+    from .solvers import BARRIER_NEAR_ZERO, make_solver
+    from .solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
+    from .wrench import force_columns, generator_columns
+
+    m = int(cols.count[rows[0]])
+    names = {FRICTIONLESS: "frictionless", POINT: "point", SOFT: "soft"}
+    models = tuple(names[int(c)] for c in cols.model[rows[0], :m])
+    P, N = cols.P[rows, :m, :], cols.N[rows, :m, :]
+    mu, tor, c, L = cols.mu[rows, :m], cols.torsion[rows, :m], cols.center[rows], cols.length[rows]
+    B = len(rows)
+    # force closure: the barrier method on the solver columns
+    columns, rays, cones, to_values = conic_columns(P, N, mu, tor, models, c, L)
+    blocks = [(r, 1, np.ones(B)) for r in rays] + list(cones)
+    rmax = max(size - 1 for _, size, _ in cones)
+    Pm = np.zeros((B, len(blocks), 6))
+    T = np.zeros((B, len(blocks), rmax, 6))
+    rk = np.zeros(len(blocks), dtype=np.int64)
+    kappa = np.ones((B, len(blocks)))
+    for b, (start, size, k) in enumerate(blocks):
+        Pm[:, b] = columns[:, :, start]
+        if size > 1:
+            T[:, b, : size - 1] = np.swapaxes(columns[:, :, start + 1:start + size], 1, 2)
+            rk[b], kappa[:, b] = size - 1, k
+    status, t, y, xn, xt = barrier_batch(Pm, T, rk, kappa, EXIT_BELOW, GAP_TOL, MAX_NEWTON)
+    x = np.zeros((B, columns.shape[2]))
+    for b, (start, size, _) in enumerate(blocks):
+        x[:, start] = xn[:, b]
+        x[:, start + 1:start + size] = xt[:, b, : size - 1]
+    # the certificate system (world-frame force columns) and its error bounds
+    C, owner = force_columns(P, N, models, c, L)
+    C = np.ascontiguousarray(C)
+    E = _force_column_error(P, N, models, c, L, C.shape[2])
+    kind = np.array([{"frictionless": 0, "point": 1, "soft": 2}[name] for name in models])
+    first = np.array([np.flatnonzero(owner == i)[0] for i in range(m)])
+    sv = np.linalg.svd(C, compute_uv=False)
+    thin = sv[:, -1] <= 1e-6 * sv[:, 0]
+    near = (status == 2) | ((status == 0) & (np.abs(t) < BARRIER_NEAR_ZERO))
+    closure = ~thin & ~near & (status == 0) & (t >= tol.margin)
+    if options.quality:
+        closure_ok = np.zeros(B, dtype=bool)  # the spatial epsilon is the per-grasp path's
+    else:
+        closure_ok = closure
+    values = world_values(np.ascontiguousarray(to_values), x)
+    farkas = ~thin & ~near & (t < tol.margin)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        yn = np.nan_to_num(y / np.sqrt(np.sum(y * y, axis=1, keepdims=True)))
+    scale = np.abs(C).max(axis=(1, 2))
+    funct = np.einsum("bdk,bd->bk", C, yn)
+    for b_ in range(m):
+        sel = owner == b_
+        farkas &= ~(np.abs(funct[:, sel]).max(axis=1) <= 1e-7 * scale)  # no tight contacts
+    code, basis = certify_rows(C, E, kind, first, np.ascontiguousarray(N), np.ascontiguousarray(mu),
+                               np.ascontiguousarray(tor), values, yn, closure_ok, farkas, scale,
+                               tol.residual)
+    # near the boundary the per-grasp rule re-solves with clarabel (tight contacts); settle those
+    # verdicts here too, with the float re-check
+    tight_rows = {}
+    solver = make_solver("fast")
+    def grasp_of(i):
+        return Grasp(tuple(Contact(P[i, j], N[i, j], models[j], mu[i, j],
+                                   tor[i, j] if models[j] == "soft" else None) for j in range(m)),
+                     center=c[i], length=L[i])
+
+    for i in np.flatnonzero(near & ~thin):
+        # the per-grasp decision on the columns already built (same arithmetic as grasp_problem)
+        system = System(C[i], tuple(Block(("ray", "point", "soft")[kind[b]],
+                                          tuple(np.flatnonzero(owner == b)), tuple(N[i, b]),
+                                          float(mu[i, b]), float(tor[i, b]) if kind[b] == 2 else 0)
+                                    for b in range(m)), "forces")
+        problem = ClosureProblem(columns[i], rays, tuple((st, sz, float(k[i])) for st, sz, k in cones),
+                                 to_values[i], system)
+        v = decide(problem, lambda i=i: grasp_system(grasp_of(i), exact=True).columns, solver, tol)
+        cert = v.certificate
+        if v.status == "closure" and not options.quality:
+            values[i], basis[i], t[i] = cert.values, cert.basis, v.margin
+            if verify_interior_general(C[i], E[i], kind, first, N[i], mu[i], tor[i], values[i],
+                                       basis[i], tol.residual):
+                code[i] = 1
+        elif v.status == "no_closure" and not cert.null_space:
+            yn[i] = cert.y
+            mask = np.zeros(m, dtype=bool)
+            mask[list(cert.tight)] = True
+            shift = 0.0
+            if mask.any():
+                shift = _tight_shift(C[i], E[i], owner, mask, models, P[i], yn[i])
+            proved = shift <= 1e-6 * np.sqrt(np.sum(yn[i] ** 2)) and verify_farkas_general(
+                C[i], E[i], kind, first, N[i], mu[i], tor[i], yn[i], mask, shift)
+            # tight blocks of lower rank than their columns (two fingers squeezing) have an
+            # exact span that floats cannot certify: the exact checker decides those
+            if proved or verify(grasp_of(i), cert, status="no_closure"):
+                code[i] = 4 if mask.any() else 2
+                tight_rows[int(i)] = np.flatnonzero(mask)
+    # form closure: frictionless generators
+    Wf, _ = generator_columns(P, N, mu, models, c, L, frictionless=True)
+    Wf = np.ascontiguousarray(Wf)
+    Ef = _force_column_error(P, N, ("frictionless",) * m, c, L, m)
+    code_f = np.zeros(B, dtype=np.int64)
+    t_f = np.zeros(B)
+    lam_f = np.zeros((B, m))
+    basis_f = np.zeros((B, 6), dtype=np.int64)
+    y_f = np.zeros((B, 6))
+    if m < 6:
+        y_f = np.ascontiguousarray(np.linalg.svd(Wf)[0][:, :, -1])
+        code_f = null_rows(Wf, Ef, y_f)
+    # m >= 6: the enumerated LP (left to the per-grasp path for now)
+    settled = (code > 0) & (code_f > 0)
+    out = {"force": (code, t, values, basis, np.nan_to_num(yn)),
+           "form": (code_f, t_f, lam_f, basis_f, y_f),
+           "force_layout": ("forces", m), "tight": tight_rows}
+    return settled, out
+
+
+def _tight_shift(C, E, owner, mask, models, P, y) -> float:
+    """Rigorous bound on how far the exact projection of ``y`` off the span of the tight blocks'
+    columns moves it (``inf`` when not proved in floats).
+
+    The columns of one point contact are independent. Those of two point contacts at distinct
+    points, ``(e_j, (p_i - c) x e_j / L)``, have rank exactly 5 for any data: the map
+    ``(a, b) -> (a + b, (r_1 x a + r_2 x b) / L)`` has kernel ``{(a, -a) : a || r_1 - r_2}``. So
+    their span is that of any 5 of them proved independent, which floats can bound. Other tight
+    sets go to the exact checker."""
+    from .kernels import projection_bound
+
+    tight = np.flatnonzero(mask)
+    cols = np.flatnonzero(mask[owner])
+    if len(tight) == 2 and all(models[b] == "point" for b in tight) and \
+            not np.array_equal(P[tight[0]], P[tight[1]]):
+        for drop in range(len(cols)):
+            keep = np.delete(cols, drop)
+            bound = projection_bound(np.ascontiguousarray(C[:, keep]), np.ascontiguousarray(E[:, keep]), y)
+            if np.isfinite(bound):
+                return bound
+        return np.inf
+    if len(tight) == 1 and models[tight[0]] != "soft":
+        return projection_bound(np.ascontiguousarray(C[:, cols]), np.ascontiguousarray(E[:, cols]), y)
+    return np.inf
+
+
+def _force_column_error(P, N, models, center, length, k) -> np.ndarray:
+    """Bounds (B, 6, k) on the distance between float world-frame force columns and their exact
+    values on the same data: forces are exact (axes or stored normals); torques
+    ``(r x f) / L`` within ``gamma_8 (|r_a| |f_b| + |r_b| |f_a|) / L`` per component; a
+    torsion column ``n / L`` within ``2u |n| / L``."""
+    B = P.shape[0]
+    E = np.zeros((B, 6, k))
+    L = np.asarray(length)
+    g8 = 8 * 2.0**-53 / (1 - 8 * 2.0**-53)
+    j = 0
+    for i, model in enumerate(models):
+        r = np.abs(P[:, i, :] - center)
+        forces = [np.abs(N[:, i, :])] if model == "frictionless" else [np.broadcast_to(np.eye(3)[q], (B, 3)) for q in range(3)]
+        for f in forces:
+            E[:, 3, j] = g8 * (r[:, 1] * f[:, 2] + r[:, 2] * f[:, 1]) / L
+            E[:, 4, j] = g8 * (r[:, 2] * f[:, 0] + r[:, 0] * f[:, 2]) / L
+            E[:, 5, j] = g8 * (r[:, 0] * f[:, 1] + r[:, 1] * f[:, 0]) / L
+            j += 1
+        if model == "soft":
+            E[:, 3:, j] = 2 * 2.0**-53 * np.abs(N[:, i, :]) / L[:, None]
+            j += 1
+    return E
+
+
 def _group_table(cols: GraspColumns, rows: np.ndarray, lines: np.ndarray, out, options) -> pa.Table:
-    closure, t, lam, basis, yn, null = out["force"]
-    fclosure, ft, flam, fbasis, fyn, fnull = out["form"]
+    code, t, lam, basis, yn = out["force"]
+    fcode, ft, flam, fbasis, fyn = out["form"]
+    closure, fclosure = code == 1, fcode == 1
     n = len(rows)
-    status = np.where(closure, "closure", "no_closure").astype(object)
-    form_status = np.where(fclosure, "closure", "no_closure").astype(object)
+    dim = int(cols.dim[rows[0]])
+    force_layout, blocks = out.get("force_layout", ("generators", None))
     cert = pa.StructArray.from_arrays(
-        [_certificates(closure, lam, basis, yn, null), _certificates(fclosure, flam, fbasis, fyn, fnull)],
+        [_certificates(code, lam, basis, yn, force_layout, blocks, out.get("tight")),
+         _certificates(fcode, flam, fbasis, fyn)],
         fields=list(RESULT_SCHEMA.field("certificate").type))
     eps = {}
     for norm, key in (("L1", "l1"), ("Linf", "linf")):
         values = out.get(norm) if options.quality else None
         arr = pa.array(values) if values is not None else pa.nulls(n, pa.float64())
         eps[f"eps_{key}_lo"] = eps[f"eps_{key}_hi"] = arr
-    ids = [cols.ids[r] for r in rows]
+    ids = cols.ids if len(rows) == len(cols.ids) else cols.ids.take(pa.array(rows))
     return pa.table({
-        "id": pa.array(ids, type=pa.string()),
+        "id": ids.cast(pa.string()),
         "line": pa.array(lines, type=pa.int64()),
-        "dim": pa.array(np.full(n, 2, dtype=np.int8)),
-        "status": pa.array(status, type=pa.string()),
+        "dim": pa.array(np.full(n, dim, dtype=np.int8)),
+        "status": _STATUS.take(pa.array(closure.astype(np.int8))),
         "form_closure": pa.array(fclosure),
         "force_closure": pa.array(closure),
         "margin": pa.array(np.where(closure, t, 0.0)),
-        "form_status": pa.array(form_status, type=pa.string()),
+        "form_status": _STATUS.take(pa.array(fclosure.astype(np.int8))),
         "form_margin": pa.array(np.where(fclosure, ft, 0.0)),
         "certificate": cert,
         "verified": pa.array(np.ones(n, dtype=bool)),
         "error": pa.nulls(n, pa.string()),
-        "center": _list_array(cols.center[rows, :2], np.ones(n, bool), RESULT_SCHEMA.field("center").type),
+        "center": _list_array(np.ascontiguousarray(cols.center[rows, :dim]), None,
+                              RESULT_SCHEMA.field("center").type),
         "length": pa.array(cols.length[rows]),
         "n_contacts": pa.array(cols.count[rows].astype(np.int32)),
         **eps,
@@ -212,14 +335,21 @@ def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(
     done = np.zeros(n, dtype=bool)
     pieces, order = [], []
     planar = cols.ok & (cols.dim == 2) & ((cols.model <= POINT)).all(axis=1) & (cols.count >= 1)
-    if options.method == "fast" and planar.any():
+    spatial = cols.ok & (cols.dim == 3) & (cols.model > FRICTIONLESS).any(axis=1)
+    if options.method == "fast" and (planar | spatial).any():
         m = cols.model.shape[1]
-        key = cols.count * 3 ** m + (np.where(cols.model < 0, 0, cols.model) * 3 ** np.arange(m)).sum(1)
-        for k in np.unique(key[planar]):
-            rows = np.flatnonzero(planar & (key == k))
-            settled, out = _planar_group(cols, rows, options, tol)
+        key = cols.dim * 3 ** (m + 2) + cols.count * 3 ** m + \
+            (np.where(cols.model < 0, 0, cols.model) * 3 ** np.arange(m)).sum(1)
+        for k in np.unique(key[planar | spatial]):
+            rows = np.flatnonzero((planar | spatial) & (key == k))
+            group = _planar_group if planar[rows[0]] else _spatial_group
+            settled, out = group(cols, rows, options, tol)
             if settled.any():
-                sub = {name: _take(value, settled) for name, value in out.items()}
+                sub = {name: (value if name == "force_layout" else _take(value, settled))
+                       for name, value in out.items() if name != "tight"}
+                if "tight" in out:  # re-index the per-row tight lists to the settled rows
+                    new = np.cumsum(settled) - 1
+                    sub["tight"] = {int(new[r]): v for r, v in out["tight"].items() if settled[r]}
                 pieces.append(_group_table(cols, rows[settled], lines[rows[settled]], sub, options))
                 order.append(rows[settled])
                 done[rows[settled]] = True
@@ -229,8 +359,13 @@ def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(
 
         pieces.append(rows_to_table(slow(rest)))
         order.append(rest)
-    result = pa.concat_tables(pieces) if pieces else RESULT_SCHEMA.empty_table()
-    return result.take(pa.array(np.argsort(np.concatenate(order), kind="stable")))
+    if not pieces:
+        return RESULT_SCHEMA.empty_table()
+    result = pa.concat_tables(pieces)
+    order = np.concatenate(order)
+    if (np.diff(order) > 0).all():  # a single group in input order: nothing to move
+        return result
+    return result.take(pa.array(np.argsort(order, kind="stable")))
 
 
 def _take(value, mask):

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, Sequence
 
 import numpy as np
 
@@ -28,7 +28,7 @@ from .grasp import Grasp
 from .wrench import (contact_frame, force_columns, generator_columns, grasp_arrays, tangent,
                      to_exact, wrench)
 
-__all__ = ["Block", "System", "ClosureProblem", "grasp_problem", "span_problem", "grasp_system",
+__all__ = ["Block", "block_arrays", "System", "ClosureProblem", "grasp_problem", "span_problem", "grasp_system",
            "span_system", "is_polyhedral"]
 
 
@@ -41,6 +41,17 @@ class Block:
     n: tuple = ()
     mu: Any = 0
     torsion: Any = 0
+
+
+def block_arrays(blocks: Sequence[Block], dim: int):
+    """``(kind, first column, n, mu, torsion)`` arrays of cone blocks (kind 0 ray, 1 point,
+    2 soft), the form the compiled kernels take; rays get zero normals."""
+    kind = np.array([("ray", "point", "soft").index(b.kind) for b in blocks], dtype=np.int64)
+    first = np.array([b.cols[0] for b in blocks], dtype=np.int64)
+    n = np.array([[float(v) for v in b.n] if b.n else [0.0] * dim for b in blocks]).reshape(len(blocks), dim)
+    mu = np.array([float(b.mu) for b in blocks])
+    torsion = np.array([float(b.torsion) for b in blocks])
+    return kind, first, n, mu, torsion
 
 
 class System(NamedTuple):
@@ -113,11 +124,12 @@ def is_polyhedral(grasp: Grasp, frictionless: bool = False, socp: bool = False) 
 
 
 def _frames(N: np.ndarray) -> np.ndarray:
-    """Contact frames, shape ``(m, dim, dim)``: rows ``n, t`` (plane) or ``n, t1, t2`` (space)."""
-    if N.shape[1] == 2:
-        return np.stack([N, tangent(N)], axis=1)
-    T1, T2 = contact_frame(N)
-    return np.stack([N, T1, T2], axis=1)
+    """Contact frames, shape ``(..., m, dim, dim)``: rows ``n, t`` (plane) or ``n, t1, t2``
+    (space)."""
+    if N.shape[-1] == 2:
+        return np.stack([N, tangent(N)], axis=-2)
+    T1, T2 = contact_frame(N.reshape(-1, 3))
+    return np.stack([N, T1.reshape(N.shape), T2.reshape(N.shape)], axis=-2)
 
 
 def grasp_problem(grasp: Grasp, *, frictionless: bool = False, socp: bool = False) -> ClosureProblem:
@@ -136,33 +148,73 @@ def grasp_problem(grasp: Grasp, *, frictionless: bool = False, socp: bool = Fals
         return ClosureProblem(system.columns, tuple(range(k)), (), np.eye(k), system)
     P, N, mu, torsion, c, L = grasp_arrays(grasp)
     models = tuple(contact.model for contact in grasp.contacts)
-    frames = _frames(N)
-    wrenches = wrench(P[:, None, :], frames, c, L)  # (m, dim, d): one per frame direction
+    columns, rays, cones, to_values = conic_columns(P, N, mu, torsion, models, c, L)
+    return ClosureProblem(columns, rays, cones, to_values, system)
+
+
+def conic_columns(P, N, mu, torsion, models, center, length):
+    """Solver columns of a closure programme with cones, for one grasp or a batch.
+
+    Parameters
+    ----------
+    P, N : array, shape (..., m, dim)
+    mu, torsion : array, shape (..., m)
+    models : sequence of str, length m (shared by the batch)
+    center : array, shape (..., dim)
+    length : array, shape (...)
+
+    Returns
+    -------
+    columns : array, shape (..., d, nvar)
+        Wrench of each variable: frictionless contacts one ray (``n``); frictional contacts the
+        normal and tangential forces of the contact frame ``(n, t1, t2)`` (``(n, t)`` in the
+        plane) and, for a soft contact, the scaled torsional moment ``m / torsion``.
+    to_values : array, shape (..., ncert, nvar)
+        Map from the variables to the certificate's world-frame values (forces, moments).
+    rays, cones : tuple
+        As :class:`ClosureProblem` (the structure, shared by the batch).
+    """
+    frames = _frames(N)  # (..., m, dim, dim)
+    c = np.asarray(center)[..., None, None, :]
+    L = np.asarray(length)[..., None, None]
+    wrenches = wrench(P[..., :, None, :], frames, c, L)  # (..., m, dim, d)
+    dim = P.shape[-1]
+    batch = P.shape[:-2]
     cols, rays, cones, blocks = [], [], [], []
     for i, model in enumerate(models):
         start = len(cols)
         if model == "frictionless":
-            cols.append(wrenches[i, 0])
+            cols.append(wrenches[..., i, 0, :])
             rays.append(start)
-            blocks.append(N[i][:, None])
+            blocks.append(N[..., i, :, None])
             continue
-        cols.extend(wrenches[i])
-        frame = frames[i].T
+        cols.extend(wrenches[..., i, j, :] for j in range(dim))
+        frame = np.swapaxes(frames[..., i, :, :], -1, -2)
         if model == "soft":
-            g = torsion[i]
-            cols.append(np.concatenate([np.zeros(3), g * N[i] / L]))
-            frame = np.block([[frame, np.zeros((3, 1))], [np.zeros((1, 3)), np.array([[g]])]])
-        cones.append((start, len(cols) - start, float(mu[i])))
+            g = torsion[..., i]
+            L_ = np.asarray(length)[..., None]
+            cols.append(np.concatenate([np.zeros(batch + (3,)), g[..., None] * N[..., i, :] / L_], axis=-1))
+            frame4 = np.zeros(batch + (4, 4))
+            frame4[..., :3, :3] = frame
+            frame4[..., 3, 3] = g
+            frame = frame4
+        cones.append((start, len(cols) - start, mu[..., i]))
         blocks.append(frame)
-    return ClosureProblem(np.array(cols).T, tuple(rays), tuple(cones), _block_diag(blocks), system)
+    columns = np.stack(cols, axis=-1)
+    to_values = _block_diag(blocks, batch)
+    if not batch:
+        cones = [(start, size, float(k)) for start, size, k in cones]
+    return columns, tuple(rays), tuple(cones), to_values
 
 
-def _block_diag(blocks: list[np.ndarray]) -> np.ndarray:
-    out = np.zeros((sum(b.shape[0] for b in blocks), sum(b.shape[1] for b in blocks)))
+def _block_diag(blocks: list[np.ndarray], batch: tuple = ()) -> np.ndarray:
+    rows = sum(b.shape[-2] for b in blocks)
+    cols = sum(b.shape[-1] for b in blocks)
+    out = np.zeros(batch + (rows, cols))
     r = c = 0
     for b in blocks:
-        out[r:r + b.shape[0], c:c + b.shape[1]] = b
-        r, c = r + b.shape[0], c + b.shape[1]
+        out[..., r:r + b.shape[-2], c:c + b.shape[-1]] = b
+        r, c = r + b.shape[-2], c + b.shape[-1]
     return out
 
 

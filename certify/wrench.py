@@ -135,27 +135,25 @@ def force_columns(P, N, models, center, length):
     Layout per contact: frictionless ``[n]``; point ``[e_1, ..., e_dim]`` (world axes); soft
     ``[e_1, e_2, e_3, tau]`` where ``tau = (0, n / L)`` is the wrench of a unit torsional moment
     about the (stored, unit up to rounding) normal ``n``. Arguments as in
-    :func:`generator_columns`; no batch dimensions.
+    :func:`generator_columns` (leading batch dimensions allowed).
 
     Returns
     -------
-    C : array, shape (d, k)
+    C : array, shape (..., d, k)
     owner : ndarray of int, shape (k,)
     """
     dim = P.shape[-1]
+    batch = P.shape[:-2]
     eye = to_exact(np.eye(dim)) if N.dtype == object else np.eye(dim)
-    forces, owner = [], []
+    c = np.asarray(center)[..., None, :]
+    L = np.asarray(length)[..., None]
+    cols, owner = [], []
     for i, model in enumerate(models):
-        rows = [N[i]] if model == "frictionless" else list(eye)
-        forces += rows
-        owner += [i] * len(rows)
-    owner = np.array(owner, dtype=int)
-    cols = list(wrench(P[owner], np.array(forces), center, length))
-    out, out_owner = [], []
-    for j, i in enumerate(owner):
-        out.append(cols[j]), out_owner.append(i)
-        last = j + 1 == len(owner) or owner[j + 1] != i
-        if last and models[i] == "soft":
-            out.append(np.concatenate([N[i] * 0, N[i] / length]))
-            out_owner.append(i)
-    return np.array(out).T, np.array(out_owner, dtype=int)
+        forces = N[..., i:i + 1, :] if model == "frictionless" else np.broadcast_to(eye, batch + (dim, dim))
+        w = wrench(P[..., i:i + 1, :], forces, c, L)
+        cols += [w[..., j, :] for j in range(w.shape[-2])]
+        owner += [i] * w.shape[-2]
+        if model == "soft":
+            cols.append(np.concatenate([N[..., i, :] * 0, N[..., i, :] / np.asarray(length)[..., None]], axis=-1))
+            owner.append(i)
+    return np.stack(cols, axis=-1), np.array(owner, dtype=int)

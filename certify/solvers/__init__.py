@@ -46,22 +46,36 @@ class Solution:
     y: np.ndarray | None
 
 
+#: Barrier solutions with ``abs(t) <`` this are re-solved by clarabel.
+BARRIER_NEAR_ZERO = 1e-5
+
+
 class FastSolver:
-    """Exact enumeration for small polyhedral programmes, clarabel's API for the rest."""
+    """Exact enumeration for small polyhedral programmes, the compiled dual barrier method for
+    cones, clarabel's API for the rest (large polyhedral programmes, and cones whose barrier
+    solution is within :data:`BARRIER_NEAR_ZERO` of the closure boundary, where the
+    interior-point solver's sharper duals tell tight contacts apart)."""
 
     #: Largest number of bases (``k choose d``) enumerated before handing over to clarabel.
     max_bases = 64
 
     def __init__(self) -> None:
+        from .barrier import BarrierSolver
         from .clarabel_direct import ClarabelSolver
 
         self._clarabel = ClarabelSolver()
+        self._barrier = BarrierSolver()
 
     def solve(self, problem: ClosureProblem) -> Solution:
         from math import comb
 
         from .enumeration import solve_enumeration
 
+        if problem.cones:
+            sol = self._barrier.solve(problem)
+            if sol is not None and abs(sol.t) >= BARRIER_NEAR_ZERO:
+                return sol
+            return self._clarabel.solve(problem)
         if not problem.cones and comb(problem.nvar, problem.d) <= self.max_bases:
             sol = solve_enumeration(problem)
             if sol.y is not None or (sol.status == "optimal" and sol.t > 0):
@@ -72,7 +86,8 @@ class FastSolver:
 
 
 def make_solver(method: str = "fast"):
-    """A solver instance for ``method`` in ``{'fast', 'reference', 'clarabel', 'enumeration'}``."""
+    """A solver instance for ``method`` in ``{'fast', 'reference', 'clarabel', 'enumeration',
+    'linprog'}``."""
     if method == "fast":
         return FastSolver()
     if method == "reference":
@@ -87,4 +102,8 @@ def make_solver(method: str = "fast"):
         from .enumeration import EnumerationSolver
 
         return EnumerationSolver()
+    if method == "linprog":
+        from .linprog import LinprogSolver
+
+        return LinprogSolver()
     raise ValueError(f"unknown method {method!r}; use 'fast' or 'reference'")
