@@ -68,8 +68,8 @@ class Summary:
         return self.statuses.get("error", 0)
 
 
-def _result_rows(path: Path, size: int) -> Iterator[list[tuple[int, Any]]]:
-    """Results rows in chunks of ``size``: ``(position, row dict or error)``."""
+def _result_rows(path: Path, size: int) -> Iterator[tuple[list, Any]]:
+    """Results in chunks of ``size``: ``(rows as dicts or errors, Arrow table or None)``."""
     import json
 
     for chunk in iter_chunks(path, size):
@@ -80,42 +80,63 @@ def _result_rows(path: Path, size: int) -> Iterator[list[tuple[int, Any]]]:
                     out.append(json.loads(text))
                 except json.JSONDecodeError:
                     out.append(GraspFileError("not a JSON object"))
-            yield out
+            yield out, None
         else:
-            yield table_to_rows(chunk.rows)
+            yield table_to_rows(chunk.rows), chunk.rows
 
 
-def _verify_chunk(grasp_values: list, lines: list[int], rows: list, tol: Tolerances):
-    """Verify one chunk of aligned (grasp, results row) pairs; return counts and failures."""
+def _verify_one(value, line: int, row, tol: Tolerances) -> tuple[str, tuple | None]:
+    """Re-check one results row against its parsed grasp value: ``(status, failure or None)``."""
+    if not isinstance(row, dict):
+        return "error", (None, f"results row for line {line}: not a JSON object")
+    status = str(row.get("status"))
+    gid = value.get("id") if isinstance(value, dict) else None
+    if row.get("line") not in (None, line):
+        return status, (row.get("id"), f"results row is for line {row.get('line')}, grasp is line {line}")
+    if row.get("id") != gid and str(row.get("id")) != str(gid):
+        return status, (row.get("id"), f"id does not match grasp line {line} ({gid!r})")
+    try:
+        grasp = grasp_from_dict(value) if isinstance(value, dict) else value
+    except CertifyError as err:
+        grasp = err
+    if status == "error":
+        if not isinstance(grasp, Exception):
+            return status, (gid, "row says error but the grasp is valid")
+        return status, None
+    if isinstance(grasp, Exception):
+        return status, (gid, f"grasp is invalid: {grasp}")
+    check = verify_row(grasp, row, tol)
+    return status, None if check else (gid, check.reason)
+
+
+def _verify_chunk(grasp_values: list, lines: list[int], rows, tol: Tolerances, tables=None):
+    """Verify one chunk of aligned (grasp, results row) pairs; return counts and failures.
+
+    With ``tables`` (the chunk's grasp and results Arrow tables) the common certificates are
+    proved in bulk (:func:`certify.recheck.recheck_table`) and only the rest row by row."""
     statuses: dict[str, int] = {}
     failures = []
+    if tables is not None:
+        from .recheck import recheck_table
+
+        grasps, results = tables
+
+        def slow(i):
+            status, failure = _verify_one(grasp_values[i], lines[i], rows[i], tol)
+            if failure:
+                failures.append(failure)
+            return failure is None
+
+        recheck_table(grasps, results, lines, slow, tol)
+        for r in rows:
+            s = str(r.get("status"))
+            statuses[s] = statuses.get(s, 0) + 1
+        return statuses, failures
     for value, line, row in zip(grasp_values, lines, rows):
-        if not isinstance(row, dict):
-            statuses["error"] = statuses.get("error", 0) + 1
-            failures.append((None, f"results row for line {line}: not a JSON object"))
-            continue
-        status = str(row.get("status"))
+        status, failure = _verify_one(value, line, row, tol)
         statuses[status] = statuses.get(status, 0) + 1
-        gid = value.get("id") if isinstance(value, dict) else None
-        if row.get("line") not in (None, line):
-            failures.append((row.get("id"), f"results row is for line {row.get('line')}, grasp is line {line}"))
-            continue
-        if row.get("id") != gid and str(row.get("id")) != str(gid):
-            failures.append((row.get("id"), f"id does not match grasp line {line} ({gid!r})"))
-            continue
-        try:
-            grasp = grasp_from_dict(value) if isinstance(value, dict) else value
-        except CertifyError as err:
-            grasp = err
-        if status == "error":
-            if not isinstance(grasp, Exception):
-                failures.append((gid, "row says error but the grasp is valid"))
-        elif isinstance(grasp, Exception):
-            failures.append((gid, f"grasp is invalid: {grasp}"))
-        else:
-            check = verify_row(grasp, row, tol)
-            if not check:
-                failures.append((gid, check.reason))
+        if failure:
+            failures.append(failure)
     return statuses, failures
 
 
@@ -149,8 +170,10 @@ def verify_file(results_path: str | Path, grasps_path: str | Path,
     futures = []
     try:
         pairs = zip(iter_chunks(grasps_path, chunk_size), _result_rows(results_path, chunk_size))
-        for chunk, rows in pairs:
-            args = (_grasp_values(chunk), chunk.lines, rows, tol)
+        for chunk, (rows, table) in pairs:
+            tables = (chunk.rows, table) if table is not None and not isinstance(chunk.rows, list) \
+                and len(rows) == len(chunk) else None
+            args = (_grasp_values(chunk), chunk.lines, rows, tol, tables)
             if pool is None:
                 _merge(summary, _verify_chunk(*args))
                 continue

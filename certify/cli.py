@@ -107,8 +107,25 @@ def bench_command(
         print_bench(run_bench(n=n, seed=seed, reference_n=reference_n))
 
 
+def sample_command(
+    output: Path = typer.Argument(..., help="Grasp set to write: .parquet or .jsonl."),
+    n: int = typer.Option(100_000, "--n", help="Number of grasps."),
+    dim: int = typer.Option(2, help="2 (planar) or 3 (spatial)."),
+    contacts: int = typer.Option(3, help="Contacts per grasp."),
+    model: str = typer.Option("point", help="frictionless, point or soft."),
+    seed: int = typer.Option(0, help="Random seed."),
+) -> None:
+    """Write a random grasp set (contacts around a blob, about a third in closure), for trying
+    the toolkit and for benchmarks at scale."""
+    from .samples import write_random_grasp_file
+
+    count = write_random_grasp_file(output, n, seed=seed, dim=dim, n_contacts=contacts, model=model)
+    console.print(f"wrote {count} grasps to {output}")
+
+
 def register(app: typer.Typer) -> None:
     """Add the certify commands to the ``qualgrasp`` application."""
     app.command("certify")(certify_command)
     app.command("verify")(verify_command)
     app.command("bench")(bench_command)
+    app.command("sample")(sample_command)

@@ -131,3 +131,34 @@ def random_grasp_table(seed: int, count: int, *, dim: int = 2, n_contacts: int =
     ids = pa.array([f"r{i}" for i in range(start, start + count)])
     return pa.table({"id": ids, "contacts": per_row, "center": pa.nulls(count, pa.list_(pa.float64())),
                      "length": pa.nulls(count, pa.float64())}, schema=GRASP_SCHEMA)
+
+
+def write_random_grasp_file(path, count: int, *, seed: int = 0, chunk: int = 500_000, **kwargs) -> int:
+    """Write ``count`` random grasps (:func:`random_grasp_table`) to a Parquet or JSON Lines file,
+    ``chunk`` at a time, so that memory stays bounded; return how many were written."""
+    import json
+
+    import pyarrow.parquet as pq
+
+    from .table import GRASP_SCHEMA, is_parquet
+
+    written = 0
+    writer = pq.ParquetWriter(path, GRASP_SCHEMA) if is_parquet(path) else None
+    fh = None if writer else open(path, "w", encoding="utf-8")
+    try:
+        for start in range(0, count, chunk):
+            n = min(chunk, count - start)
+            table = random_grasp_table(seed + start, n, start=start, **kwargs)
+            if writer:
+                writer.write_table(table)
+            else:
+                for row in table.to_pylist():
+                    row["contacts"] = [{k: v for k, v in c.items() if v is not None} for c in row["contacts"]]
+                    fh.write(json.dumps({k: v for k, v in row.items() if v is not None}) + "\n")
+            written += n
+    finally:
+        if writer:
+            writer.close()
+        if fh:
+            fh.close()
+    return written

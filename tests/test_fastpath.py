@@ -83,3 +83,38 @@ def test_fast_results_verify(tmp_path):
     assert summary.rows == 3000 and not summary.failures
     statuses = res.column("status").value_counts().to_pylist()
     assert {s["values"] for s in statuses} == {"closure", "no_closure"}
+
+
+def test_bulk_recheck_rejects_tampered_rows(tmp_path):
+    """The columnar re-check catches the same tampering as the exact one, planar and spatial."""
+    import pyarrow.parquet as pq
+
+    from certify.batch import certify_file
+
+    grasps = random_grasps(4, 150, dim=2, n_contacts=3) + [
+        Grasp(g.contacts, id=f"s{i}") for i, g in enumerate(
+            random_grasps(5, 60, dim=3, n_contacts=3, model="point", spread=0.3))]
+    gpath, rpath = tmp_path / "g.parquet", tmp_path / "r.parquet"
+    from certify.io import write_grasps
+
+    write_grasps(gpath, grasps)
+    certify_file(gpath, rpath, quality=False, chunk_size=64)
+    assert not verify_file(rpath, gpath).failures
+    rows = table_to_rows(pq.read_table(rpath))
+    tampered = set()
+    for dim in (2, 3):
+        for kind in ("interior", "farkas"):
+            row = next(r for r in rows if r["dim"] == dim and r["certificate"]["force"]["kind"] == kind
+                       and r["id"] not in tampered)
+            cert = row["certificate"]["force"]
+            if kind == "interior":
+                cert["values"] = [-v for v in cert["values"]]
+            else:
+                cert["y"] = [-v for v in cert["y"]]
+            tampered.add(row["id"])
+    row = next(r for r in rows if r["status"] == "closure" and r["id"] not in tampered)
+    row["margin"] *= 3  # more margin than the forces show
+    tampered.add(row["id"])
+    pq.write_table(rows_to_table(rows), rpath)
+    failures = verify_file(rpath, gpath, workers=2).failures
+    assert {gid for gid, _ in failures} == tampered
