@@ -14,6 +14,7 @@ def register(app: typer.Typer) -> None:
     app.command("st0")(st0_command)
     app.command("outline")(outline_command)
     app.command("regions")(regions_command)
+    app.command("synthesize")(synthesize_command)
 
 
 def st0_command(
@@ -107,3 +108,68 @@ def regions_command(
     for r in regions:
         rho = "inf" if r.rho == float("inf") else f"{r.rho:.1f}"
         typer.echo(f"{r.type}\tarc {r.arc[0]:.1f}..{r.arc[1]:.1f} px\t{len(r.points)} points\trho {rho} px")
+
+
+def synthesize_command(
+    image: Path = typer.Argument(..., help="Image file (PNG, JPEG, anything OpenCV reads)."),
+    fingers: int = typer.Option(..., "--fingers", help="4: FormGrasp (frictionless form closure); "
+                                "2 or 3: ForceGrasp (force closure with friction)."),
+    output: Path = typer.Option(..., "-o", "--output", help="Grasp set to write: .jsonl (or .parquet, "
+                                "which keeps only certify's fields)."),
+    mu: float | None = typer.Option(None, "--mu", help="Friction coefficient of ForceGrasp (default 0.5)."),
+    theta_min: float | None = typer.Option(None, "--theta-min", help="Friction cone half-angle in degrees, "
+                                           "instead of --mu (mu = tan(theta_min))."),
+    alpha: float = typer.Option(0.5, "--alpha", help="Bounding-circle diameter threshold of curves, "
+                                "as a fraction of the object's size (its enclosing circle's diameter)."),
+    plot: Path | None = typer.Option(None, "--plot", help="Save a figure of the best grasps (PNG): "
+                                     "contacts, normals, friction cones, zones of freedom."),
+    largest: bool = typer.Option(False, "--largest", help="With several objects, use the largest whole one."),
+    threshold: float | None = typer.Option(None, "--threshold", help="Grey level separating object and "
+                                           "background, in the image's units (default: Otsu's)."),
+) -> None:
+    """Synthesise grasps of the object in an image and write them in certify's grasp format.
+
+    Contacts are in pixels of the input image (x = column, y = row) with inward unit normals;
+    center is the object's area centroid and length its radius. The file goes straight into
+    'qualgrasp certify'. Prints one line per grasp (id, regions, certified margin and L1 epsilon)
+    and a summary. Exit code 0 (with an empty file) when no grasp exists, 1 when a synthesised grasp
+    fails certification, 2 on unusable input or options.
+    """
+    import math
+
+    from certify.io import write_grasps
+
+    from .errors import QualitativeError
+    from .synthesis import synthesize
+    from .vision import read_image
+
+    if mu is not None and theta_min is not None:
+        typer.echo("error: give --mu or --theta-min, not both", err=True)
+        raise typer.Exit(2)
+    try:
+        result = synthesize(image, fingers, mu, None if theta_min is None else math.radians(theta_min),
+                            alpha, threshold=threshold, largest=largest)
+    except QualitativeError as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(2)
+    write_grasps(output, result.grasps)
+    if plot is not None:
+        from .grasp_plot import synthesis_figure
+
+        synthesis_figure(result, read_image(image)).savefig(plot, dpi=110)
+    friction = "frictionless" if result.mu is None else f"mu {result.mu:.4g}"
+    if not result.grasps:
+        typer.echo(f"no grasp found: {result.procedure} ({fingers} fingers, {friction}) on {len(result.regions)} "
+                   f"feasible region(s) of {result.outline.string}; wrote an empty grasp set to {output}")
+        return
+    for grasp, report, ok in zip(result.grasps, result.reports, result.certified):
+        eps = report.epsilons["L1"].hi if report.epsilons else float("nan")
+        typer.echo(f"{grasp.id}\tregions {grasp.meta['regions']}\t{report.force.status}\t"
+                   f"margin {report.force.margin:.4f}\teps {eps:.4f}\t{'verified' if ok else 'NOT CERTIFIED'}")
+    s = result.summary()
+    typer.echo(f"{s['grasps']} grasp(s) by {result.procedure} ({fingers} fingers, {friction}) -> {output}; "
+               f"{100 * s['certified_fraction']:.0f} % certified; synthesis {s['seconds']:.2f} s, "
+               f"certification {s['certify_seconds']:.2f} s")
+    if s["certified"] < s["grasps"]:
+        typer.echo("error: some synthesised grasps did not certify (a synthesis bug: please report it)", err=True)
+        raise typer.Exit(1)

@@ -16,6 +16,8 @@ __all__ = [
     "TraceError",
     "NetworkError",
     "RegionError",
+    "ZoneError",
+    "SynthesisError",
 ]
 
 
@@ -53,3 +55,11 @@ class NetworkError(QualitativeError, ValueError):
 
 class RegionError(QualitativeError, ValueError):
     """A region or grasp scene cannot be built (not polygonal, empty, invalid, bad scene parameters)."""
+
+
+class ZoneError(QualitativeError, ValueError):
+    """Contacts given to the zone-of-freedom computation are malformed (shapes, NaN, zero normal)."""
+
+
+class SynthesisError(QualitativeError, ValueError):
+    """Grasp synthesis parameters are invalid (finger count, friction, thresholds)."""

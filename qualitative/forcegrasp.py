@@ -1,0 +1,393 @@
+"""ForceGrasp (paper 5.1.3-5.1.4): two- and three-finger force-closure grasps with friction.
+
+Friction is Coulomb friction with coefficient ``mu``; the friction threshold is
+``theta_min = atan(mu)``, the half-angle of each friction cone (paper, definition 14). Given
+``theta_min`` directly, ``mu = tan(theta_min)``. Angles are in radians, positions in pixels of the
+input image (x = column, y = row), normals point into the object.
+
+Two fingers (Nguyen 1988; paper definitions 14-15)
+    Contacts ``F_1``, ``F_2`` are in force closure iff the grasp line lies strictly inside both
+    friction cones: ``theta_1 = angle(n_1, F_2 - F_1) < theta_min`` and
+    ``theta_2 = angle(n_2, F_1 - F_2) < theta_min``. A **feasible region pair** holds such a pair,
+    one point on each region (the same region twice is allowed: two points of a disc's single
+    curve). For each pair of regions we choose, among the candidate points
+    (:mod:`qualitative.candidates`), the pair **farthest from the cone boundaries**: largest margin
+    ``theta_min - max(theta_1, theta_2)``; among pairs within 1 % of ``theta_min`` of the best, the
+    one farthest from the regions' ends. One grasp per region pair.
+
+Three fingers (Ponce & Faverjon 1995, proposition 3; paper definitions 16-17)
+    The **friction zone** of three contacts is the intersection of their inward friction cones
+    (wedges of half-angle ``theta_min`` about the normals); that of three regions is the
+    intersection, over the regions, of the union of their points' cones (definition 16). The
+    paper accepts a triplet when the friction zone is non-empty and the three normals positively
+    span the plane (largest angular gap below pi). Those two conditions are not quite sufficient:
+    forces aimed at a point ``x`` of the friction zone are concurrent at ``x`` (no torque about
+    it) and balance with positive weights only when their directions ``x - F_i`` positively span
+    the plane, i.e. ``x`` lies inside the contact triangle. With ``x`` strictly inside every cone
+    and the triangle, that internal force lies strictly inside the cones, which proves force
+    closure (Murray, Li & Sastry, proposition 5.2). So for every region triplet we search a grid of
+    points ``x`` over the object's convex hull, take for each ``x`` the candidate point of each
+    region with ``x`` deepest in its cone, and keep the ``x`` with the largest margin: the
+    smallest of the three cone margins ``theta_min - angle(n_i, x - F_i)``, of the spanning margin
+    of the force directions and of the normals (``(pi - largest gap) / 2``). One grasp per region
+    triplet.
+
+A grasp is kept when its margin is at least ``margin * theta_min``: contacts stay inside their
+cones (and forces keep spanning) under angular errors of that size, e.g. normals estimated from
+the image.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+import shapely
+from shapely.geometry import Polygon
+from shapely.geometry.base import BaseGeometry
+
+from .candidates import Candidates
+from .errors import SynthesisError
+
+__all__ = ["MARGIN", "GAP", "ForceGrasp", "friction", "nguyen_angles", "span_margin",
+           "positively_spans", "pair_grasps", "triplet_grasps", "friction_cone", "friction_zone"]
+
+MARGIN = 0.25
+GAP = 0.08
+GRID = 40
+REFINE = 3
+_TIE = 0.01
+
+
+@dataclass(frozen=True, eq=False)
+class ForceGrasp:
+    """A force-closure grasp found by ForceGrasp.
+
+    Attributes
+    ----------
+    contacts : tuple of int
+        Candidate indices of the contacts.
+    points, normals : numpy.ndarray
+        ``(m, 2)`` contact points and inward unit normals, pixels.
+    regions : tuple of int
+        Region index of each contact.
+    angles : tuple of float
+        Angle between each normal and its force direction (the grasp line for two fingers, the
+        direction to ``point`` for three), radians.
+    margin : float
+        Smallest angular distance to the closure boundary (cone edges, spanning), radians.
+    point : numpy.ndarray or None
+        Three fingers: the point of the friction zone where the forces meet (pixels).
+    theta_min : float
+        Half-angle of the friction cones, radians.
+    """
+
+    contacts: tuple[int, ...]
+    points: np.ndarray
+    normals: np.ndarray
+    regions: tuple[int, ...]
+    angles: tuple[float, ...]
+    margin: float
+    point: np.ndarray | None
+    theta_min: float
+
+
+def friction(mu: float | None = None, theta_min: float | None = None) -> tuple[float, float]:
+    """``(mu, theta_min)`` from either one: ``theta_min = atan(mu)`` (radians).
+
+    Raises
+    ------
+    SynthesisError
+        Both or neither given, ``mu <= 0`` or not finite, ``theta_min`` outside ``(0, pi/2)``.
+    """
+    if (mu is None) == (theta_min is None):
+        raise SynthesisError("give the friction coefficient mu or the friction threshold theta_min, not both")
+    if mu is not None:
+        if not (math.isfinite(mu) and mu > 0):
+            raise SynthesisError(f"friction coefficient mu must be finite and > 0, got {mu}")
+        return float(mu), math.atan(mu)
+    if not (0 < theta_min < math.pi / 2):
+        raise SynthesisError(f"theta_min must lie strictly between 0 and 90 degrees, got {math.degrees(theta_min):g}")
+    return math.tan(theta_min), float(theta_min)
+
+
+def _angle(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Unsigned angle between vectors (last axis 2), accurate near 0 and pi."""
+    cross = u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
+    dot = (u * v).sum(axis=-1)
+    return np.arctan2(np.abs(cross), dot)
+
+
+def nguyen_angles(p1, n1, p2, n2) -> tuple[np.ndarray, np.ndarray]:
+    """Angles ``theta_1 = angle(n_1, p_2 - p_1)`` and ``theta_2 = angle(n_2, p_1 - p_2)`` (radians).
+
+    Arrays broadcast over leading axes; the last axis holds (x, y).
+    """
+    d = np.asarray(p2, dtype=float) - np.asarray(p1, dtype=float)
+    return _angle(np.asarray(n1, dtype=float), d), _angle(np.asarray(n2, dtype=float), -d)
+
+
+def span_margin(vectors) -> np.ndarray:
+    """``(pi - G) / 2`` for ``G`` the largest angular gap between planar vectors (last two axes ``(k, 2)``).
+
+    Positive iff the vectors positively span the plane (the angular-gap rule); its value is the
+    angle by which any of them may turn without losing that.
+    """
+    v = np.asarray(vectors, dtype=float)
+    angles = np.sort(np.arctan2(v[..., 1], v[..., 0]), axis=-1)
+    gaps = np.diff(np.concatenate([angles, angles[..., :1] + 2 * np.pi], axis=-1), axis=-1)
+    return (np.pi - gaps.max(axis=-1)) / 2
+
+
+def positively_spans(vectors) -> bool:
+    """True when planar vectors positively span the plane (largest angular gap below pi)."""
+    return bool(span_margin(vectors) > 0)
+
+
+def _far(cands: Candidates, gap: float, size: float) -> np.ndarray:
+    P = np.asarray(cands.points)
+    return np.linalg.norm(P[:, None] - P[None], axis=2) >= gap * size
+
+
+def _check(theta_min: float, margin: float, gap: float) -> None:
+    if not (0 < theta_min < math.pi / 2):
+        raise SynthesisError(f"theta_min must lie strictly between 0 and pi/2 radians, got {theta_min}")
+    if not (0 <= margin < 1 and gap >= 0):
+        raise SynthesisError(f"need 0 <= margin < 1 (a fraction of theta_min) and gap >= 0, got {margin} and {gap}")
+
+
+def pair_grasps(cands: Candidates, theta_min: float, size: float, *, margin: float = MARGIN,
+                gap: float = GAP) -> list[ForceGrasp]:
+    """Two-finger force-closure grasps, one per feasible region pair (Nguyen's condition).
+
+    Parameters
+    ----------
+    cands : Candidates
+        Candidate contacts on the feasible regions.
+    theta_min : float
+        Friction cone half-angle ``atan(mu)``, radians.
+    size : float
+        Object size, pixels (``gap`` is a fraction of it).
+    margin : float
+        Smallest accepted margin ``theta_min - max(theta_1, theta_2)``, fraction of ``theta_min``.
+    gap : float
+        Smallest distance between the two contacts, fraction of ``size``.
+
+    Returns
+    -------
+    list of ForceGrasp
+        Ordered by region pair.
+    """
+    _check(theta_min, margin, gap)
+    P, N = np.asarray(cands.points), np.asarray(cands.normals)
+    far = _far(cands, gap, size)
+    regions = np.unique(cands.region)
+    found = []
+    for r1, r2 in itertools.combinations_with_replacement(regions, 2):
+        a, b = cands.of_region(r1), cands.of_region(r2)
+        A, B = np.meshgrid(a, b, indexing="ij")
+        A, B = A.ravel(), B.ravel()
+        keep = far[A, B] & ((r1 != r2) | (A < B))
+        A, B = A[keep], B[keep]
+        if not len(A):
+            continue
+        t1, t2 = nguyen_angles(P[A], N[A], P[B], N[B])
+        slack = theta_min - np.maximum(t1, t2)
+        best = slack.max()
+        if best < margin * theta_min:
+            continue
+        near = np.flatnonzero(slack >= best - _TIE * theta_min)
+        clear = np.minimum(cands.clearance[A[near]], cands.clearance[B[near]])
+        k = near[int(np.argmax(clear))]
+        i, j = int(A[k]), int(B[k])
+        found.append(ForceGrasp((i, j), P[[i, j]], N[[i, j]], (int(r1), int(r2)),
+                                (float(t1[k]), float(t2[k])), float(slack[k]), None, theta_min))
+    return found
+
+
+def _grid(contour: np.ndarray, size: float, count: int) -> np.ndarray:
+    """Points on a square grid of spacing ``size / count`` inside the contour's convex hull."""
+    hull = shapely.convex_hull(shapely.MultiPoint(contour))
+    lo, hi = contour.min(axis=0), contour.max(axis=0)
+    step = size / count
+    xs = np.arange(lo[0] + step / 2, hi[0], step)
+    ys = np.arange(lo[1] + step / 2, hi[1], step)
+    X, Y = np.meshgrid(xs, ys)
+    pts = np.column_stack([X.ravel(), Y.ravel()])
+    return pts[shapely.contains_xy(hull, pts[:, 0], pts[:, 1])]
+
+
+def _pick(order: np.ndarray, taken: list[np.ndarray], far: np.ndarray) -> np.ndarray:
+    """For every point, the first candidate in ``order`` (rows: candidates by preference, columns:
+    points) far from all ``taken`` ones; -1 when none is."""
+    ok = np.ones(order.shape, bool)
+    for t in taken:
+        ok &= far[t[None, :], order] & (t[None, :] >= 0)
+    first = np.argmax(ok, axis=0)
+    pick = order[first, np.arange(order.shape[1])]
+    return np.where(ok.any(axis=0), pick, -1)
+
+
+def triplet_grasps(cands: Candidates, contour: np.ndarray, theta_min: float, size: float, *,
+                   margin: float = MARGIN, gap: float = GAP, grid: int = GRID) -> list[ForceGrasp]:
+    """Three-finger force-closure grasps, one per feasible region triplet (friction zone).
+
+    Parameters
+    ----------
+    cands : Candidates
+        Candidate contacts on the feasible regions.
+    contour : numpy.ndarray
+        ``(n, 2)`` object contour; the meeting point is searched in its convex hull.
+    theta_min : float
+        Friction cone half-angle ``atan(mu)``, radians.
+    size : float
+        Object size, pixels.
+    margin : float
+        Smallest accepted margin (see module notes), fraction of ``theta_min``.
+    gap : float
+        Smallest distance between two contacts, fraction of ``size``.
+    grid : int
+        Points per object size of the coarse grid searched for the meeting point; the best points
+        are then refined on finer grids around them (``REFINE`` levels, each a third of the last).
+
+    Returns
+    -------
+    list of ForceGrasp
+        Ordered by region triplet.
+    """
+    _check(theta_min, margin, gap)
+    if grid < 2:
+        raise SynthesisError(f"grid must be at least 2, got {grid}")
+    P, N = np.asarray(cands.points), np.asarray(cands.normals)
+    X = _grid(np.asarray(contour, dtype=float), size, grid)
+    if not len(P) or not len(X):
+        return []
+    far = _far(cands, gap, size)
+    regions = np.unique(cands.region)
+    curved = {int(r): len(np.unique(np.round(N[cands.of_region(r)], 9), axis=0)) > 1 for r in regions}
+    found = []
+    for triple in itertools.combinations_with_replacement(regions, 3):
+        if len(set(triple)) < 3 and not all(curved[int(r)] for r in triple if triple.count(r) > 1):
+            continue  # two contacts on one straight region share their normal: never spanning
+        combos = None
+        if len(set(triple)) < 3:
+            combos = _combinations(triple, cands, far)
+            # the normals' spanning margin bounds the score whatever the meeting point
+            combos = combos[:, span_margin(np.moveaxis(N[combos], 0, 1)) >= margin * theta_min]
+            if not combos.shape[1]:
+                continue
+        best = _search(triple, combos, X, size / grid, cands, far, theta_min)
+        if best is None or best[1] < margin * theta_min:
+            continue
+        idx, score, x = best
+        ang = _angle(N[idx], x - P[idx])
+        found.append(ForceGrasp(tuple(int(i) for i in idx), P[idx], N[idx],
+                                tuple(int(cands.region[i]) for i in idx), tuple(float(v) for v in ang),
+                                float(score), x.copy(), theta_min))
+    return found
+
+
+def _search(triple, combos, X, step, cands, far, theta_min, keep: int = 8):
+    """Best (contacts, margin, meeting point): the grid ``X``, then finer grids around the best."""
+    offsets = np.stack(np.meshgrid(np.arange(-2, 3), np.arange(-2, 3)), axis=-1).reshape(-1, 2)
+    score, T = _scores(triple, combos, X, cands, far, theta_min)
+    for _ in range(REFINE):
+        if not np.isfinite(score).any():
+            return None
+        step /= 3
+        top = np.argsort(-score)[:keep]
+        X = np.vstack([X[top], (X[top][:, None, :] + step * offsets[None]).reshape(-1, 2)])
+        score, T = _scores(triple, combos, X, cands, far, theta_min)
+    g = int(np.argmax(score))
+    if not np.isfinite(score[g]):
+        return None
+    return T[:, g], float(score[g]), X[g]
+
+
+def _scores(triple, combos, X, cands, far, theta_min) -> tuple[np.ndarray, np.ndarray]:
+    """Margin at every point of ``X`` with its best contacts: ``(G,)`` scores, ``(3, G)`` contacts.
+
+    Distinct regions: each region's candidate deepest in its cone at the point. A region used more
+    than once: the best of the admissible ``combos`` (``(3, C)``) at the point.
+    """
+    P, N = np.asarray(cands.points), np.asarray(cands.normals)
+    if combos is None:
+        taken: list[np.ndarray] = []
+        for r in triple:
+            idx = cands.of_region(r)
+            cone = theta_min - _angle(N[idx][:, None, :], X[None] - P[idx][:, None, :])
+            taken.append(_pick(idx[np.argsort(-cone, axis=0, kind="stable")], taken, far))
+        T = np.stack(taken)
+        valid = (T >= 0).all(axis=0)
+        T = np.where(valid, T, 0)
+        score = _margins(T, X, P, N, theta_min)
+        return np.where(valid, score, -np.inf), T
+    best = np.full(len(X), -np.inf)
+    T = np.zeros((3, len(X)), dtype=np.intp)
+    for lo in range(0, combos.shape[1], 256):  # chunks bound the (3, C, G, 2) temporaries
+        part = combos[:, lo:lo + 256]
+        score = _margins(part[:, :, None], X[None], P, N, theta_min)  # (C, G)
+        c = np.argmax(score, axis=0)
+        better = score[c, np.arange(len(X))] > best
+        best[better] = score[c, np.arange(len(X))][better]
+        T[:, better] = part[:, c[better]]
+    return best, T
+
+
+def _margins(T: np.ndarray, X: np.ndarray, P, N, theta_min: float) -> np.ndarray:
+    """Smallest of the cone margins of the meeting points ``X`` and the spanning margins of the
+    force directions and of the normals, for contact triples ``T`` (first axis: the three)."""
+    d = X - P[T]  # (3, ..., 2)
+    cone = (theta_min - _angle(N[T], d)).min(axis=0)
+    forces = span_margin(np.moveaxis(d, 0, -2))
+    normals = span_margin(np.moveaxis(N[T], 0, -2))
+    return np.minimum(np.minimum(cone, forces), normals)
+
+
+def _combinations(triple, cands: Candidates, far: np.ndarray, limit: int = 2048) -> np.ndarray:
+    """A region used twice or thrice: every admissible triple of its points (with the other
+    region's points), ``(3, C)``; evenly thinned to ``limit`` triples. The point deepest in the
+    cone is no guide here (on a disc every point is equally deep from the centre): the spread
+    of the points decides."""
+    parts = []
+    for r in sorted(set(triple)):
+        idx = cands.of_region(r)
+        parts.append(list(itertools.combinations(idx, triple.count(r))))
+    rows = np.array([sum(combo, ()) for combo in itertools.product(*parts)], dtype=np.intp).reshape(-1, 3)
+    ok = far[rows[:, 0], rows[:, 1]] & far[rows[:, 0], rows[:, 2]] & far[rows[:, 1], rows[:, 2]]
+    rows = rows[ok]
+    if len(rows) > limit:
+        rows = rows[np.linspace(0, len(rows) - 1, limit).astype(int)]
+    return rows.T
+
+
+def friction_cone(point, normal, theta_min: float, reach: float) -> Polygon:
+    """The inward friction cone of a contact as a triangle of side ``reach`` (pixels).
+
+    Parameters
+    ----------
+    point, normal : array_like
+        Contact point and inward unit normal, pixels.
+    theta_min : float
+        Half-angle, radians.
+    reach : float
+        Length of the cone's edges (the cone itself is unbounded).
+    """
+    p = np.asarray(point, dtype=float)
+    n = np.asarray(normal, dtype=float)
+    n = n / np.linalg.norm(n)
+    edges = [p + reach * np.array([n[0] * math.cos(s) - n[1] * math.sin(s),
+                                   n[0] * math.sin(s) + n[1] * math.cos(s)]) for s in (-theta_min, theta_min)]
+    return Polygon([p, *edges])
+
+
+def friction_zone(points: Sequence, normals: Sequence, theta_min: float, reach: float) -> BaseGeometry:
+    """Intersection of the contacts' inward friction cones (each cut at ``reach`` pixels)."""
+    zone = None
+    for p, n in zip(points, normals):
+        cone = friction_cone(p, n, theta_min, reach)
+        zone = cone if zone is None else zone.intersection(cone)
+    return zone if zone is not None else Polygon()
