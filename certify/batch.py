@@ -13,13 +13,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator
 
+import pyarrow as pa
+
 from .certificates import Tolerances
-from .engine import Options, RunSummary, _clean, run
+from .engine import Options, RunSummary, run
 from .errors import CertifyError, GraspFileError
 from .grasp import grasp_from_dict
 from .report import certify_grasp, error_row, verify_row
 from .solvers import make_solver
-from .table import iter_chunks, table_to_rows
+from .table import chunk_values, iter_chunks, table_to_rows, table_values
 
 __all__ = ["Summary", "certify_values", "certify_file", "verify_file"]
 
@@ -68,21 +70,23 @@ class Summary:
         return self.statuses.get("error", 0)
 
 
-def _result_rows(path: Path, size: int) -> Iterator[tuple[list, Any]]:
-    """Results in chunks of ``size``: ``(rows as dicts or errors, Arrow table or None)``."""
+def _result_rows(path: Path, size: int) -> Iterator[tuple[Callable[[], list], Any]]:
+    """Results in chunks of ``size``: ``(function giving the rows as dicts or errors, Arrow table
+    or None)``; rows are built only when asked for (a columnar re-check rarely needs them)."""
     import json
+
+    def parse(text):
+        try:
+            return json.loads(text)
+        except json.JSONDecodeError:
+            return GraspFileError("not a JSON object")
 
     for chunk in iter_chunks(path, size):
         if isinstance(chunk.rows, list):
-            out = []
-            for _, text in chunk.rows:
-                try:
-                    out.append(json.loads(text))
-                except json.JSONDecodeError:
-                    out.append(GraspFileError("not a JSON object"))
-            yield out, None
+            rows = [parse(text) for _, text in chunk.rows]
+            yield (lambda rows=rows: rows), None
         else:
-            yield table_to_rows(chunk.rows), chunk.rows
+            yield (lambda t=chunk.rows: table_to_rows(t)), chunk.rows
 
 
 def _verify_one(value, line: int, row, tol: Tolerances) -> tuple[str, tuple | None]:
@@ -109,29 +113,10 @@ def _verify_one(value, line: int, row, tol: Tolerances) -> tuple[str, tuple | No
     return status, None if check else (gid, check.reason)
 
 
-def _verify_chunk(grasp_values: list, lines: list[int], rows, tol: Tolerances, tables=None):
-    """Verify one chunk of aligned (grasp, results row) pairs; return counts and failures.
-
-    With ``tables`` (the chunk's grasp and results Arrow tables) the common certificates are
-    proved in bulk (:func:`certify.recheck.recheck_table`) and only the rest row by row."""
+def _verify_chunk(grasp_values: list, lines: list[int], rows, tol: Tolerances):
+    """Verify one chunk of aligned (parsed grasp, results row) pairs; return counts and failures."""
     statuses: dict[str, int] = {}
     failures = []
-    if tables is not None:
-        from .recheck import recheck_table
-
-        grasps, results = tables
-
-        def slow(i):
-            status, failure = _verify_one(grasp_values[i], lines[i], rows[i], tol)
-            if failure:
-                failures.append(failure)
-            return failure is None
-
-        recheck_table(grasps, results, lines, slow, tol)
-        for r in rows:
-            s = str(r.get("status"))
-            statuses[s] = statuses.get(s, 0) + 1
-        return statuses, failures
     for value, line, row in zip(grasp_values, lines, rows):
         status, failure = _verify_one(value, line, row, tol)
         statuses[status] = statuses.get(status, 0) + 1
@@ -140,18 +125,24 @@ def _verify_chunk(grasp_values: list, lines: list[int], rows, tol: Tolerances, t
     return statuses, failures
 
 
-def _grasp_values(chunk) -> list:
-    import json
+def _verify_tables(grasps, results, lines: list[int], tol: Tolerances):
+    """Verify one chunk of aligned Arrow tables: the common certificates are proved in bulk
+    (:func:`certify.recheck.recheck_table`); only the other rows are turned into Python values
+    and re-checked one by one."""
+    from .recheck import recheck_table
 
-    if isinstance(chunk.rows, list):
-        out = []
-        for _, text in chunk.rows:
-            try:
-                out.append(json.loads(text))
-            except json.JSONDecodeError as err:
-                out.append(GraspFileError(f"malformed JSON ({err.msg})"))
-        return out
-    return [_clean(d) for d in chunk.rows.to_pylist()]
+    failures = []
+
+    def slow(i):
+        value = table_values(grasps.slice(i, 1))[0]
+        status, failure = _verify_one(value, lines[i], table_to_rows(results.slice(i, 1))[0], tol)
+        if failure:
+            failures.append(failure)
+        return failure is None
+
+    recheck_table(grasps, results, lines, slow, tol)
+    counts = results.column("status").value_counts().to_pylist()
+    return {c["values"]: c["counts"] for c in counts}, failures
 
 
 def verify_file(results_path: str | Path, grasps_path: str | Path,
@@ -171,13 +162,14 @@ def verify_file(results_path: str | Path, grasps_path: str | Path,
     try:
         pairs = zip(iter_chunks(grasps_path, chunk_size), _result_rows(results_path, chunk_size))
         for chunk, (rows, table) in pairs:
-            tables = (chunk.rows, table) if table is not None and not isinstance(chunk.rows, list) \
-                and len(rows) == len(chunk) else None
-            args = (_grasp_values(chunk), chunk.lines, rows, tol, tables)
+            if table is not None and isinstance(chunk.rows, pa.Table) and table.num_rows == len(chunk):
+                fn, args = _verify_tables, (chunk.rows, table, chunk.lines, tol)
+            else:
+                fn, args = _verify_chunk, (chunk_values(chunk), chunk.lines, rows(), tol)
             if pool is None:
-                _merge(summary, _verify_chunk(*args))
+                _merge(summary, fn(*args))
                 continue
-            futures.append(pool.submit(_verify_chunk, *args))
+            futures.append(pool.submit(fn, *args))
             if len(futures) > 2 * workers:  # bounded memory: few chunks in flight
                 _merge(summary, futures.pop(0).result())
         for f in futures:

@@ -2,8 +2,9 @@
 
 The input is read in chunks of a fixed number of grasps (:func:`certify.table.iter_chunks`).
 Each chunk is certified by a worker (local processes by default, or a dask.distributed cluster)
-which writes its results to ``RESULTS.parts/part-NNNNNN.EXT`` under a temporary name and renames
-it atomically when complete. When every part exists they are concatenated, in chunk order, into a
+and its results are written to ``RESULTS.parts/part-NNNNNN.EXT`` under a temporary name, renamed
+atomically when complete (local workers write their own parts; dask workers send their results
+back to the client, which writes them, so a remote cluster needs no shared filesystem). When every part exists they are concatenated, in chunk order, into a
 temporary file renamed to ``RESULTS``, and the parts folder is removed.
 
 A run killed at any moment leaves only complete parts (plus temporaries, discarded).
@@ -27,7 +28,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from .errors import CertifyError, GraspFileError
-from .table import Chunk, RESULT_SCHEMA, count_grasps, is_parquet, iter_chunks
+from .table import Chunk, RESULT_SCHEMA, chunk_values, count_grasps, is_parquet, iter_chunks, table_values
 
 __all__ = ["Options", "RunSummary", "run", "certify_chunk"]
 
@@ -63,39 +64,19 @@ class RunSummary:
         self.unverified += unverified
 
 
-def _clean(d: Any) -> Any:
-    """Drop null fields (Parquet's missing values) so that defaults apply as in JSON."""
-    if not isinstance(d, dict):
-        return d
-    out = {k: v for k, v in d.items() if v is not None}
-    if isinstance(out.get("contacts"), list):
-        out["contacts"] = [_clean(c) for c in out["contacts"]]
-    return out
-
-
-def _json_values(chunk: Chunk) -> list:
-    values = []
-    for _, text in chunk.rows:
-        try:
-            values.append(json.loads(text))
-        except json.JSONDecodeError as err:
-            values.append(GraspFileError(f"malformed JSON ({err.msg} at column {err.colno})"))
-    return values
-
-
 def certify_chunk_results(chunk: Chunk, options: Options):
     """Results of ``chunk``: an Arrow table for Parquet input (columnar path), a list of rows
     for JSON Lines input (per-grasp path)."""
     from .batch import certify_values
 
     if not isinstance(chunk.rows, pa.Table):
-        return list(certify_values(_json_values(chunk), chunk.lines, options))
+        return list(certify_values(chunk_values(chunk), chunk.lines, options))
     from .fastpath import certify_table
 
     table = chunk.rows
 
     def slow(idx):
-        values = [_clean(d) for d in table.take(pa.array(idx)).to_pylist()]
+        values = table_values(table.take(pa.array(idx)))
         return list(certify_values(values, [chunk.lines[i] for i in idx], options))
 
     return certify_table(table, chunk.lines, options, slow=slow)
@@ -119,10 +100,14 @@ def certify_chunk(chunk: Chunk, options: Options, part: str) -> tuple[int, dict[
     """Certify ``chunk`` and write its results to ``part`` atomically.
 
     Returns ``(chunk index, status counts, unverified count)``. This is the unit of work sent to
-    local processes or dask workers.
+    local processes.
     """
-    results = certify_chunk_results(chunk, options)
-    _write_part(results, Path(part))
+    return chunk.index, *_finish(certify_chunk_results(chunk, options), Path(part))
+
+
+def _finish(results, part: Path) -> tuple[dict[str, int], int]:
+    """Write a chunk's results to ``part`` atomically; its status counts and unverified count."""
+    _write_part(results, part)
     if isinstance(results, pa.Table):
         statuses = results.column("status").to_pylist()
         verified = results.column("verified").to_pylist()
@@ -133,7 +118,7 @@ def certify_chunk(chunk: Chunk, options: Options, part: str) -> tuple[int, dict[
     for status in statuses:
         counts[status] = counts.get(status, 0) + 1
     unverified = sum(1 for s, v in zip(statuses, verified) if s != "error" and not v)
-    return chunk.index, counts, unverified
+    return counts, unverified
 
 
 def _part_counts(part: Path) -> tuple[dict[str, int], int]:
@@ -203,6 +188,11 @@ class _LocalPool:
         return self.pool.submit(certify_chunk, *args)
 
     @staticmethod
+    def result(future) -> tuple[dict[str, int], int]:
+        _, counts, unverified = future.result()
+        return counts, unverified
+
+    @staticmethod
     def wait_one(futures):
         done, _ = wait(futures, return_when=FIRST_COMPLETED)
         return done
@@ -225,9 +215,18 @@ class _DaskPool:
             self.cluster = None
             self.client = Client(address)
         self.capacity = 2 * max(1, len(self.client.scheduler_info()["workers"]))
+        self.parts: dict[Any, Path] = {}
 
-    def submit(self, *args):
-        return self.client.submit(certify_chunk, *args, pure=False)
+    def submit(self, chunk: Chunk, options: Options, part: str):
+        # Workers only compute: the chunk travels by scatter (not inside the task graph) and the
+        # results come back here to be written, so a remote cluster needs no shared filesystem.
+        data = self.client.scatter(chunk, direct=False)
+        future = self.client.submit(certify_chunk_results, data, options, pure=False)
+        self.parts[future] = Path(part)
+        return future
+
+    def result(self, future) -> tuple[dict[str, int], int]:
+        return _finish(future.result(), self.parts.pop(future))
 
     @staticmethod
     def wait_one(futures):
@@ -271,8 +270,7 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
     pending: dict[Any, int] = {}
 
     def collect(future) -> None:
-        _, counts, unverified = future.result()
-        summary.add(counts, unverified)
+        summary.add(*pool.result(future))
         size = pending.pop(future)
         if progress:
             progress(size)

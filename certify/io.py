@@ -16,29 +16,15 @@ import pyarrow.parquet as pq
 
 from .errors import CertifyError, GraspFileError
 from .grasp import Grasp, grasp_from_dict, grasp_to_dict
-from .table import grasps_table, is_parquet, iter_chunks, rows_to_table, table_to_rows
+from .table import chunk_values, grasps_table, is_parquet, iter_chunks, rows_to_table, table_to_rows
 
 __all__ = ["read_grasps", "write_grasps", "read_results", "write_rows"]
-
-
-def _values(chunk) -> Iterator[Any]:
-    """Parsed grasp values of a chunk (dicts, or the JSON error of a malformed line)."""
-    from .engine import _clean
-
-    if isinstance(chunk.rows, list):
-        for _, text in chunk.rows:
-            try:
-                yield json.loads(text)
-            except json.JSONDecodeError as err:
-                yield GraspFileError(f"malformed JSON ({err.msg} at column {err.colno})")
-    else:
-        yield from (_clean(d) for d in chunk.rows.to_pylist())
 
 
 def read_grasps(path: str | Path, chunk_size: int = 4096) -> Iterator[tuple[int, Any, Grasp | CertifyError]]:
     """Yield ``(line number, id or None, Grasp or the error that line raised)``."""
     for chunk in iter_chunks(path, chunk_size):
-        for number, value in zip(chunk.lines, _values(chunk)):
+        for number, value in zip(chunk.lines, chunk_values(chunk)):
             gid = value.get("id") if isinstance(value, dict) else None
             if isinstance(value, CertifyError):
                 yield number, gid, type(value)(f"line {number}: {value}")

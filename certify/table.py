@@ -82,7 +82,9 @@ def iter_chunks(path: str | Path, size: int) -> Iterator[Chunk]:
     path = Path(path)
     if is_parquet(path):
         try:
-            reader = pq.ParquetFile(path)
+            # Without pre-buffering, pyarrow (26) keeps every decoded page of the file alive while
+            # iterating batches; buffered reads keep memory bounded by the chunk size.
+            reader = pq.ParquetFile(path, pre_buffer=False, buffer_size=1 << 20)
         except (OSError, pa.ArrowException) as err:
             raise _open_error(path, err) from None
         buffered, start, index = [], 0, 0
@@ -114,6 +116,34 @@ def iter_chunks(path: str | Path, size: int) -> Iterator[Chunk]:
                     rows, index = [], index + 1
         if rows:
             yield Chunk(index, [n for n, _ in rows], rows)
+
+
+def clean_value(d: Any) -> Any:
+    """Drop null fields (Parquet's missing values) so that defaults apply as in JSON."""
+    if not isinstance(d, dict):
+        return d
+    out = {k: v for k, v in d.items() if v is not None}
+    if isinstance(out.get("contacts"), list):
+        out["contacts"] = [clean_value(c) for c in out["contacts"]]
+    return out
+
+
+def table_values(table: pa.Table) -> list:
+    """Grasp values (dicts, JSON-like) of the rows of an Arrow grasp table."""
+    return [clean_value(d) for d in table.to_pylist()]
+
+
+def chunk_values(chunk: Chunk) -> list:
+    """Parsed grasp values of a chunk: dicts, or a :class:`GraspFileError` for a malformed line."""
+    if isinstance(chunk.rows, pa.Table):
+        return table_values(chunk.rows)
+    values = []
+    for _, text in chunk.rows:
+        try:
+            values.append(json.loads(text))
+        except json.JSONDecodeError as err:
+            values.append(GraspFileError(f"malformed JSON ({err.msg} at column {err.colno})"))
+    return values
 
 
 def count_grasps(path: str | Path) -> int | None:
