@@ -93,8 +93,10 @@ def bench_command(
     reference_n: int = typer.Option(300, "--reference-n", help="Grasps per kind for slow routes."),
     quality: bool = typer.Option(False, "--quality", help="Benchmark epsilon instead: gaps, times, 8-edge error."),
 ) -> None:
-    """Time every route (batch path, per-grasp fast route, clarabel, linprog, cvxpy) on the same
-    random grasps; print grasps per second and each route's ratio to the batch path.
+    """Time every certification route on the same random grasps, with ratios to the batch path.
+
+    Routes: the batch path, the per-grasp fast route, clarabel, linprog, cvxpy with Parameters
+    and cvxpy rebuilt per grasp; prints grasps per second and each route's ratio.
 
     With --quality: epsilon bound gaps and time per grasp, and the error of the 8-edge cone
     linearisation other toolkits use, on --n random grasps in closure per kind.
@@ -115,8 +117,9 @@ def sample_command(
     model: str = typer.Option("point", help="frictionless, point or soft."),
     seed: int = typer.Option(0, help="Random seed."),
 ) -> None:
-    """Write a random grasp set (contacts around a blob, about a third in closure), for trying
-    the toolkit and for benchmarks at scale."""
+    """Write a random grasp set, for trying the toolkit and for benchmarks at scale.
+
+    Contacts are placed around a random blob; about a third of the grasps are in closure."""
     from .samples import write_random_grasp_file
 
     count = write_random_grasp_file(output, n, seed=seed, dim=dim, n_contacts=contacts, model=model)

@@ -13,6 +13,7 @@ per-grasp path, so the two agree by construction.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -24,7 +25,7 @@ from .kernels import planar_batch
 from .solvers.enumeration import _FEAS, bases
 from .table import CERTIFICATE, RESULT_SCHEMA
 
-__all__ = ["certify_table"]
+__all__ = ["certify_table", "PlanarScreen", "planar_screen"]
 
 _MODEL_NAMES = {FRICTIONLESS: "frictionless", POINT: "point"}
 
@@ -88,6 +89,101 @@ def _layout(models, frictionless: bool):
     return np.array(owner, dtype=np.int64), np.array(sign, dtype=np.float64)
 
 
+@dataclass(frozen=True, eq=False)
+class PlanarScreen:
+    """Columnar force-closure verdicts and exact epsilons of a batch of planar grasps.
+
+    Attributes
+    ----------
+    closure : numpy.ndarray
+        ``(B,)`` bool: force closure **proved** (LP optimum above the margin tolerance and the
+        interior certificate re-checked in floating point with rigorous error bounds).
+    settled : numpy.ndarray
+        ``(B,)`` bool: the columnar rules settled the verdict (closure proved, or a strict or
+        null-space Farkas certificate proved); unsettled rows (near-degenerate, tight contacts)
+        are what :func:`certify.certify_grasp` decides grasp by grasp.
+    margin : numpy.ndarray
+        ``(B,)`` min-weight margin ``t*`` of force closure (``-inf`` when infeasible).
+    eps_l1, eps_linf : numpy.ndarray
+        ``(B,)`` exact Ferrari-Canny epsilon of the L1 and L-infinity grasp wrench spaces where
+        ``closure``, else 0 (with the batch's ``center`` and ``length``).
+    """
+
+    closure: np.ndarray
+    settled: np.ndarray
+    margin: np.ndarray
+    eps_l1: np.ndarray
+    eps_linf: np.ndarray
+
+
+def planar_screen(P, N, mu, center, length, *, quality: bool = True,
+                  tol: Tolerances = Tolerances()) -> PlanarScreen:
+    """Force closure and epsilon of many planar grasps sharing one contact pattern, columnar.
+
+    The same compiled kernels as :func:`certify_table` (:func:`certify.kernels.planar_batch`:
+    min-weight LP by basis enumeration, certificate re-checked in floating point, exact planar
+    epsilon), called directly on arrays, without building grasp tables or certificates. Use it
+    to screen large candidate sets (a grasp search); a grasp retained is then certified with
+    :func:`certify.certify_grasp`, which decides exactly the rows left unsettled here.
+
+    Parameters
+    ----------
+    P, N : array_like
+        ``(B, m, 2)`` contact points and **inward** normals (normalised here).
+    mu : array_like
+        ``(B, m)`` friction coefficients; 0 is a frictionless contact. Every row must have the
+        same pattern of frictionless and ``point`` contacts.
+    center : array_like
+        ``(B, 2)`` or ``(2,)`` reference point of torques.
+    length : array_like or float
+        ``(B,)`` or scalar length dividing torques, ``> 0``.
+    quality : bool
+        Compute the epsilons (otherwise they are 0).
+    tol : Tolerances
+        Verdict tolerances (as for :func:`certify.certify_grasp`).
+
+    Returns
+    -------
+    PlanarScreen
+
+    Raises
+    ------
+    ValueError
+        Shapes disagree, rows mix contact patterns, or a normal or length is not usable.
+    """
+    P = np.asarray(P, dtype=float)
+    N = np.asarray(N, dtype=float)
+    if P.ndim != 3 or P.shape[2] != 2 or N.shape != P.shape:
+        raise ValueError(f"P and N must both be (B, m, 2), got {P.shape} and {N.shape}")
+    B, m, _ = P.shape
+    mu = np.broadcast_to(np.asarray(mu, dtype=float), (B, m))
+    center = np.broadcast_to(np.asarray(center, dtype=float), (B, 2))
+    length = np.broadcast_to(np.asarray(length, dtype=float), (B,))
+    norm = np.linalg.norm(N, axis=2, keepdims=True)
+    if not (np.isfinite(P).all() and np.isfinite(N).all() and (norm >= 1e-9).all()):
+        raise ValueError("points and normals must be finite, normals non-zero")
+    if not (np.isfinite(mu).all() and (mu >= 0).all() and (length > 0).all() and np.isfinite(length).all()):
+        raise ValueError("mu must be finite and >= 0, length finite and > 0")
+    pattern = mu > 0
+    if B and not (pattern == pattern[0]).all():
+        raise ValueError("every row must have the same pattern of frictionless and point contacts")
+    N = np.where(np.abs(norm - 1.0) > 1e-12, N / norm, N)  # as certify.grasp.Contact stores it
+    if B == 0:
+        empty = np.zeros(0)
+        return PlanarScreen(empty.astype(bool), empty.astype(bool), empty, empty, empty)
+    models = tuple("point" if f else "frictionless" for f in pattern[0])
+    owner, sign = _layout(models, False)
+    owner_f, _ = _layout(models, True)
+    same = not pattern[0].any()
+    code, t, *_, code_f, _t_f, _lam_f, _basis_f, _y_f, eps = planar_batch(
+        np.ascontiguousarray(P), np.ascontiguousarray(N), np.ascontiguousarray(mu),
+        np.ascontiguousarray(center), np.ascontiguousarray(length), owner, sign,
+        bases(len(owner), 3), owner_f, bases(m, 3), same, tol.margin, _FEAS, tol.residual, quality)
+    closure = code == 1
+    return PlanarScreen(closure, code > 0, t, np.where(closure, eps[:, 0], 0.0),
+                        np.where(closure, eps[:, 1], 0.0))
+
+
 def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances):
     """Certify the planar grasps ``rows`` (one contact pattern) with :func:`planar_batch`;
     return the settled rows and their result columns."""
@@ -106,6 +202,54 @@ def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances
     if options.quality:
         out["L1"], out["Linf"] = eps[:, 0], eps[:, 1]
     return settled, out
+
+
+def _polyhedral_rows(P, N, c, L, options, tol: Tolerances):
+    """Form closure of spatial grasps (also the force closure of frictionless ones) whose LP has
+    too many bases for a columnar rule: decided row by row exactly as the per-grasp path decides
+    it (same problem, same fast solver, same certificate), with the certificate then proved by
+    the rigorous float kernels instead of rationals (the exact checker only where floats cannot
+    decide). Returns ``(code, t, lam, basis, y)`` and the tight blocks of code-4 rows."""
+    from .certificates import verify
+    from .closure import decide
+    from .grasp import Contact, Grasp
+    from .kernels import verify_farkas_general, verify_interior_general
+    from .problem import grasp_problem, grasp_system
+    from .solvers import make_solver
+    from .wrench import generator_columns
+
+    B, m, d = P.shape
+    models = ("frictionless",) * m
+    zeros = np.zeros((B, m))
+    W, _ = generator_columns(P, N, zeros, models, c, L, frictionless=True)
+    W = np.ascontiguousarray(W)
+    E = _force_column_error(P, N, models, c, L, m)
+    kind, first = np.zeros(m, dtype=np.int64), np.arange(m)
+    code = np.zeros(B, dtype=np.int64)
+    t, lam = np.zeros(B), np.zeros((B, m))
+    basis, y = np.zeros((B, 2 * d), dtype=np.int64), np.zeros((B, 2 * d))
+    tight_rows = {}
+    solver = make_solver("fast")
+    for i in range(B):
+        grasp = Grasp(tuple(Contact(P[i, j], N[i, j]) for j in range(m)), center=c[i], length=L[i])
+        v = decide(grasp_problem(grasp, frictionless=True),
+                   lambda g=grasp: grasp_system(g, frictionless=True, exact=True).columns, solver, tol)
+        cert = v.certificate
+        if v.status == "closure":
+            t[i], lam[i], basis[i] = v.margin, cert.values, cert.basis
+            if not options.quality and verify_interior_general(
+                    W[i], E[i], kind, first, N[i], zeros[i], zeros[i], lam[i], basis[i], tol.residual):
+                code[i] = 1
+        elif v.status == "no_closure":
+            y[i] = cert.y
+            mask = np.zeros(m, dtype=bool)
+            mask[list(cert.tight)] = True
+            proved = not cert.null_space and not mask.any() and verify_farkas_general(
+                W[i], E[i], kind, first, N[i], zeros[i], zeros[i], y[i], mask, 0.0)
+            if proved or verify(grasp, cert, status="no_closure", frictionless=True):
+                code[i] = 3 if cert.null_space else 4 if mask.any() else 2
+                tight_rows[i] = np.flatnonzero(mask)
+    return (code, t, lam, basis, y), tight_rows
 
 
 def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances):
@@ -131,6 +275,9 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
     P, N = cols.P[rows, :m, :], cols.N[rows, :m, :]
     mu, tor, c, L = cols.mu[rows, :m], cols.torsion[rows, :m], cols.center[rows], cols.length[rows]
     B = len(rows)
+    if all(name == "frictionless" for name in models):  # force closure is form closure
+        form, tight = _polyhedral_rows(P, N, c, L, options, tol)
+        return form[0] > 0, {"force": form, "form": form, "tight": tight, "form_tight": tight}
     # force closure: the barrier method on the solver columns
     columns, rays, cones, to_values = conic_columns(P, N, mu, tor, models, c, L)
     blocks = [(r, 1, np.ones(B)) for r in rays] + list(cones)
@@ -225,11 +372,13 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
     if m < 6:
         y_f = np.ascontiguousarray(np.linalg.svd(Wf)[0][:, :, -1])
         code_f = null_rows(Wf, Ef, y_f)
-    # m >= 6: the enumerated LP (left to the per-grasp path for now)
+    form_tight = {}
+    if m >= 6:
+        (code_f, t_f, lam_f, basis_f, y_f), form_tight = _polyhedral_rows(P, N, c, L, options, tol)
     settled = (code > 0) & (code_f > 0)
     out = {"force": (code, t, values, basis, np.nan_to_num(yn)),
            "form": (code_f, t_f, lam_f, basis_f, y_f),
-           "force_layout": ("forces", m), "tight": tight_rows}
+           "force_layout": ("forces", m), "tight": tight_rows, "form_tight": form_tight}
     return settled, out
 
 
@@ -292,7 +441,7 @@ def _group_table(cols: GraspColumns, rows: np.ndarray, lines: np.ndarray, out, o
     force_layout, blocks = out.get("force_layout", ("generators", None))
     cert = pa.StructArray.from_arrays(
         [_certificates(code, lam, basis, yn, force_layout, blocks, out.get("tight")),
-         _certificates(fcode, flam, fbasis, fyn)],
+         _certificates(fcode, flam, fbasis, fyn, tight=out.get("form_tight"))],
         fields=list(RESULT_SCHEMA.field("certificate").type))
     eps = {}
     for norm, key in (("L1", "l1"), ("Linf", "linf")):
@@ -335,7 +484,7 @@ def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(
     done = np.zeros(n, dtype=bool)
     pieces, order = [], []
     planar = cols.ok & (cols.dim == 2) & ((cols.model <= POINT)).all(axis=1) & (cols.count >= 1)
-    spatial = cols.ok & (cols.dim == 3) & (cols.model > FRICTIONLESS).any(axis=1)
+    spatial = cols.ok & (cols.dim == 3) & (cols.count >= 1)
     if options.method == "fast" and (planar | spatial).any():
         m = cols.model.shape[1]
         key = cols.dim * 3 ** (m + 2) + cols.count * 3 ** m + \
@@ -346,10 +495,11 @@ def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(
             settled, out = group(cols, rows, options, tol)
             if settled.any():
                 sub = {name: (value if name == "force_layout" else _take(value, settled))
-                       for name, value in out.items() if name != "tight"}
-                if "tight" in out:  # re-index the per-row tight lists to the settled rows
-                    new = np.cumsum(settled) - 1
-                    sub["tight"] = {int(new[r]): v for r, v in out["tight"].items() if settled[r]}
+                       for name, value in out.items() if name not in ("tight", "form_tight")}
+                new = np.cumsum(settled) - 1  # re-index the per-row tight lists to the settled rows
+                for name in ("tight", "form_tight"):
+                    if name in out:
+                        sub[name] = {int(new[r]): v for r, v in out[name].items() if settled[r]}
                 pieces.append(_group_table(cols, rows[settled], lines[rows[settled]], sub, options))
                 order.append(rows[settled])
                 done[rows[settled]] = True

@@ -52,7 +52,7 @@ BARRIER_NEAR_ZERO = 1e-5
 
 class FastSolver:
     """Exact enumeration for small polyhedral programmes, the compiled dual barrier method for
-    cones, clarabel's API for the rest (large polyhedral programmes, and cones whose barrier
+    cones and large polyhedral programmes, clarabel's API for the rest (programmes whose barrier
     solution is within :data:`BARRIER_NEAR_ZERO` of the closure boundary, where the
     interior-point solver's sharper duals tell tight contacts apart)."""
 
@@ -71,17 +71,16 @@ class FastSolver:
 
         from .enumeration import solve_enumeration
 
-        if problem.cones:
+        if problem.cones or comb(problem.nvar, problem.d) > self.max_bases:
             sol = self._barrier.solve(problem)
             if sol is not None and abs(sol.t) >= BARRIER_NEAR_ZERO:
                 return sol
             return self._clarabel.solve(problem)
-        if not problem.cones and comb(problem.nvar, problem.d) <= self.max_bases:
-            sol = solve_enumeration(problem)
-            if sol.y is not None or (sol.status == "optimal" and sol.t > 0):
-                return sol
-            # A verdict against closure needs a dual direction, and no dual basis survived the
-            # feasibility tolerance (numerically tied bases): the interior-point route has one.
+        sol = solve_enumeration(problem)
+        if sol.y is not None or (sol.status == "optimal" and sol.t > 0):
+            return sol
+        # A verdict against closure needs a dual direction, and no dual basis survived the
+        # feasibility tolerance (numerically tied bases): the interior-point route has one.
         return self._clarabel.solve(problem)
 
 
