@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import typer
@@ -23,25 +22,131 @@ console = Console()
 def demo_command(out: Path = typer.Option(Path("qualgrasp-demo"), "--out", help="Output folder.")) -> None:
     """Run the main job on the built-in objects and say what was written where.
 
-    Currently: certifies the built-in textbook grasps (square, pinwheel, disc, antipodal planar and
-    spatial, cube) and re-verifies every certificate.
+    The paper's figures 3 to 8; FormGrasp and ForceGrasp on the built-in camera images, certified
+    and every certificate re-checked; the comparison study (quick setting); a Markdown report.
     """
-    from .demo import run_demo
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-    result = run_demo(out)
-    table = Table(title="textbook grasps")
-    for col in ("id", "force closure", "form closure", "margin", "verified"):
-        table.add_column(col)
-    with result.results.open() as fh:
-        for line in fh:
-            row = json.loads(line)
-            table.add_row(str(row["id"]), row["status"], row["form_status"],
-                          f"{row['margin']:.4g}", str(row["verified"]))
+    from .demo import demo_steps, run_demo
+
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                  console=console) as bar:
+        task = bar.add_task("demo", total=demo_steps())
+        result = run_demo(out, progress=lambda message: bar.update(task, advance=1, description=message))
+    table = Table(title="synthesis on the built-in objects, certified and re-checked")
+    for col in ("object", "outline", "route", "grasps", "certified", "median eps"):
+        table.add_column(col, no_wrap=True)
+    for r in result.synthesis:
+        eps = "-" if r.median_eps_l1 is None else f"{r.median_eps_l1:.3f}"
+        table.add_row(r.name, r.string, f"{r.procedure} {r.fingers}", str(r.grasps), str(r.certified), eps)
     console.print(table)
-    console.print(f"wrote {result.grasps} (grasp set) and {result.results} (results); "
-                  f"{len(result.verified.failures)} certificates failed re-verification")
-    if result.verified.failures or result.certified.errors:
+    table = Table(title="qualitative versus baseline (quick study)")
+    for col in ("route", "grasps", "eps best", "best/base", "robust"):
+        table.add_column(col, no_wrap=True)
+    for r in result.study.routes:
+        table.add_row(r.route, str(r.grasps), *("-" if v is None else f"{v:.3f}"
+                                                for v in (r.eps_best, r.ratio_best, r.robustness)))
+    console.print(table)
+    console.print(f"figures: {len(result.figures)} files in {out / 'figures'}", soft_wrap=True)
+    console.print(f"grasps: {result.grasps} -> {result.results} ({result.certified.rows} rows, "
+                  f"{len(result.verified.failures)} certificates failed the re-check)", soft_wrap=True)
+    console.print(f"study: {len(result.study.files)} tables and plots in {out / 'study'}", soft_wrap=True)
+    console.print(f"report: {result.report}  ({result.seconds:.0f} s)", soft_wrap=True)
+    if not result.ok:
         raise typer.Exit(1)
+
+
+@app.command("figures")
+def figures_command(out: Path = typer.Option(Path("qualgrasp-figures"), "--out", help="Output folder."),
+                    formats: str = typer.Option("pdf,png", "--formats",
+                                                help="Comma-separated file formats, e.g. pdf,png,svg.")) -> None:
+    """Draw the paper's figures 3 to 8 from the toolkit's own computations and say where they went."""
+    from .figures import make_figures
+    from .style import check_formats
+
+    try:
+        kinds = check_formats([f.strip() for f in formats.split(",") if f.strip()])
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc), param_hint="--formats") from exc
+    paths = make_figures(out, formats=kinds, progress=lambda message: console.print(message))
+    for path in paths:
+        console.print(f"wrote {path}", soft_wrap=True)  # paths stay whole, for copy and paste
+    console.print(f"{len(paths)} files in {out}", soft_wrap=True)
+
+
+_IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp")
+
+
+@app.command("compare")
+def compare_command(
+        folder: Path | None = typer.Argument(None, help="Folder of object images (PNG, JPEG, TIFF, BMP), "
+                                                        "one object per image."),
+        out: Path = typer.Option(Path("qualgrasp-compare"), "--out", help="Output folder."),
+        builtins: bool = typer.Option(False, "--builtins", help="Add the built-in objects polygon, nut, "
+                                                                "disc and figure3."),
+        silhouettes: int = typer.Option(0, "--silhouettes", help="Add this many bundled cell silhouettes "
+                                                                 "and the horse, rendered in memory."),
+        setting: str = typer.Option("quick", "--setting", help="Size of the work: quick or full."),
+        workers: int = typer.Option(2, "--workers", help="Processes."),
+        trials: int | None = typer.Option(None, "--trials", help="Robustness trials per object, kind and "
+                                                                 "size (default: the setting's)."),
+) -> None:
+    """Compare qualitative grasps with the quantitative baseline: quality, time, robustness."""
+    from dataclasses import replace
+
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from .silhouettes import silhouettes as bundled
+    from .study import BUILTINS, SETTINGS, compare, workload
+
+    if setting not in SETTINGS:
+        raise typer.BadParameter(f"use one of {', '.join(SETTINGS)}", param_hint="--setting")
+    if folder is not None and not folder.is_dir():
+        raise typer.BadParameter(f"{folder} is not a folder", param_hint="FOLDER")
+    images: list = sorted(p for p in folder.iterdir() if p.suffix.lower() in _IMAGE_SUFFIXES) if folder else []
+    images += list(BUILTINS) if builtins else []
+    images += bundled(silhouettes) if silhouettes else []
+    if not images:
+        raise typer.BadParameter("no images: give a FOLDER of images, --builtins or --silhouettes N")
+    settings = replace(SETTINGS[setting], workers=workers,
+                       **({} if trials is None else {"trials": trials}))
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                  console=console) as bar:
+        task = bar.add_task("compare", total=workload(len(images), settings))
+        result = compare(images, out, settings=settings,
+                         progress=lambda message: bar.update(task, advance=1, description=message))
+    table = Table(title=f"{len(result.objects)} objects, {result.seconds:.0f} s; eps: certified L1, "
+                        "robust: fraction still certified under vision errors", box=None,
+                  padding=(0, 1, 0, 0), pad_edge=False)
+    for col in ("route", "grasps", "cert", "eps med", "eps best", "best/base", "s/obj", "robust",
+                "paired"):
+        table.add_column(col, no_wrap=True)
+
+    def fmt(value, spec=".3f"):
+        return "-" if value is None else format(value, spec)
+
+    for r in result.routes:
+        table.add_row(r.route, str(r.grasps), fmt(r.certified_fraction), fmt(r.eps_median), fmt(r.eps_best),
+                      fmt(r.ratio_best), fmt(r.seconds_median), fmt(r.robustness), fmt(r.robustness_paired))
+    console.print(table)
+    for path in result.files:
+        console.print(f"wrote {path}", soft_wrap=True)
+
+
+@app.command("silhouettes")
+def silhouettes_command(out: Path = typer.Option(Path("qualgrasp-silhouettes"), "--out", help="Output folder."),
+                        n: int = typer.Option(24, "--n", help="Number of cell outlines."),
+                        horse: bool = typer.Option(True, "--horse/--no-horse",
+                                                   help="Also write scikit-image's horse.")) -> None:
+    """Write the bundled real silhouettes (geomstats cells, scikit-image horse) as 512 x 512 PNG images."""
+    from .silhouettes import write_silhouettes
+
+    try:
+        paths = write_silhouettes(out, n, with_horse=horse)
+    except (FileNotFoundError, ValueError) as exc:
+        console.print(f"[red]{exc}[/red]")
+        raise typer.Exit(1) from None
+    console.print(f"wrote {len(paths)} images into {out}", soft_wrap=True)
 
 
 def main() -> None:

@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import shapely.ops
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
@@ -68,7 +69,8 @@ def _draw_geometry(ax: Axes, geom: BaseGeometry, style: dict, zorder: int = 2) -
             ax.plot(g.x, g.y, "o", color=style["edgecolor"], ms=6, zorder=zorder)
 
 
-def plot_zones(ax: Axes, zones: Zones, bounds: tuple[float, float, float, float], size: float) -> Axes:
+def plot_zones(ax: Axes, zones: Zones, bounds: tuple[float, float, float, float], size: float,
+               labels: bool = False) -> Axes:
     """Draw ``Z+``, ``Z-`` (clipped to ``bounds``) and the free translations ``T``.
 
     Parameters
@@ -81,6 +83,9 @@ def plot_zones(ax: Axes, zones: Zones, bounds: tuple[float, float, float, float]
         Box the unbounded zones are clipped to, pixels.
     size : float
         Object size, pixels (scales the sector showing ``T``).
+    labels : bool
+        Also name every large zone (``Z+``, ``Z-``) inside it; small zones are always ringed
+        and named.
 
     Returns
     -------
@@ -95,6 +100,8 @@ def plot_zones(ax: Axes, zones: Zones, bounds: tuple[float, float, float, float]
             ax.plot(*c, "o", ms=22, mfc="none", mec=style["edgecolor"], mew=1.5, zorder=9)
             ax.annotate(label, c, c + np.array([0.09, -0.09]) * size, color=style["edgecolor"], fontsize=9,
                         fontweight="bold", zorder=9, arrowprops={"arrowstyle": "-", "color": style["edgecolor"]})
+        elif labels and not geom.is_empty and geom.area > 0:
+            _zone_label(ax, geom, label, style["edgecolor"], size)
     t = zones.translations
     if not t.empty:
         a = math.degrees(math.atan2(t.centre[1], t.centre[0]))
@@ -104,6 +111,14 @@ def plot_zones(ax: Axes, zones: Zones, bounds: tuple[float, float, float, float]
             ax.annotate("", zones.center + 0.22 * size * d, zones.center,
                         arrowprops={"arrowstyle": "->", "color": TCOLOR, "lw": 1.5}, zorder=3)
     return ax
+
+
+def _zone_label(ax: Axes, geom: BaseGeometry, label: str, color: str, size: float) -> None:
+    """The zone's name at the point of its largest part farthest from the part's edges."""
+    part = max(getattr(geom, "geoms", [geom]), key=lambda g: g.area)
+    where = shapely.ops.polylabel(part, tolerance=0.01 * size) if part.geom_type == "Polygon" else part.centroid
+    ax.text(where.x, where.y, label, color=color, fontsize=10, fontweight="bold", ha="center", va="center",
+            zorder=9, bbox={"boxstyle": "round,pad=0.2", "facecolor": "white", "edgecolor": color, "lw": 0.8})
 
 
 def plot_contacts(ax: Axes, points: np.ndarray, normals: np.ndarray, size: float, labels: bool = True) -> Axes:
@@ -134,15 +149,18 @@ def _chords(ax: Axes, grasp: FormGrasp, synth: Synthesis, count: int) -> None:
 
 
 def plot_form_step(ax: Axes, synth: Synthesis, k: int, count: int, image: np.ndarray | None = None,
-                   zones: Zones | None = None) -> Axes:
-    """The zones of freedom of FormGrasp grasp ``k`` after its first ``count`` contacts (figure 5)."""
+                   zones: Zones | None = None, labels: bool = False) -> Axes:
+    """The zones of freedom of FormGrasp grasp ``k`` after its first ``count`` contacts (figure 5).
+
+    ``zones`` saves recomputing them; ``labels`` names every zone in place (:func:`plot_zones`).
+    """
     grasp = synth.found[k]
     bounds = _view(synth, 0.35)
     _frame(ax, synth.outline, image)
     _set_view(ax, bounds)
     _regions(ax, synth)
     z = zones if zones is not None else zone_steps(grasp, synth.center, synth.length)[count - 1]
-    plot_zones(ax, z, bounds, synth.outline.size)
+    plot_zones(ax, z, bounds, synth.outline.size, labels)
     _chords(ax, grasp, synth, count)
     plot_contacts(ax, grasp.points[:count], grasp.normals[:count], synth.outline.size)
     state = "Z empty: form closure" if z.status == "closure" else f"depth {z.depth:+.3f}"
@@ -150,8 +168,12 @@ def plot_form_step(ax: Axes, synth: Synthesis, k: int, count: int, image: np.nda
     return ax
 
 
-def plot_grasp(ax: Axes, synth: Synthesis, k: int, image: np.ndarray | None = None) -> Axes:
-    """One synthesised grasp: contacts, normals and, for ForceGrasp, cones, grasp line, friction zone."""
+def plot_grasp(ax: Axes, synth: Synthesis, k: int, image: np.ndarray | None = None, inset: bool = True) -> Axes:
+    """One synthesised grasp: contacts, normals and, for ForceGrasp, cones, grasp line, friction zone.
+
+    ``inset``: for three fingers, also draw the normals from one point in an inset (figure 8);
+    off when the figure shows them in a panel of their own.
+    """
     grasp = synth.found[k]
     size = synth.outline.size
     _frame(ax, synth.outline, image)
@@ -167,7 +189,7 @@ def plot_grasp(ax: Axes, synth: Synthesis, k: int, image: np.ndarray | None = No
                 far = np.linalg.norm(corners[None] - grasp.points[:, None], axis=2).max(axis=1)
                 reach = np.minimum(2 * size, 1.1 * far / math.cos(grasp.theta_min))
         for p, n, r in zip(grasp.points, grasp.normals, reach):
-            _draw_geometry(ax, friction_cone(p, n, grasp.theta_min, r), CONE, zorder=3)
+            _draw_cone(ax, p, n, grasp.theta_min, r)
         if len(grasp.points) == 2:
             a, b = grasp.points
             ax.plot([a[0], b[0]], [a[1], b[1]], color="tab:red", lw=1.5, zorder=5)
@@ -176,12 +198,20 @@ def plot_grasp(ax: Axes, synth: Synthesis, k: int, image: np.ndarray | None = No
             for p in grasp.points:
                 ax.plot([p[0], grasp.point[0]], [p[1], grasp.point[1]], color="darkgreen", lw=1, zorder=5)
             ax.plot(*grasp.point, "*", color="darkgreen", ms=12, mec="white", zorder=6)
-            _normals_inset(ax, grasp.normals)
+            if inset:
+                _normals_inset(ax, grasp.normals)
     else:
         _chords(ax, grasp, synth, len(grasp.points))
     plot_contacts(ax, grasp.points, grasp.normals, size)
     ax.set_title(_caption(synth, k), fontsize=9)
     return ax
+
+
+def _draw_cone(ax: Axes, point: np.ndarray, normal: np.ndarray, theta_min: float, reach: float) -> None:
+    """A friction cone: shaded, with its two edges drawn and no far side (the cone is unbounded)."""
+    xy = np.asarray(friction_cone(point, normal, theta_min, reach).exterior.coords)[:3]
+    ax.add_patch(PolygonPatch(xy, closed=True, facecolor=CONE["facecolor"], alpha=CONE["alpha"], lw=0, zorder=3))
+    ax.plot(xy[[1, 0, 2], 0], xy[[1, 0, 2], 1], color=CONE["edgecolor"], lw=CONE["lw"], zorder=3)
 
 
 def _normals_inset(ax: Axes, normals: np.ndarray) -> None:

@@ -40,7 +40,8 @@ from shapely.geometry import Polygon
 
 from .errors import QualitativeError
 
-__all__ = ["NAMES", "RADIUS", "BACKGROUND", "FOREGROUND", "shape", "render"]
+__all__ = ["NAMES", "RADIUS", "BACKGROUND", "FOREGROUND", "shape", "render", "render_polygon",
+           "normalise", "place"]
 
 NAMES = ("polygon", "nut", "disc", "figure3", "square")
 RADIUS = 0.21
@@ -86,12 +87,45 @@ def _template(name: str) -> Polygon:
         raw = Polygon([(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)])
     else:
         raise QualitativeError(f"unknown object {name!r}; built-in objects: {', '.join(NAMES)}")
+    return normalise(raw)
+
+
+def normalise(raw: Polygon) -> Polygon:
+    """A polygon scaled and shifted to a unit minimum bounding circle centred at the origin.
+
+    Parameters
+    ----------
+    raw : shapely.geometry.Polygon
+        Any valid polygon, any unit, any orientation.
+
+    Returns
+    -------
+    shapely.geometry.Polygon
+        Exterior oriented so that the shoelace area on (x, y) is positive, holes kept. This is the
+        template that :func:`place` puts into an image.
+    """
     circle = shapely.minimum_bounding_circle(raw.exterior)
     center = np.array(circle.centroid.coords[0])
     radius = shapely.minimum_bounding_radius(raw.exterior)
     poly = shapely.affinity.affine_transform(
         raw, [1 / radius, 0, 0, 1 / radius, -center[0] / radius, -center[1] / radius])
     return shapely.geometry.polygon.orient(poly, sign=1.0)
+
+
+def place(template: Polygon, size: int = 512, rotation: float = 0.0, scale: float = 1.0,
+          offset: tuple[float, float] = (0.0, 0.0)) -> Polygon:
+    """A template (unit bounding circle at the origin, :func:`normalise`) in pixel coordinates.
+
+    Parameters are those of :func:`shape`: rotation in degrees about the template's origin (the
+    centre of its bounding circle) turning +x towards +y, bounding-circle radius
+    ``RADIUS * size * scale`` pixels, centre at the image centre plus ``offset`` pixels.
+    """
+    angle = np.radians(rotation)
+    k = RADIUS * size * scale
+    c, s = k * np.cos(angle), k * np.sin(angle)
+    center = (size - 1) / 2.0
+    return shapely.affinity.affine_transform(
+        template, [c, -s, s, c, center + offset[0], center + offset[1]])
 
 
 def shape(name: str, size: int = 512, rotation: float = 0.0, scale: float = 1.0,
@@ -117,25 +151,45 @@ def shape(name: str, size: int = 512, rotation: float = 0.0, scale: float = 1.0,
         Exterior oriented so that the shoelace area on (x, y) is positive (the project's
         orientation); the nut has one interior ring (its hole).
     """
-    angle = np.radians(rotation)
-    k = RADIUS * size * scale
-    c, s = k * np.cos(angle), k * np.sin(angle)
-    center = (size - 1) / 2.0
-    return shapely.affinity.affine_transform(
-        _template(name), [c, -s, s, c, center + offset[0], center + offset[1]])
+    return place(_template(name), size, rotation, scale, offset)
 
 
 def render(name: str, size: int = 512, rotation: float = 0.0, scale: float = 1.0,
            offset: tuple[float, float] = (0.0, 0.0), noise: float = 0.0, seed: int = 0) -> np.ndarray:
     """A synthetic camera image of a built-in object: dark object on a light, plain background.
 
-    Anti-aliased by supersampling (``8 x 8`` samples per pixel, area-averaged), so the grey level
-    of an edge pixel is proportional to the fraction of it the object covers.
+    The object's exact geometry (:func:`shape`) drawn by :func:`render_polygon`.
 
     Parameters
     ----------
     name, size, rotation, scale, offset
         As in :func:`shape`.
+    noise, seed
+        As in :func:`render_polygon`.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(size, size)`` ``uint8`` image.
+    """
+    return render_polygon(shape(name, size, rotation, scale, offset), size, noise=noise, seed=seed)
+
+
+def render_polygon(poly: Polygon, size: int = 512, *, noise: float = 0.0, seed: int = 0) -> np.ndarray:
+    """A synthetic camera image of any polygon: dark object on a light, plain background.
+
+    Anti-aliased by supersampling (``8 x 8`` samples per pixel, area-averaged), so the grey level
+    of an edge pixel is proportional to the fraction of it the object covers. Grey levels are
+    :data:`FOREGROUND` on the object and :data:`BACKGROUND` elsewhere.
+
+    Parameters
+    ----------
+    poly : shapely.geometry.Polygon
+        The object in pixel coordinates of the image (x = column, y = row, pixel centres at
+        integer coordinates); its interior rings are drawn as holes. It should lie inside the
+        image with some background around it.
+    size : int
+        Side of the (square) image, pixels.
     noise : float
         Standard deviation of additive Gaussian pixel noise, in grey levels (0 to 255); the
         object/background contrast is ``BACKGROUND - FOREGROUND = 200`` grey levels.
@@ -150,7 +204,6 @@ def render(name: str, size: int = 512, rotation: float = 0.0, scale: float = 1.0
     f = _SUPERSAMPLE
     shift = 8  # fixed-point bits of cv2.fillPoly coordinates
     big = np.full((size * f, size * f), 255, np.uint8)
-    poly = shape(name, size, rotation, scale, offset)
 
     def fill(ring, value):
         # cv2.fillPoly also fills the subsamples the boundary passes through, which dilates the

@@ -15,11 +15,12 @@ from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.path import Path as MplPath
 
 from .outline import NAMES, Outline
 from .regions import Region
 
-__all__ = ["STYLE", "plot_outline", "plot_regions", "outline_figure"]
+__all__ = ["STYLE", "plot_outline", "plot_regions", "outline_figure", "curvature_handles"]
 
 # Colour and marker of each curvature type; point-like types are drawn as markers at the apex.
 STYLE = {
@@ -79,14 +80,45 @@ def plot_outline(ax: Axes, outline: Outline, image: np.ndarray | None = None, la
             ax.plot(seg.points[:, 0], seg.points[:, 1], lw=2.5, zorder=3, solid_capstyle="butt", **style)
             where = seg.points[len(seg.points) // 2]
         if labels:
-            mid = (seg.start + (seg.stop - seg.start) // 2) % n
-            text = where - offset * normals[mid]  # outside the object
+            where, text = _label_spot(outline, seg, normals, offset)
             ax.annotate(seg.symbol, where, text, ha="center", va="center", fontsize=13,
                         fontfamily="monospace", fontweight="bold", color=style["color"], zorder=5,
                         arrowprops={"arrowstyle": "-", "color": style["color"], "lw": 0.6})
     _legend(ax, sorted({seg.symbol for seg in outline.segments}, key="/)(><}{".index))
     ax.set_title(f"outline {outline.string}", fontfamily="monospace")
     return ax
+
+
+def _label_spot(outline: Outline, seg, normals: np.ndarray, offset: float) -> tuple[np.ndarray, np.ndarray]:
+    """Where a segment's symbol goes: ``(anchor on the segment, text position outside the object)``.
+
+    Candidates slide along the middle half of a line-like segment and out along the outward
+    normal (half to twice ``offset``); of those outside the object, the one farthest from the whole
+    contour wins, its clearance capped at ``offset`` so that a label in open space stays near its
+    segment. This keeps symbols
+    off other parts of the outline in narrow gaps (figure 3's slot between the disc and the thorn).
+    """
+    n = len(outline.contour)
+    mid = (seg.start + (seg.stop - seg.start) // 2) % n
+    if seg.is_point:
+        idx = np.array([mid])
+        anchors = np.asarray(seg.position, dtype=float)[None]
+    else:
+        idx = (seg.start + np.linspace(0.25, 0.75, 9) * (seg.stop - seg.start)).astype(int) % n
+        anchors = outline.contour[idx]
+    steps = np.linspace(0.5, 2.0, 7) * offset
+    spots = anchors[:, None] - steps[None, :, None] * normals[idx][:, None]  # (anchors, steps, 2)
+    clear = np.linalg.norm(spots[:, :, None] - outline.contour[None, None], axis=3).min(axis=2)
+    # prefer clearance, then staying near the segment's middle and the nominal offset
+    cost = (np.abs(np.arange(len(idx)) - len(idx) // 2)[:, None] / max(len(idx), 1)
+            + np.abs(steps - offset)[None] / offset)
+    score = np.minimum(clear, offset) - 0.05 * offset * cost
+    inside = MplPath(outline.contour).contains_points(spots.reshape(-1, 2)).reshape(score.shape)
+    score[inside] = -np.inf  # a label on the object would read as belonging to the wrong segment
+    if not np.isfinite(score).any():
+        return anchors[len(idx) // 2], anchors[len(idx) // 2] - offset * normals[idx[len(idx) // 2]]
+    a, t = np.unravel_index(int(np.argmax(score)), score.shape)
+    return anchors[a], spots[a, t]
 
 
 def plot_regions(ax: Axes, outline: Outline, regions: Sequence[Region], image: np.ndarray | None = None,
@@ -117,8 +149,10 @@ def plot_regions(ax: Axes, outline: Outline, regions: Sequence[Region], image: n
     length = 0.07 * outline.size
     for region in regions:
         style = STYLE[region.type]
-        ax.plot(region.points[:, 0], region.points[:, 1], lw=5, alpha=0.8, zorder=3,
-                solid_capstyle="butt", color=style["color"])
+        line = region.points
+        if region.stop - region.start >= len(outline.contour):  # all round a closed curve: close the ring
+            line = np.vstack([line, line[:1]])
+        ax.plot(line[:, 0], line[:, 1], lw=5, alpha=0.8, zorder=3, solid_capstyle="butt", color=style["color"])
         if normals and len(region.points):
             pick = np.unique(np.linspace(0, len(region.points) - 1, normals).round().astype(int))
             p, v = region.points[pick], region.normals[pick] * length
@@ -130,7 +164,8 @@ def plot_regions(ax: Axes, outline: Outline, regions: Sequence[Region], image: n
     return ax
 
 
-def _legend(ax: Axes, symbols: Sequence[str], region: bool = False) -> None:
+def curvature_handles(symbols: Sequence[str], region: bool = False) -> list[Line2D]:
+    """Legend entries of curvature types, styled as drawn here (``region``: as feasible regions)."""
     handles = []
     for s in symbols:
         style = STYLE[s]
@@ -139,6 +174,11 @@ def _legend(ax: Axes, symbols: Sequence[str], region: bool = False) -> None:
             handles.append(Line2D([], [], ls="none", ms=8, label=label, **style))
         else:
             handles.append(Line2D([], [], lw=5 if region else 2.5, label=label, **style))
+    return handles
+
+
+def _legend(ax: Axes, symbols: Sequence[str], region: bool = False) -> None:
+    handles = curvature_handles(symbols, region)
     if handles:
         ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncols=2,
                   prop={"family": "monospace", "size": 8}, frameon=False)

@@ -114,8 +114,3 @@ def test_missing_file_is_a_clear_error(tmp_path):
     assert result.exit_code == 2
     assert "cannot read" in result.output
 
-
-def test_demo_runs(tmp_path):
-    result = runner.invoke(app, ["demo", "--out", str(tmp_path / "demo")])
-    assert result.exit_code == 0, result.output
-    assert (tmp_path / "demo" / "textbook-results.jsonl").exists()

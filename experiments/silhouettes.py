@@ -1,0 +1,273 @@
+"""Real object silhouettes for the comparison study: cell outlines and scikit-image's horse.
+
+Sources and licences
+--------------------
+* **Cells.** Outlines of mouse osteosarcoma cells (two cell lines, ``dlm8`` and ``dunn``, each
+  under three treatments, ``control``, ``cytd`` and ``jasp``; 650 outlines) shipped with
+  geomstats (MIT licence, copyright Nina Miolane) as
+  ``geomstats/datasets/data/cells/cells.txt`` with ``cell_lines.txt`` and ``treatments.txt``.
+  The files are located with :func:`importlib.util.find_spec` without importing geomstats
+  (which is slow to import) and parsed here: outlines are separated by blank lines, one
+  ``x y`` integer pair per line.
+* **Horse.** scikit-image's ``skimage.data.horse()`` (bundled with scikit-image, offline; BSD
+  licence), a binary silhouette; its outline is the mask's outer pixel contour
+  (:func:`cv2.findContours`), resampled and smoothed like the cells' (Gaussian of 1 pixel).
+
+Selection rule (deterministic)
+------------------------------
+1. Parse every cell; drop repeated consecutive points and a repeated closing point.
+2. Keep the **valid** ones: a simple polygon (shapely ``is_valid``: no self-intersection), at least
+   40 vertices, bounding box at least :data:`MIN_EXTENT` pixels in both directions (smaller cells
+   are magnified so much that their pixel staircase dominates).
+3. Smooth (:func:`smooth_outline`): resample by arc length at 1 source pixel, periodic Gaussian of
+   :data:`SMOOTHING` source pixels (removes the digitisation staircase, keeps the shape), keep
+   every second point; drop the cell if the smoothed outline is not a simple polygon.
+4. Drop **degenerate** shapes, those with filaments thinner than a finger could touch or a camera
+   resolve: normalised to a unit bounding circle, the outline eroded by :data:`THIN` must stay in
+   one piece and its opening (erosion then dilation by :data:`THIN`) must keep at least 90 % of
+   the area (at the rendered scale, no part thinner than about 7 pixels).
+5. Share the ``n`` cells among the six (cell line, treatment) groups, one at a time round the
+   groups in a fixed order while a group has cells left; within a group, sort by **solidity**
+   (area over convex-hull area, a measure of concavity) and take its share at evenly spaced ranks,
+   from the least to the most solid. The subset therefore spans both cell lines, the three
+   treatments and convex to strongly concave shapes.
+
+Rendering
+---------
+Each outline is normalised to a unit minimum bounding circle (:func:`qualitative.objects.normalise`)
+and drawn like the built-in objects (:func:`qualitative.objects.render_polygon`: anti-aliased,
+dark object ``FOREGROUND`` on a light background ``BACKGROUND``), in a 512 x 512 image, its minimum
+bounding circle of radius ``RADIUS * 512`` (about 108 pixels) centred in the image (the fraction
+used for the built-ins, :data:`qualitative.objects.RADIUS`).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+import shapely
+from scipy import ndimage
+from shapely.geometry import Polygon
+
+from qualitative.objects import normalise, place, render_polygon
+
+__all__ = ["MIN_EXTENT", "THIN", "SMOOTHING", "SIZE", "Silhouette", "cells_path", "read_cells",
+           "smooth_outline", "select_cells", "horse", "silhouettes", "write_silhouettes"]
+
+MIN_EXTENT = 50
+"""Smallest bounding-box side of a kept cell outline, source pixels."""
+
+THIN = 0.03
+"""Half the thinnest part a kept outline may have, fraction of its bounding-circle radius."""
+
+SMOOTHING = 1.5
+"""Standard deviation of the Gaussian smoothing of outlines, source pixels."""
+
+SIZE = 512
+"""Side of the rendered images, pixels."""
+
+_GROUPS = (("dlm8", "control"), ("dlm8", "cytd"), ("dlm8", "jasp"),
+           ("dunn", "control"), ("dunn", "cytd"), ("dunn", "jasp"))
+
+
+@dataclass(frozen=True, eq=False)
+class Silhouette:
+    """A real outline, normalised, ready to be placed in an image.
+
+    Attributes
+    ----------
+    name : str
+        ``cell-NNN-<line>-<treatment>`` (``NNN`` the index in ``cells.txt``) or ``horse``.
+    template : shapely.geometry.Polygon
+        The outline with a unit minimum bounding circle centred at the origin, positively oriented
+        (:func:`qualitative.objects.normalise`); :func:`qualitative.objects.place` puts it into an
+        image.
+    source : str
+        Where it comes from (package and file).
+    solidity : float
+        Area over convex-hull area.
+    """
+
+    name: str
+    template: Polygon
+    source: str
+    solidity: float
+
+    def polygon(self, size: int = SIZE, rotation: float = 0.0,
+                offset: tuple[float, float] = (0.0, 0.0)) -> Polygon:
+        """Exact geometry in pixels of a ``size`` image (see :func:`qualitative.objects.place`)."""
+        return place(self.template, size, rotation, 1.0, offset)
+
+    def image(self, size: int = SIZE, rotation: float = 0.0, offset: tuple[float, float] = (0.0, 0.0),
+              noise: float = 0.0, seed: int = 0) -> np.ndarray:
+        """``(size, size)`` uint8 synthetic camera image (:func:`qualitative.objects.render_polygon`)."""
+        return render_polygon(self.polygon(size, rotation, offset), size, noise=noise, seed=seed)
+
+
+def cells_path() -> Path:
+    """Folder holding geomstats' cell files, found without importing geomstats.
+
+    Raises
+    ------
+    FileNotFoundError
+        geomstats is not installed (``pip install geomstats``) or ships no cell data.
+    """
+    spec = importlib.util.find_spec("geomstats")
+    if spec is None or not spec.submodule_search_locations:
+        raise FileNotFoundError("geomstats is not installed: pip install geomstats (its cell outlines "
+                                "are the real silhouettes of the study)")
+    folder = Path(list(spec.submodule_search_locations)[0]) / "datasets" / "data" / "cells"
+    if not (folder / "cells.txt").is_file():
+        raise FileNotFoundError(f"no cells.txt in {folder}")
+    return folder
+
+
+def _lines(path: Path) -> list[str]:
+    return [line.strip() for line in path.read_text().split("\n") if line.strip()]
+
+
+def read_cells() -> list[tuple[np.ndarray, str, str]]:
+    """Every cell outline with its cell line and treatment.
+
+    Returns
+    -------
+    list of (numpy.ndarray, str, str)
+        ``(m, 2)`` float outline (source pixels, repeated consecutive and closing points removed),
+        cell line, treatment; in file order.
+    """
+    folder = cells_path()
+    blocks = [b for b in (folder / "cells.txt").read_text().split("\n\n") if b.strip()]
+    lines, treatments = _lines(folder / "cell_lines.txt"), _lines(folder / "treatments.txt")
+    out = []
+    for block, line, treatment in zip(blocks, lines, treatments):
+        xy = np.array([[float(v) for v in row.split()] for row in block.strip().split("\n")])
+        keep = np.any(xy != np.roll(xy, -1, axis=0), axis=1)  # drops repeats and the closing point
+        out.append((xy[keep], line, treatment))
+    return out
+
+
+def smooth_outline(xy: np.ndarray, sigma: float = SMOOTHING) -> np.ndarray:
+    """Resample a closed outline at unit arc length and smooth it with a periodic Gaussian.
+
+    Parameters
+    ----------
+    xy : numpy.ndarray
+        ``(m, 2)`` closed outline, closing point not repeated, source pixels.
+    sigma : float
+        Standard deviation of the Gaussian, source pixels.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(k, 2)`` smoothed outline, one point every 2 source pixels.
+    """
+    closed = np.vstack([xy, xy[:1]])
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(closed, axis=0), axis=1))])
+    t = np.arange(0.0, s[-1], 1.0)
+    points = np.column_stack([np.interp(t, s, closed[:, 0]), np.interp(t, s, closed[:, 1])])
+    return ndimage.gaussian_filter1d(points, sigma, axis=0, mode="wrap")[::2]
+
+
+def _solidity(poly: Polygon) -> float:
+    return float(poly.area / poly.convex_hull.area)
+
+
+def _valid_cells() -> dict[tuple[str, str], list[tuple[int, Polygon]]]:
+    """Kept cells (rule steps 1 to 3) per (cell line, treatment), as smoothed polygons."""
+    groups: dict[tuple[str, str], list[tuple[int, Polygon]]] = {g: [] for g in _GROUPS}
+    for index, (xy, line, treatment) in enumerate(read_cells()):
+        extent = np.ptp(xy, axis=0) if len(xy) else np.zeros(2)
+        if len(xy) < 40 or extent.min() < MIN_EXTENT or not Polygon(xy).is_valid:
+            continue
+        poly = Polygon(smooth_outline(xy))
+        if poly.is_valid and (line, treatment) in groups and not _thin(normalise(poly)):
+            groups[(line, treatment)].append((index, poly))
+    return groups
+
+
+def _thin(template: Polygon) -> bool:
+    """True when a unit template has parts thinner than ``2 * THIN`` (rule step 4)."""
+    eroded = template.buffer(-THIN)
+    pieces = len(getattr(eroded, "geoms", [eroded]))
+    return pieces != 1 or eroded.buffer(THIN).area < 0.9 * template.area
+
+
+def select_cells(n: int = 24) -> list[Silhouette]:
+    """A deterministic, varied subset of ``n`` cell outlines (module notes, selection rule).
+
+    Raises
+    ------
+    ValueError
+        Fewer than ``n`` cells pass the rule.
+    """
+    groups = _valid_cells()
+    total = sum(len(v) for v in groups.values())
+    if total < n:
+        raise ValueError(f"only {total} cells pass the selection rule, {n} asked for")
+    share = dict.fromkeys(_GROUPS, 0)
+    while sum(share.values()) < n:
+        for g in _GROUPS:
+            if share[g] < len(groups[g]) and sum(share.values()) < n:
+                share[g] += 1
+    chosen = []
+    for g in _GROUPS:
+        ranked = sorted(groups[g], key=lambda item: _solidity(item[1]))
+        picks = np.round(np.linspace(0, len(ranked) - 1, share[g])).astype(int) if share[g] else []
+        for k in picks:
+            index, poly = ranked[k]
+            chosen.append(Silhouette(f"cell-{index:03d}-{g[0]}-{g[1]}", normalise(poly),
+                                     "geomstats/datasets/data/cells/cells.txt (MIT)", _solidity(poly)))
+    return chosen
+
+
+def horse() -> Silhouette:
+    """scikit-image's horse silhouette (bundled, offline), its outline smoothed like the cells'."""
+    from skimage import data
+
+    mask = ~data.horse()  # True on the horse
+    found, _ = cv2.findContours(mask.astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    xy = max(found, key=len)[:, 0, :].astype(np.float64)
+    poly = Polygon(smooth_outline(xy, 1.0))
+    if not poly.is_valid:  # keep the largest simple piece
+        poly = max(getattr(shapely.make_valid(poly), "geoms", []), key=lambda g: g.area)
+    return Silhouette("horse", normalise(poly), "skimage.data.horse (BSD-3-Clause)", _solidity(poly))
+
+
+def silhouettes(n: int = 24, with_horse: bool = True) -> list[Silhouette]:
+    """The study's real silhouettes: ``n`` cells (:func:`select_cells`) and the horse."""
+    return select_cells(n) + ([horse()] if with_horse else [])
+
+
+def write_silhouettes(out_dir: str | Path, n: int = 24, *, with_horse: bool = True,
+                      size: int = SIZE) -> list[Path]:
+    """Render the silhouettes as PNG images (``<name>.png``) into ``out_dir``.
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        Folder, created if needed.
+    n : int
+        Number of cells.
+    with_horse : bool
+        Also write ``horse.png``.
+    size : int
+        Image side, pixels.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written, cells first.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for item in silhouettes(n, with_horse):
+        path = out / f"{item.name}.png"
+        if not cv2.imwrite(str(path), item.image(size)):
+            raise OSError(f"cannot write {path}")
+        paths.append(path)
+    return paths

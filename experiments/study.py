@@ -1,0 +1,626 @@
+"""Qualitative versus quantitative grasps: quality, time and robustness to vision errors.
+
+:func:`compare` runs both routes on every object image and writes tables and plots.
+
+Routes
+------
+* qualitative: :func:`qualitative.synthesis.synthesize`, FormGrasp with 4 frictionless fingers and
+  ForceGrasp with 2 and 3 point contacts at ``mu`` (0.5);
+* baseline: :func:`experiments.baseline.baseline` for the same finger counts and contact models,
+  the grasps of largest certified L1 epsilon on a densely sampled boundary (its docstring states
+  the search and its budget).
+
+Both see the same contour and use the same torque scaling (object centroid and radius), so their
+L1 epsilons are comparable. A grasp is **certified** when force closure is certified (and its
+certificates re-verify) by :mod:`certify`; uncertified grasps have epsilon 0. ``seconds`` is image
+to certified grasps (vision, search, certification) for both routes.
+
+Robustness model
+----------------
+The **true object** is the boundary perceived in the unperturbed image
+(:func:`experiments.baseline.boundary`: contour and smoothed inward normals; on the built-in and
+silhouette images it lies within a few hundredths of a pixel of the exact shape, with corners
+rounded at the outline's smoothing scale, 0.4 % of the perimeter). Each perturbation changes the
+image the routes plan on; the plans are then executed on the true object:
+
+* ``rotation`` (degrees) and ``translation`` (pixels): a **pose error**. The image shows the object
+  rotated about its true centroid by the size (+x towards +y, clockwise as displayed, in even
+  trials; the other way in odd ones) or shifted by the size (random direction; the image is
+  warped with bilinear interpolation), while the object really stays at its true pose. Plans
+  made in image coordinates are executed unchanged in the world frame (= the unperturbed image's
+  frame): the pose error is the perturbation itself.
+* ``noise`` (grey levels, standard deviation of additive Gaussian noise; contrast 200),
+  ``blur`` (pixels, standard deviation of a Gaussian defocus) and ``threshold`` (grey levels
+  added to the unperturbed image's Otsu threshold, signed: positive grows a dark object): a
+  **shape error** with no pose error; plans are executed unchanged.
+* ``none`` (size 0): the unperturbed image itself (one trial per object).
+
+``blur`` and ``threshold`` are deterministic: they get one trial whatever ``Settings.trials``.
+
+**Execution** of a planned contact ``(p, n)``: the finger is pre-positioned at the standoff
+``p - d n`` and moves along the planned inward normal ``n``; the contact is the first point where
+it meets the true boundary, with the true inward normal there (normals of the true contour
+interpolated along the edge hit). The planner chooses ``d`` on the object it perceived:
+``standoff * size`` beyond the perceived surface along ``-n`` (``size`` the object's diameter;
+``standoff`` 0.1 by default; a planned point may lie a little inside the perceived contour, e.g.
+the qualitative route's points on a fitted straight line), or half-way to the next part of the
+perceived object if that is closer (a contact in a pocket), so the pre-position is
+collision-free on the perceived object. A finger that starts inside the true
+object (``collision``) or never meets it (``miss``) fails the grasp.
+Contact models, ``mu``, and the torque frame (true centroid and radius) are kept. The executed
+grasp **holds** when it certifies. Robustness = held / planned, over the planned grasps that
+certified on the perturbed image (the grasps the planner would use), pooled over objects and
+trials.
+
+Outputs (in ``out``)
+--------------------
+``objects.csv``/``.md`` (:data:`OBJECT_COLUMNS`), ``overall.csv``/``.md``
+(:data:`OVERALL_COLUMNS`), ``robustness.csv``/``.md`` (:data:`ROBUSTNESS_COLUMNS`, aggregated) and
+``robustness-trials.csv`` (one row per route and trial), ``grasps.csv`` (:data:`GRASP_COLUMNS`,
+one row per nominal grasp) and the plots of :mod:`experiments.study_plots` (PNG and PDF).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import zlib
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Iterable, Mapping, Sequence
+
+import cv2
+import numpy as np
+
+from certify import Contact, Grasp
+from qualitative.errors import QualitativeError
+from qualitative.objects import NAMES, render
+from qualitative.synthesis import synthesize
+from qualitative.vision import read_image, segment
+
+from .baseline import MU, Boundary, Budget, baseline, boundary, screen_grasps
+from .silhouettes import Silhouette
+
+__all__ = ["BUILTINS", "KINDS", "UNITS", "ROUTES", "QUICK", "FULL", "SETTINGS", "OBJECT_COLUMNS",
+           "OVERALL_COLUMNS", "ROBUSTNESS_COLUMNS", "GRASP_COLUMNS", "Settings", "Subject",
+           "RouteSummary", "StudyResult", "subjects", "perturb", "execute", "evaluate_object",
+           "robustness_trial", "warm_up", "workload", "compare"]
+
+KINDS = ("rotation", "translation", "noise", "blur", "threshold")
+UNITS = {"none": "", "rotation": "deg", "translation": "px", "noise": "grey sd", "blur": "px sd",
+         "threshold": "grey levels"}
+BUILTINS = ("polygon", "nut", "disc", "figure3")
+ROUTES = (("ForceGrasp", 2), ("ForceGrasp", 3), ("FormGrasp", 4),
+          ("Baseline", 2), ("Baseline", 3), ("Baseline", 4))
+
+OBJECT_COLUMNS = ("object", "route", "method", "fingers", "mu", "grasps", "certified",
+                  "certified_fraction", "eps_median", "eps_best", "ratio_best", "ratio_median",
+                  "seconds", "candidates", "error")
+"""Per object and route: grasps returned, certified, certified fraction, median and best certified
+L1 epsilon (uncertified grasps count 0), the qualitative best and median over the baseline's best
+with the same fingers (empty for the baseline), seconds (image to certified grasps), candidates
+screened (baseline), error message (route failed on the image)."""
+
+OVERALL_COLUMNS = ("route", "method", "fingers", "objects", "objects_with_grasps", "grasps",
+                   "certified_fraction", "eps_median", "eps_best", "ratio_best", "ratio_median",
+                   "seconds_median", "seconds_total", "robustness", "robustness_paired")
+"""Per route over all objects: objects, objects where the route found a certified grasp, grasps,
+certified fraction (pooled), medians over objects of the per-object median and best epsilon and
+of the ratios (objects where both routes found grasps), median and total seconds, robustness
+pooled over every perturbation (not ``none``), and the same over the trials where both methods
+planned a certified grasp with the route's finger count (``paired``: the qualitative route finds
+no grasp on some objects, where the baseline's grasps may be the most fragile)."""
+
+ROBUSTNESS_COLUMNS = ("route", "method", "fingers", "kind", "size", "unit", "trials", "planned",
+                      "held", "fraction", "misses", "collisions", "eps_planned", "eps_executed")
+"""Per route, perturbation kind and size: trials (object x trial), planned grasps that certified on
+the perturbed image, how many hold on the true object, their fraction, fingers that missed or
+collided, median epsilon of the planned and of the executed grasps (0 for those that fail)."""
+
+GRASP_COLUMNS = ("object", "route", "method", "fingers", "certified", "eps")
+
+_DETERMINISTIC = ("blur", "threshold")
+_ON = 1e-3  # a point this close to a contour (pixels) is on it
+_VERTEX = 1e-9  # rounding allowed at the ends of an edge (fraction of the edge)
+
+_FULL_SIZES = (("rotation", (1.0, 2.0, 4.0, 8.0)), ("translation", (1.0, 2.0, 4.0, 8.0)),
+               ("noise", (10.0, 20.0, 40.0, 60.0)), ("blur", (1.0, 2.0, 4.0, 8.0)),
+               ("threshold", (-60.0, -30.0, 30.0, 60.0)))
+_QUICK_SIZES = (("rotation", (2.0, 8.0)), ("translation", (2.0, 8.0)), ("noise", (20.0, 60.0)),
+                ("blur", (2.0, 8.0)), ("threshold", (-60.0, 60.0)))
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How much work the study does.
+
+    Attributes
+    ----------
+    budget : Budget
+        Baseline search budget (nominal images and every perturbed image).
+    sizes : tuple of (str, tuple of float)
+        Perturbation sizes per kind (units in :data:`UNITS`).
+    trials : int
+        Random trials per object, kind and size.
+    mu : float
+        Friction coefficient of the 2- and 3-finger routes.
+    standoff : float
+        Finger start distance before the planned contact, fraction of the object's diameter.
+    workers : int
+        Processes (1: run in this process).
+    seed : int
+        Seed of the perturbations.
+    """
+
+    budget: Budget = Budget()
+    sizes: tuple[tuple[str, tuple[float, ...]], ...] = _FULL_SIZES
+    trials: int = 2
+    mu: float = MU
+    standoff: float = 0.1
+    workers: int = 2
+    seed: int = 0
+
+
+QUICK = Settings(budget=Budget(samples=128, extend=32, random=4000, starts=8, rounds=2),
+                 sizes=_QUICK_SIZES, trials=1)
+FULL = Settings()
+SETTINGS = {"quick": QUICK, "full": FULL}
+
+
+@dataclass(frozen=True, eq=False)
+class Subject:
+    """An object of the study: a name and its unperturbed grey image (uint8)."""
+
+    name: str
+    image: np.ndarray
+
+
+@dataclass(frozen=True)
+class RouteSummary:
+    """Headline numbers of one route (see :data:`OVERALL_COLUMNS`); None where undefined."""
+
+    route: str
+    fingers: int
+    grasps: int
+    certified_fraction: float | None
+    eps_median: float | None
+    eps_best: float | None
+    ratio_best: float | None
+    ratio_median: float | None
+    seconds_median: float | None
+    robustness: float | None
+    robustness_paired: float | None
+
+
+@dataclass(frozen=True)
+class StudyResult:
+    """What :func:`compare` found and wrote.
+
+    Attributes
+    ----------
+    objects : tuple of str
+        Object names.
+    routes : tuple of RouteSummary
+        One per route of :data:`ROUTES`.
+    robustness : mapping of (route, kind) to float
+        Robustness pooled over sizes and objects, per route and perturbation kind.
+    seconds : float
+        Wall time of the study, seconds.
+    files : tuple of pathlib.Path
+        Tables and plots written.
+    """
+
+    objects: tuple[str, ...]
+    routes: tuple[RouteSummary, ...]
+    robustness: Mapping[tuple[str, str], float | None]
+    seconds: float
+    files: tuple[Path, ...] = field(default=())
+
+
+# --------------------------------------------------------------------------------------------------
+# Subjects and perturbations
+
+
+def _as_uint8(image: np.ndarray) -> np.ndarray:
+    return np.clip(np.round(image), 0, 255).astype(np.uint8)
+
+
+def subjects(images: Iterable[Any]) -> list[Subject]:
+    """Study subjects from built-in object names, image files, arrays or silhouettes.
+
+    Parameters
+    ----------
+    images : iterable
+        Each a built-in object name (:data:`qualitative.objects.NAMES`, rendered at 512 x 512), an
+        image path (name: the file's stem), a :class:`experiments.silhouettes.Silhouette`, a
+        :class:`Subject`, a ``(name, array)`` pair or an array (named ``image-<k>``).
+
+    Returns
+    -------
+    list of Subject
+        Grey uint8 images (colour converted to luminance, other ranges rounded and clipped).
+    """
+    out = []
+    for k, item in enumerate(images):
+        if isinstance(item, Subject):
+            out.append(item)
+        elif isinstance(item, Silhouette):
+            out.append(Subject(item.name, item.image()))
+        elif isinstance(item, str) and item in NAMES:
+            out.append(Subject(item, render(item)))
+        elif isinstance(item, (str, Path)):
+            out.append(Subject(Path(item).stem, _as_uint8(read_image(item))))
+        elif isinstance(item, tuple):
+            out.append(Subject(str(item[0]), _as_uint8(read_image(item[1]))))
+        else:
+            out.append(Subject(f"image-{k}", _as_uint8(read_image(item))))
+    return out
+
+
+def _pose_matrix(center: np.ndarray, degrees: float, shift: Sequence[float]) -> np.ndarray:
+    """2 x 3 affine map: rotation by ``degrees`` about ``center`` (+x towards +y), then ``shift``."""
+    a = math.radians(degrees)
+    R = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
+    return np.column_stack([R, center - R @ center + np.asarray(shift, dtype=float)])
+
+
+def perturb(image: np.ndarray, kind: str, size: float, rng: np.random.Generator,
+            center: np.ndarray, level: float) -> tuple[np.ndarray, float | None]:
+    """A perturbed image and the segmentation threshold to use on it (module notes).
+
+    Parameters
+    ----------
+    image : numpy.ndarray
+        Unperturbed grey uint8 image.
+    kind : str
+        ``none`` or one of :data:`KINDS`.
+    size : float
+        Perturbation size in the unit of :data:`UNITS`; rotations are signed (positive turns +x
+        towards +y: clockwise as displayed, y pointing down).
+    rng : numpy.random.Generator
+        Source of the random direction or noise.
+    center : numpy.ndarray
+        True centroid of the object (centre of rotations), pixels.
+    level : float
+        Unperturbed segmentation threshold (grey level).
+
+    Returns
+    -------
+    image : numpy.ndarray
+        Perturbed uint8 image.
+    threshold : float or None
+        Threshold for ``threshold`` perturbations, else None (Otsu's on the perturbed image).
+    """
+    if kind == "none" or size == 0:
+        return image, None
+    if kind in ("rotation", "translation"):
+        if kind == "rotation":
+            matrix = _pose_matrix(center, size, (0.0, 0.0))
+        else:
+            phi = rng.uniform(0.0, 2 * math.pi)
+            matrix = _pose_matrix(center, 0.0, (size * math.cos(phi), size * math.sin(phi)))
+        rows, cols = image.shape
+        return cv2.warpAffine(image, matrix, (cols, rows), flags=cv2.INTER_LINEAR,
+                              borderMode=cv2.BORDER_REPLICATE), None
+    if kind == "noise":
+        return _as_uint8(image + rng.normal(0.0, size, image.shape)), None
+    if kind == "blur":
+        return _as_uint8(cv2.GaussianBlur(image.astype(np.float64), (0, 0), size,
+                                          borderType=cv2.BORDER_REFLECT)), None
+    if kind == "threshold":
+        return image, level + size
+    raise ValueError(f"unknown perturbation {kind!r}; use none or one of {', '.join(KINDS)}")
+
+
+# --------------------------------------------------------------------------------------------------
+# Execution on the true object
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _hits(start: np.ndarray, direction: np.ndarray, points: np.ndarray):
+    """Crossings of the ray ``start + t direction`` (t > 0) with the closed polyline ``points``:
+    ``(t, edge index, parameter u in [0, 1])`` arrays, by increasing ``t``. Edges are closed (to
+    within rounding), so a ray through a vertex meets both of its edges."""
+    e = np.roll(points, -1, axis=0) - points
+    w = points - start
+    den = _cross(direction, e)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = _cross(w, e) / den
+        u = _cross(w, direction) / den
+    ok = (den != 0) & (t > 0) & (u >= -_VERTEX) & (u <= 1 + _VERTEX)
+    k = np.flatnonzero(ok)
+    order = np.argsort(t[k])
+    return t[k][order], k[order], np.clip(u[k][order], 0.0, 1.0)
+
+
+def _depth(contour: np.ndarray, point: np.ndarray) -> float:
+    """Signed distance from ``point`` to the closed polyline ``contour``, positive inside, pixels."""
+    polygon = contour.astype(np.float32).reshape(-1, 1, 2)
+    return cv2.pointPolygonTest(polygon, (float(point[0]), float(point[1])), True)
+
+
+def _free(p: np.ndarray, n: np.ndarray, perceived: np.ndarray | None, reach: float) -> float:
+    """Pre-position distance along ``-n`` from ``p``: ``reach`` beyond the perceived surface, or
+    half-way to the next part of the perceived object if that is closer (a pocket)."""
+    if perceived is None:
+        return reach
+    t, _, _ = _hits(p, -n, perceived)
+    exit_ = 0.0
+    if _depth(perceived, p) > _ON and len(t):  # p lies a little inside: leave the object first
+        exit_, t = t[0], t[1:]
+    t = t[t > exit_ + _ON]
+    nxt = t[0] if len(t) else np.inf
+    return float(min(exit_ + reach, 0.5 * (exit_ + nxt)))
+
+
+def execute(grasp: Grasp, truth: Boundary, standoff: float = 0.1,
+            perceived: np.ndarray | None = None) -> tuple[Grasp | None, str]:
+    """Execute a planned planar grasp on the true object (module notes, robustness model).
+
+    Parameters
+    ----------
+    grasp : certify.Grasp
+        Planned grasp, pixels of the world (unperturbed image) frame, inward normals.
+    truth : Boundary
+        The true object.
+    standoff : float
+        Largest finger pre-position distance before the planned contact, fraction of
+        ``truth.size``.
+    perceived : numpy.ndarray, optional
+        ``(n, 2)`` contour the grasp was planned on: pre-positions are kept collision-free on it.
+
+    Returns
+    -------
+    grasp : certify.Grasp or None
+        The executed grasp (true contacts and normals, the truth's ``center`` and ``length``), or
+        None when a finger fails.
+    outcome : str
+        ``contact``, ``miss`` (a finger never meets the object) or ``collision`` (a finger starts
+        inside it).
+    """
+    contacts = []
+    points, normals = truth.points, truth.normals
+    for c in grasp.contacts:
+        n, p = np.asarray(c.n, dtype=float), np.asarray(c.p, dtype=float)
+        start = p - _free(p, n, perceived, standoff * truth.size) * n
+        if _depth(points, start) >= 0:
+            return None, "collision"  # the finger starts inside (or on) the true object
+        t, k, u = _hits(start, n, points)
+        if len(t) == 0:
+            return None, "miss"
+        p = start + t[0] * n
+        k1 = (k[0] + 1) % len(points)
+        normal = (1 - u[0]) * normals[k[0]] + u[0] * normals[k1]
+        contacts.append(Contact(tuple(p), tuple(normal / np.linalg.norm(normal)), c.model, c.mu))
+    return Grasp(tuple(contacts), center=tuple(truth.center), length=truth.length, id=grasp.id,
+                 meta=dict(grasp.meta)), "contact"
+
+
+# --------------------------------------------------------------------------------------------------
+# One object, one perturbation
+
+
+def _route(method: str, fingers: int) -> str:
+    return f"{method} {fingers}"
+
+
+def _plan(image: np.ndarray, method: str, fingers: int, settings: Settings, name: str,
+          threshold: float | None, final: bool):
+    """Plan with one route: ``(grasps, certified, eps, seconds, candidates, contour)``.
+
+    ``final``: the nominal evaluation (qualitative grasps certified one by one with reports, as
+    ``synthesize`` does); otherwise certified columnar (:func:`screen_grasps`)."""
+    mu = None if fingers == 4 else settings.mu
+    start = time.perf_counter()
+    if method == "Baseline":
+        found = baseline(image, fingers, settings.mu, settings.budget, name=name, threshold=threshold)
+        return (found.grasps, np.array(found.certified, dtype=bool), np.array(found.epsilons),
+                found.seconds, found.candidates, found.boundary.points)
+    s = synthesize(image, fingers, mu, name=name, certify=final, quality=final, threshold=threshold,
+                   largest=True)
+    if final:
+        ok = np.array(s.certified, dtype=bool)
+        eps = np.array([r.epsilons["L1"].hi if c else 0.0 for r, c in zip(s.reports, ok)])
+    else:
+        ok, eps = screen_grasps(s.grasps)
+    return s.grasps, ok, eps, time.perf_counter() - start, None, s.outline.contour
+
+
+def _stats(eps: np.ndarray) -> tuple[float | None, float | None]:
+    return (float(np.median(eps)), float(np.max(eps))) if len(eps) else (None, None)
+
+
+def evaluate_object(subject: Subject, settings: Settings = QUICK) -> tuple[list[dict], list[dict]]:
+    """Both routes on one unperturbed image: per-route rows (:data:`OBJECT_COLUMNS`, ratios still
+    empty) and per-grasp rows (:data:`GRASP_COLUMNS`)."""
+    rows, grasp_rows = [], []
+    for method, fingers in ROUTES:
+        row = dict.fromkeys(OBJECT_COLUMNS)
+        row.update(object=subject.name, route=_route(method, fingers), fingers=fingers,
+                   method="baseline" if method == "Baseline" else "qualitative",
+                   mu=None if fingers == 4 else settings.mu)
+        try:
+            grasps, ok, eps, seconds, candidates, _ = _plan(subject.image, method, fingers, settings,
+                                                            subject.name, None, True)
+        except QualitativeError as err:
+            row.update(grasps=0, certified=0, error=f"{type(err).__name__}: {err}")
+            rows.append(row)
+            continue
+        median, best = _stats(eps)
+        row.update(grasps=len(grasps), certified=int(ok.sum()), eps_median=median, eps_best=best,
+                   certified_fraction=float(ok.mean()) if len(ok) else None, seconds=seconds,
+                   candidates=candidates)
+        rows.append(row)
+        grasp_rows += [{"object": subject.name, "route": row["route"], "method": row["method"],
+                        "fingers": fingers, "certified": bool(c), "eps": float(e)}
+                       for c, e in zip(ok, eps)]
+    return _with_ratios(rows), grasp_rows
+
+
+def _with_ratios(rows: list[dict]) -> list[dict]:
+    """Fill ``ratio_best``/``ratio_median`` of qualitative rows from the baseline's best."""
+    best = {r["fingers"]: r["eps_best"] for r in rows if r["method"] == "baseline"}
+    for r in rows:
+        ref = best.get(r["fingers"])
+        if r["method"] == "qualitative" and ref and r["eps_best"] is not None:
+            r["ratio_best"] = r["eps_best"] / ref
+            r["ratio_median"] = r["eps_median"] / ref
+    return rows
+
+
+def _seed(settings: Settings, name: str, kind: str, size: float, trial: int) -> np.random.Generator:
+    key = zlib.crc32(f"{name}/{kind}/{size!r}/{trial}".encode())
+    return np.random.default_rng([settings.seed, key])
+
+
+def robustness_trial(subject: Subject, truth: Boundary, level: float, kind: str, size: float,
+                     trial: int, settings: Settings = QUICK) -> list[dict]:
+    """Plan with every route on one perturbed image and execute on the true object.
+
+    Returns one row per route: ``object, route, method, fingers, kind, size, trial, planned``
+    (grasps that certified on the perturbed image), ``held``, ``misses``, ``collisions``,
+    ``eps_planned`` and ``eps_executed`` (lists, per planned grasp) and ``error``.
+    """
+    rng = _seed(settings, subject.name, kind, size, trial)
+    signed = -size if kind == "rotation" and trial % 2 else size
+    image, threshold = perturb(subject.image, kind, signed, rng, truth.center, level)
+    rows = []
+    for method, fingers in ROUTES:
+        row = {"object": subject.name, "route": _route(method, fingers), "fingers": fingers,
+               "method": "baseline" if method == "Baseline" else "qualitative", "kind": kind,
+               "size": size, "trial": trial, "planned": 0, "held": 0, "misses": 0, "collisions": 0,
+               "eps_planned": [], "eps_executed": [], "error": None}
+        try:
+            grasps, ok, eps, _, _, seen = _plan(image, method, fingers, settings, subject.name,
+                                                threshold, False)
+        except QualitativeError as err:
+            row["error"] = f"{type(err).__name__}: {err}"
+            rows.append(row)
+            continue
+        runs = [execute(g, truth, settings.standoff, seen) for g, c in zip(grasps, ok) if c]
+        executed, outcomes = tuple(r[0] for r in runs), [r[1] for r in runs]
+        done = [g for g in executed if g is not None]
+        held, eps_done = screen_grasps(done) if done else (np.zeros(0, bool), np.zeros(0))
+        eps_exec = iter(np.where(held, eps_done, 0.0))
+        row.update(planned=int(ok.sum()), held=int(held.sum()), misses=outcomes.count("miss"),
+                   collisions=outcomes.count("collision"), eps_planned=[float(e) for e in eps[ok]],
+                   eps_executed=[float(next(eps_exec)) if g is not None else 0.0 for g in executed])
+        rows.append(row)
+    return rows
+
+
+# --------------------------------------------------------------------------------------------------
+# The study
+
+
+def _nominal(subject: Subject, settings: Settings):
+    truth = boundary(subject.image)
+    level = segment(subject.image).level
+    return subject.name, evaluate_object(subject, settings), truth, level
+
+
+def _tasks(items: list[Subject], truths: dict, settings: Settings) -> list[tuple]:
+    tasks = []
+    for s in items:
+        truth, level = truths[s.name]
+        tasks.append((s, truth, level, "none", 0.0, 0, settings))
+        for kind, sizes in settings.sizes:
+            trials = 1 if kind in _DETERMINISTIC else settings.trials
+            for size in sizes:
+                tasks += [(s, truth, level, kind, float(size), trial, settings)
+                          for trial in range(trials)]
+    return tasks
+
+
+def warm_up() -> None:
+    """Run every route once on a small image, so that first-call costs (loading the compiled
+    kernels, imports) do not count in the first object's time. Run in each worker process."""
+    image = render("polygon", size=160)
+    small = Settings(budget=Budget(samples=24, extend=4, random=50, starts=2, rounds=1))
+    for method, fingers in ROUTES:
+        grasps = _plan(image, method, fingers, small, "warm-up", None, True)[0]
+        screen_grasps(grasps)
+
+
+def workload(objects: int, settings: str | Settings = "quick") -> int:
+    """Number of progress messages :func:`compare` sends for ``objects`` objects: one per object,
+    then one per robustness trial."""
+    settings = SETTINGS[settings] if isinstance(settings, str) else settings
+    per = 1 + sum(len(sizes) * (1 if kind in _DETERMINISTIC else settings.trials)
+                  for kind, sizes in settings.sizes)
+    return objects * (1 + per)
+
+
+def _run(fn, tasks: list[tuple], workers: int, progress, label: str) -> list:
+    """``fn(*task)`` for every task, in order, in ``workers`` processes; progress per task."""
+    say = progress or (lambda _msg: None)
+    if workers <= 1:
+        out = []
+        for k, task in enumerate(tasks):
+            out.append(fn(*task))
+            say(f"{label} {k + 1}/{len(tasks)}")
+        return out
+    with ProcessPoolExecutor(workers, initializer=warm_up) as pool:
+        futures = [pool.submit(fn, *task) for task in tasks]
+        out = []
+        for k, f in enumerate(futures):
+            out.append(f.result())
+            say(f"{label} {k + 1}/{len(tasks)}")
+    return out
+
+
+def compare(images: Iterable[Any], out: str | Path, *, settings: str | Settings = "quick",
+            progress: Callable[[str], None] | None = None, plots: bool = True) -> StudyResult:
+    """Compare the qualitative routes with the baseline on every image (module notes).
+
+    Parameters
+    ----------
+    images : iterable
+        Objects (see :func:`subjects`): built-in names, image paths, arrays, silhouettes.
+    out : str or pathlib.Path
+        Output folder (created).
+    settings : {'quick', 'full'} or Settings
+        Size of the work (:data:`QUICK`: about a minute on the 4 built-ins with 2 cores).
+    progress : callable, optional
+        Called with a short message after each object and each robustness trial.
+    plots : bool
+        Draw the plots (PNG and PDF).
+
+    Returns
+    -------
+    StudyResult
+    """
+    from .study_tables import overall_rows, robustness_rows, summarise, write_tables
+
+    start = time.perf_counter()
+    settings = SETTINGS[settings] if isinstance(settings, str) else settings
+    items = subjects(images)
+    if not items:
+        raise ValueError("no images to compare")
+    names = [s.name for s in items]
+    if len(set(names)) != len(names):
+        raise ValueError(f"object names must be unique, got {names}")
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    if settings.workers <= 1:
+        warm_up()
+    nominal = _run(_nominal, [(s, settings) for s in items], settings.workers, progress, "objects")
+    object_rows = [r for _, (rows, _), _, _ in nominal for r in rows]
+    grasp_rows = [g for _, (_, grasps), _, _ in nominal for g in grasps]
+    truths = {name: (truth, level) for name, _, truth, level in nominal}
+    trials = _run(robustness_trial, _tasks(items, truths, settings), settings.workers, progress,
+                  "robustness trials")
+    trial_rows = [r for rows in trials for r in rows]
+    robust = robustness_rows(trial_rows, settings)
+    overall = overall_rows(object_rows, grasp_rows, trial_rows)
+    files = write_tables(out, object_rows, overall, robust, trial_rows, grasp_rows)
+    if plots:
+        from .study_plots import plot_all
+
+        files += plot_all(out, object_rows, grasp_rows, robust)
+    routes, by_kind = summarise(overall, trial_rows)
+    return StudyResult(tuple(names), routes, by_kind, time.perf_counter() - start, tuple(files))
