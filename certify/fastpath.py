@@ -325,7 +325,9 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
     # near the boundary the per-grasp rule re-solves with clarabel (tight contacts); settle those
     # verdicts here too, with the float re-check
     tight_rows = {}
-    solver = make_solver("fast")
+    # these rows are exactly those the fast solver hands from the barrier method to clarabel
+    solver = make_solver("clarabel")
+
     def grasp_of(i):
         return Grasp(tuple(Contact(P[i, j], N[i, j], models[j], mu[i, j],
                                    tor[i, j] if models[j] == "soft" else None) for j in range(m)),
