@@ -21,7 +21,7 @@ from .errors import CertifyError, GraspFileError
 from .grasp import grasp_from_dict
 from .report import certify_grasp, error_row, verify_row
 from .solvers import make_solver
-from .table import chunk_values, iter_chunks, table_to_rows, table_values
+from .table import chunk_values, count_grasps, iter_chunks, table_to_rows, table_values
 
 __all__ = ["Summary", "certify_values", "certify_file", "verify_file"]
 
@@ -177,8 +177,6 @@ def verify_file(results_path: str | Path, grasps_path: str | Path,
     finally:
         if pool is not None:
             pool.shutdown()
-    from .table import count_grasps
-
     n_grasps, n_rows = count_grasps(grasps_path), count_grasps(results_path)
     if n_rows != n_grasps:
         summary.failures.append((None, f"{n_rows} results rows for {n_grasps} grasps"))

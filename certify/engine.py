@@ -109,29 +109,24 @@ def _finish(results, part: Path) -> tuple[dict[str, int], int]:
     """Write a chunk's results to ``part`` atomically; its status counts and unverified count."""
     _write_part(results, part)
     if isinstance(results, pa.Table):
-        statuses = results.column("status").to_pylist()
-        verified = results.column("verified").to_pylist()
-    else:
-        statuses = [r["status"] for r in results]
-        verified = [r["verified"] for r in results]
+        return _counts(results.column("status").to_pylist(), results.column("verified").to_pylist())
+    return _counts([r["status"] for r in results], [r["verified"] for r in results])
+
+
+def _counts(statuses: list, verified: list) -> tuple[dict[str, int], int]:
+    """Rows per status, and rows (not errors) whose certificates were not verified."""
     counts: dict[str, int] = {}
     for status in statuses:
         counts[status] = counts.get(status, 0) + 1
-    unverified = sum(1 for s, v in zip(statuses, verified) if s != "error" and not v)
-    return counts, unverified
+    return counts, sum(1 for s, v in zip(statuses, verified) if s != "error" and not v)
 
 
 def _part_counts(part: Path) -> tuple[dict[str, int], int]:
     if is_parquet(part):
         t = pq.read_table(part, columns=["status", "verified"]).to_pydict()
-        statuses, verified = t["status"], t["verified"]
-    else:
-        rows = [json.loads(line) for line in part.read_text(encoding="utf-8").splitlines()]
-        statuses, verified = [r["status"] for r in rows], [r["verified"] for r in rows]
-    counts: dict[str, int] = {}
-    for s in statuses:
-        counts[s] = counts.get(s, 0) + 1
-    return counts, sum(1 for s, v in zip(statuses, verified) if s != "error" and not v)
+        return _counts(t["status"], t["verified"])
+    rows = [json.loads(line) for line in part.read_text(encoding="utf-8").splitlines()]
+    return _counts([r["status"] for r in rows], [r["verified"] for r in rows])
 
 
 def _manifest(grasps: Path, results: Path, chunk_size: int, options: Options) -> dict:

@@ -1033,41 +1033,19 @@ def _residual_bound(C, E, x):
 @njit(cache=True)
 def _correction_bound(C, E, basis, rmax):
     """Bound on ``max |C_B_exact^-1 r|`` for any exact residual ``|r| <= rmax`` (and a proof
-    that ``C_B`` is invertible), from an approximate inverse ``R``: ``norm(I - R C_B) <= alpha
-    < 1`` gives ``norm(C_B^-1) <= norm(R) / (1 - alpha)``. Returns ``inf`` when not proved."""
+    that ``C_B`` is invertible), from :func:`_inverse_norm_bound` on the basis columns and their
+    error bounds. Returns ``inf`` when not proved."""
     d = C.shape[0]
     M = np.empty((d, d))
+    EM = np.empty((d, d))
     for i in range(d):
         for c in range(d):
             M[i, c] = C[i, basis[c]]
-    piv = np.empty(d, dtype=np.int64)
-    LU = M.copy()
-    if _lu(LU, piv) == 0.0:
+            EM[i, c] = E[i, basis[c]]
+    inv = _inverse_norm_bound(M, EM)
+    if not inv < np.inf:
         return np.inf
-    R = np.empty((d, d))
-    col = np.empty(d)
-    for c in range(d):
-        for i in range(d):
-            col[i] = 1.0 if i == c else 0.0
-        _lu_solve(LU, piv, col)
-        for i in range(d):
-            R[i, c] = col[i]
-    alpha, rnorm = 0.0, 0.0
-    for i in range(d):
-        row_z, row_r = 0.0, 0.0
-        for c in range(d):
-            acc, err = 1.0 if i == c else 0.0, 0.0
-            for q in range(d):
-                acc -= R[i, q] * M[q, c]
-                err += abs(R[i, q]) * (E[q, basis[c]] + _gamma(d + 2) * abs(M[q, c]))
-            row_z += abs(acc) + err
-            row_r += abs(R[i, c])
-        alpha = max(alpha, row_z)
-        rnorm = max(rnorm, row_r)
-    alpha *= 1.0 + 4 * d * _U
-    if not alpha < 1.0:
-        return np.inf
-    return rnorm * (1.0 + 4 * d * _U) / (1.0 - alpha) * rmax * (1.0 + 4 * d * _U)
+    return inv * rmax * (1.0 + 4 * d * _U)
 
 
 @njit(cache=True)

@@ -75,6 +75,7 @@ import numpy as np
 
 from certify import Contact, Grasp
 from qualitative.errors import QualitativeError
+from qualitative.formgrasp import ray_edges
 from qualitative.objects import NAMES, render
 from qualitative.synthesis import synthesize
 from qualitative.vision import read_image, segment
@@ -317,20 +318,11 @@ def perturb(image: np.ndarray, kind: str, size: float, rng: np.random.Generator,
 # Execution on the true object
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-
-
 def _hits(start: np.ndarray, direction: np.ndarray, points: np.ndarray):
     """Crossings of the ray ``start + t direction`` (t > 0) with the closed polyline ``points``:
     ``(t, edge index, parameter u in [0, 1])`` arrays, by increasing ``t``. Edges are closed (to
     within rounding), so a ray through a vertex meets both of its edges."""
-    e = np.roll(points, -1, axis=0) - points
-    w = points - start
-    den = _cross(direction, e)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = _cross(w, e) / den
-        u = _cross(w, direction) / den
+    t, u, den = ray_edges(start, direction, points)
     ok = (den != 0) & (t > 0) & (u >= -_VERTEX) & (u <= 1 + _VERTEX)
     k = np.flatnonzero(ok)
     order = np.argsort(t[k])

@@ -24,11 +24,13 @@ from .errors import SynthesisError
 from .outline import Outline
 from .regions import Region
 
-__all__ = ["STEP", "INSET", "PER_REGION", "Candidates", "candidates", "object_frame"]
+__all__ = ["STEP", "INSET", "PER_REGION", "GAP", "Candidates", "candidates", "object_frame", "separated"]
 
 STEP = 0.03
 INSET = 0.02
 PER_REGION = 16
+#: Smallest distance between two fingers, fraction of the object's size.
+GAP = 0.08
 
 
 @dataclass(frozen=True, eq=False)
@@ -146,3 +148,10 @@ def object_frame(contour: np.ndarray) -> tuple[np.ndarray, float]:
         raise SynthesisError("the contour encloses no positive area")
     center = np.array([((x + xn) * cross).sum(), ((y + yn) * cross).sum()]) / (6 * area)
     return center, float(np.linalg.norm(contour - center, axis=1).max())
+
+
+def separated(points, gap: float, size: float) -> np.ndarray:
+    """``(n, n)`` bool: points ``i`` and ``j`` are at least ``gap * size`` apart, so that two
+    fingers can hold both."""
+    P = np.asarray(points, dtype=float)
+    return np.linalg.norm(P[:, None] - P[None], axis=2) >= gap * size

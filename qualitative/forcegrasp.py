@@ -49,14 +49,13 @@ import shapely
 from shapely.geometry import Polygon
 from shapely.geometry.base import BaseGeometry
 
-from .candidates import Candidates
+from .candidates import GAP, Candidates, separated
 from .errors import SynthesisError
 
 __all__ = ["MARGIN", "GAP", "ForceGrasp", "friction", "nguyen_angles", "span_margin",
            "positively_spans", "pair_grasps", "triplet_grasps", "friction_cone", "friction_zone"]
 
 MARGIN = 0.25
-GAP = 0.08
 GRID = 40
 REFINE = 3
 _TIE = 0.01
@@ -147,11 +146,6 @@ def positively_spans(vectors) -> bool:
     return bool(span_margin(vectors) > 0)
 
 
-def _far(cands: Candidates, gap: float, size: float) -> np.ndarray:
-    P = np.asarray(cands.points)
-    return np.linalg.norm(P[:, None] - P[None], axis=2) >= gap * size
-
-
 def _check(theta_min: float, margin: float, gap: float) -> None:
     if not (0 < theta_min < math.pi / 2):
         raise SynthesisError(f"theta_min must lie strictly between 0 and pi/2 radians, got {theta_min}")
@@ -183,7 +177,7 @@ def pair_grasps(cands: Candidates, theta_min: float, size: float, *, margin: flo
     """
     _check(theta_min, margin, gap)
     P, N = np.asarray(cands.points), np.asarray(cands.normals)
-    far = _far(cands, gap, size)
+    far = separated(cands.points, gap, size)
     regions = np.unique(cands.region)
     found = []
     for r1, r2 in itertools.combinations_with_replacement(regions, 2):
@@ -265,7 +259,7 @@ def triplet_grasps(cands: Candidates, contour: np.ndarray, theta_min: float, siz
     X = _grid(np.asarray(contour, dtype=float), size, grid)
     if not len(P) or not len(X):
         return []
-    far = _far(cands, gap, size)
+    far = separated(cands.points, gap, size)
     regions = np.unique(cands.region)
     curved = {int(r): len(np.unique(np.round(N[cands.of_region(r)], 9), axis=0)) > 1 for r in regions}
     found = []

@@ -46,14 +46,16 @@ from functools import cache
 
 import numpy as np
 
-from .candidates import Candidates
-from .errors import SynthesisError
-from .zones import Zones, _cross, free_depth, zones
+from certify.wrench import torque
 
-__all__ = ["ERROR", "FormGrasp", "form_grasps", "closure_depth4", "line_of_action_exit", "zone_steps"]
+from .candidates import GAP, Candidates, separated
+from .errors import SynthesisError
+from .zones import Zones, _cross, free_depth, unit_wrenches, zones
+
+__all__ = ["ERROR", "FormGrasp", "form_grasps", "closure_depth4", "line_of_action_exit", "ray_edges",
+           "zone_steps"]
 
 ERROR = 2.0
-GAP = 0.08
 
 
 @dataclass(frozen=True, eq=False)
@@ -88,6 +90,21 @@ class FormGrasp:
     depths: tuple[float, ...]
 
 
+def ray_edges(start: np.ndarray, direction: np.ndarray, contour: np.ndarray):
+    """Where the line ``start + t * direction`` meets the line of every edge of a closed contour.
+
+    Returns ``(t, s, denom)``, each ``(n,)``: the parameter along the ray, the parameter along
+    edge ``i`` (from ``contour[i]``, 0, to the next point, 1) and the cross product of the
+    direction with the edge (0 for parallel edges, where ``t`` and ``s`` are not finite). Callers
+    keep the crossings they need (``0 <= s <= 1``, ``t > 0``).
+    """
+    e = np.roll(contour, -1, axis=0) - contour
+    w = contour - start
+    denom = torque(direction, e)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return torque(w, e) / denom, torque(w, direction) / denom, denom
+
+
 def line_of_action_exit(point: np.ndarray, direction: np.ndarray, contour: np.ndarray) -> np.ndarray | None:
     """Farthest intersection of the ray ``point + t * direction`` (``t > 0``) with a closed contour.
 
@@ -103,23 +120,12 @@ def line_of_action_exit(point: np.ndarray, direction: np.ndarray, contour: np.nd
     numpy.ndarray or None
         The intersection farthest from ``point`` (ignoring the start's own neighbourhood), or None.
     """
-    a = contour
-    b = np.roll(contour, -1, axis=0)
-    e = b - a
-    w = a - point
-    denom = direction[0] * e[:, 1] - direction[1] * e[:, 0]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = (w[:, 0] * e[:, 1] - w[:, 1] * e[:, 0]) / denom  # along the ray
-        s = (w[:, 0] * direction[1] - w[:, 1] * direction[0]) / denom  # along the edge
+    t, s, denom = ray_edges(point, direction, contour)
     scale = float(np.linalg.norm(contour.max(axis=0) - contour.min(axis=0)))
     hit = (np.abs(denom) > 1e-12) & (s >= 0) & (s < 1) & (t > 1e-6 * scale)
     if not hit.any():
         return None
     return point + t[hit].max() * direction
-
-
-def _pairwise(points: np.ndarray) -> np.ndarray:
-    return np.linalg.norm(points[:, None] - points[None], axis=2)
 
 
 def form_grasps(cands: Candidates, contour: np.ndarray, center: np.ndarray, length: float, size: float, *,
@@ -154,8 +160,8 @@ def form_grasps(cands: Candidates, contour: np.ndarray, center: np.ndarray, leng
     P, N = np.asarray(cands.points), np.asarray(cands.normals)
     if len(P) < 4:
         return []
-    far = _pairwise(P) >= gap * size  # far[i, j]: i and j may both hold a finger
-    a = _constraints(P, N, center, length)
+    far = separated(P, gap, size)
+    a = unit_wrenches(P, N, center, length)
     best_set, best_depth = _best_completions(a, far)
     found: list[FormGrasp] = []
     seen: set[frozenset] = set()
@@ -173,13 +179,6 @@ def form_grasps(cands: Candidates, contour: np.ndarray, center: np.ndarray, leng
                                tuple(int(cands.region[i]) for i in idx), s,
                                line_of_action_exit(P[s], N[s], contour), depths[-1], tuple(depths)))
     return found
-
-
-def _constraints(P: np.ndarray, N: np.ndarray, center: np.ndarray, length: float) -> np.ndarray:
-    """Unit twist constraints ``a_i`` of every candidate (see :mod:`qualitative.zones`)."""
-    u = (P - center) / length
-    a = np.column_stack([N, u[:, 0] * N[:, 1] - u[:, 1] * N[:, 0]])
-    return a / np.linalg.norm(a, axis=1, keepdims=True)
 
 
 def _det(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:

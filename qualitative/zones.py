@@ -76,6 +76,8 @@ import shapely
 from shapely.geometry import MultiPoint
 from shapely.geometry.base import BaseGeometry
 
+from certify.wrench import wrench
+
 from .errors import ZoneError
 
 __all__ = ["TOL", "Zone", "Translations", "Zones", "zones", "grasp_zones", "free_depth",
@@ -296,9 +298,16 @@ def twist_constraints(points, normals, center=None, length=None) -> tuple[np.nda
         length = reach if reach > 0 else 1.0
     elif not (math.isfinite(length) and length > 0):
         raise ZoneError(f"length must be finite and > 0, got {length!r}")
-    u = (p - c) / length
-    a = np.column_stack([n, u[:, 0] * n[:, 1] - u[:, 1] * n[:, 0]])
-    return a / np.linalg.norm(a, axis=1, keepdims=True), c, float(length)
+    return unit_wrenches(p, n, c, length), c, float(length)
+
+
+def unit_wrenches(points, normals, center, length) -> np.ndarray:
+    """The frictionless contacts' wrenches (certify's :func:`certify.wrench.wrench` of the unit
+    inward normals, torques about ``center`` divided by ``length``), each scaled to unit norm:
+    the constraint vectors ``a_i`` of the free twists, ``(..., 3)``."""
+    a = wrench(np.asarray(points, dtype=np.float64), np.asarray(normals, dtype=np.float64),
+               np.asarray(center, dtype=np.float64), length)
+    return a / np.linalg.norm(a, axis=-1, keepdims=True)
 
 
 def centre_of(y: np.ndarray, center: np.ndarray, length: float) -> np.ndarray:
@@ -380,9 +389,7 @@ def free_depth(points, normals, center, length) -> np.ndarray:
     p = np.asarray(points, dtype=np.float64)
     n = np.asarray(normals, dtype=np.float64)
     n = n / np.linalg.norm(n, axis=-1, keepdims=True)
-    u = (p - np.asarray(center, dtype=np.float64)) / length
-    a = np.concatenate([n, (u[..., 0] * n[..., 1] - u[..., 1] * n[..., 0])[..., None]], axis=-1)
-    return _depth(a / np.linalg.norm(a, axis=-1, keepdims=True))
+    return _depth(unit_wrenches(p, n, center, length))
 
 
 # --------------------------------------------------------------------------------------------------
