@@ -4,8 +4,11 @@ The input is read in chunks of a fixed number of grasps (:func:`certify.table.it
 Each chunk is certified by a worker (local processes by default, or a dask.distributed cluster)
 and its results are written to ``RESULTS.parts/part-NNNNNN.EXT`` under a temporary name, renamed
 atomically when complete (local workers write their own parts; dask workers send their results
-back to the client, which writes them, so a remote cluster needs no shared filesystem). When every part exists they are concatenated, in chunk order, into a
-temporary file renamed to ``RESULTS``, and the parts folder is removed.
+back to the client, which writes them, so a remote cluster needs no shared filesystem). Parts of
+a Parquet output are Arrow IPC files (``.arrow``, LZ4): cheap to write and to read back, so the
+Parquet encoding is done once. As parts complete, the main process appends them in chunk order to
+a temporary results file, renamed to ``RESULTS`` when the last one is in; then the parts folder
+is removed.
 
 A run killed at any moment leaves only complete parts (plus temporaries, discarded).
 ``resume=True`` keeps the complete parts and certifies only the missing chunks, so every input
@@ -28,7 +31,8 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from .errors import CertifyError, GraspFileError
-from .table import Chunk, RESULT_SCHEMA, chunk_values, count_grasps, is_parquet, iter_chunks, table_values
+from .table import (RESULT_SCHEMA, RESULT_WRITE_OPTIONS, Chunk, chunk_values, count_grasps, is_parquet,
+                    iter_chunks, table_values)
 
 __all__ = ["Options", "RunSummary", "run", "certify_chunk"]
 
@@ -82,12 +86,27 @@ def certify_chunk_results(chunk: Chunk, options: Options):
     return certify_table(table, chunk.lines, options, slow=slow)
 
 
+_IPC = pa.ipc.IpcWriteOptions(compression="lz4")
+
+
+def _part_name(index: int, results: Path) -> str:
+    """File name of chunk ``index``'s part: Arrow IPC for a Parquet output, else JSON Lines."""
+    return f"part-{index:06d}" + (".arrow" if is_parquet(results) else results.suffix)
+
+
+def _read_part(path: Path) -> pa.Table:
+    with pa.memory_map(str(path)) as source:
+        return pa.ipc.open_file(source).read_all()
+
+
 def _write_part(results, path: Path) -> None:
     from .table import rows_to_table, table_to_rows
 
     tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")  # writers never share a temporary
-    if is_parquet(path):
-        pq.write_table(results if isinstance(results, pa.Table) else rows_to_table(results), tmp)
+    if path.suffix == ".arrow":
+        table = results if isinstance(results, pa.Table) else rows_to_table(results)
+        with pa.ipc.new_file(tmp, RESULT_SCHEMA, options=_IPC) as writer:
+            writer.write_table(table)
     else:
         rows = table_to_rows(results) if isinstance(results, pa.Table) else results
         with tmp.open("w", encoding="utf-8") as fh:
@@ -122,8 +141,8 @@ def _counts(statuses: list, verified: list) -> tuple[dict[str, int], int]:
 
 
 def _part_counts(part: Path) -> tuple[dict[str, int], int]:
-    if is_parquet(part):
-        t = pq.read_table(part, columns=["status", "verified"]).to_pydict()
+    if part.suffix == ".arrow":
+        t = _read_part(part).select(["status", "verified"]).to_pydict()
         return _counts(t["status"], t["verified"])
     rows = [json.loads(line) for line in part.read_text(encoding="utf-8").splitlines()]
     return _counts([r["status"] for r in rows], [r["verified"] for r in rows])
@@ -158,20 +177,41 @@ def _prepare(grasps: Path, results: Path, chunk_size: int, options: Options, res
     return parts
 
 
-def _assemble(parts: Path, n_chunks: int, results: Path) -> None:
-    ext = results.suffix
-    tmp = results.with_name(results.name + ".tmp")
-    if is_parquet(results):
-        with pq.ParquetWriter(tmp, RESULT_SCHEMA) as writer:
-            for i in range(n_chunks):
-                writer.write_table(pq.read_table(parts / f"part-{i:06d}{ext}"))
-    else:
-        with tmp.open("wb") as out:
-            for i in range(n_chunks):
-                with (parts / f"part-{i:06d}{ext}").open("rb") as fh:
-                    shutil.copyfileobj(fh, out)
-    os.replace(tmp, results)
-    shutil.rmtree(parts)
+class _Assembler:
+    """Appends complete parts, in chunk order as they arrive, to the results' temporary file;
+    :meth:`close` renames it to the results and removes the parts (a run killed before that
+    leaves the parts, from which a resumed run assembles again)."""
+
+    def __init__(self, parts: Path, results: Path) -> None:
+        self.parts, self.results = parts, results
+        self.tmp = results.with_name(results.name + ".tmp")
+        self.parquet = is_parquet(results)
+        self.out = (pq.ParquetWriter(self.tmp, RESULT_SCHEMA, **RESULT_WRITE_OPTIONS) if self.parquet
+                    else self.tmp.open("wb"))
+        self.next, self.ready = 0, set()
+
+    def add(self, index: int) -> None:
+        self.ready.add(index)
+        while self.next in self.ready:
+            self.ready.remove(self.next)
+            part = self.parts / _part_name(self.next, self.results)
+            if self.parquet:
+                self.out.write_table(_read_part(part))
+            else:
+                with part.open("rb") as fh:
+                    shutil.copyfileobj(fh, self.out)
+            self.next += 1
+
+    def close(self, n_chunks: int) -> None:
+        self.out.close()
+        if self.next != n_chunks:
+            raise CertifyError(f"internal error: {self.next} of {n_chunks} parts assembled")
+        os.replace(self.tmp, self.results)
+        shutil.rmtree(self.parts)
+
+    def abort(self) -> None:
+        self.out.close()
+        self.tmp.unlink(missing_ok=True)
 
 
 class _LocalPool:
@@ -259,44 +299,47 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
         raise GraspFileError(f"cannot read {grasps}")
     workers = workers or os.cpu_count() or 1
     parts = _prepare(grasps, results, chunk_size, options, resume)
-    ext = results.suffix
     summary = RunSummary()
+    assembler = _Assembler(parts, results)
     pool = _DaskPool(dask, workers) if dask else (_LocalPool(workers) if workers > 1 else None)
-    pending: dict[Any, int] = {}
+    pending: dict[Any, tuple[int, int]] = {}
+
+    def done(index: int, size: int) -> None:
+        assembler.add(index)
+        if progress:
+            progress(size)
 
     def collect(future) -> None:
         summary.add(*pool.result(future))
-        size = pending.pop(future)
-        if progress:
-            progress(size)
+        done(*pending.pop(future))
 
     try:
         n_chunks = 0
         for chunk in iter_chunks(grasps, chunk_size):
             n_chunks += 1
-            part = parts / f"part-{chunk.index:06d}{ext}"
+            part = parts / _part_name(chunk.index, results)
             if part.exists():
                 summary.add(*_part_counts(part))
                 summary.resumed_chunks += 1
-                if progress:
-                    progress(len(chunk))
-                continue
-            if pool is None:
+            elif pool is None:
                 _, counts, unverified = certify_chunk(chunk, options, str(part))
                 summary.add(counts, unverified)
-                if progress:
-                    progress(len(chunk))
+            else:
+                while len(pending) >= pool.capacity:
+                    for future in pool.wait_one(pending):
+                        collect(future)
+                pending[pool.submit(chunk, options, str(part))] = (chunk.index, len(chunk))
                 continue
-            while len(pending) >= pool.capacity:
-                for future in pool.wait_one(pending):
-                    collect(future)
-            pending[pool.submit(chunk, options, str(part))] = len(chunk)
+            done(chunk.index, len(chunk))
         while pending:
             for future in pool.wait_one(pending):
                 collect(future)
+        assembler.close(n_chunks)
+    except BaseException:
+        assembler.abort()
+        raise
     finally:
         if pool is not None:
             pool.close()
     summary.chunks = n_chunks
-    _assemble(parts, n_chunks, results)
     return summary

@@ -57,12 +57,18 @@ def _certificates(code: np.ndarray, lam: np.ndarray, basis: np.ndarray, y: np.nd
     n, k = lam.shape
     nb = k if blocks is None else blocks
     interior = code == 1
-    far = ~interior
-    lists = [np.arange(nb) if c == 3 else (tight or {}).get(r, ()) if c == 4 else () for r, c in enumerate(code)]
-    lengths = np.array([len(t) if f else 0 for t, f in zip(lists, far)], dtype=np.int32)
-    offsets = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int32)
-    flat = np.concatenate([np.asarray(t, dtype=np.int32) for t, f in zip(lists, far) if f] or
-                          [np.zeros(0, np.int32)])
+    lengths = np.where(code == 3, nb, 0).astype(np.int32)
+    extra = {r: np.asarray(v, dtype=np.int32) for r, v in (tight or {}).items() if code[r] == 4}
+    for r, v in extra.items():
+        lengths[r] = len(v)
+    offsets = np.zeros(n + 1, dtype=np.int32)
+    np.cumsum(lengths, out=offsets[1:])
+    flat = np.zeros(int(offsets[-1]), dtype=np.int32)
+    null_rows = np.flatnonzero(code == 3)
+    if len(null_rows):  # every block tight: 0 .. nb-1 at each such row
+        flat[(offsets[null_rows][:, None] + np.arange(nb)).ravel()] = np.tile(np.arange(nb), len(null_rows))
+    for r, v in extra.items():
+        flat[offsets[r]:offsets[r + 1]] = v
     tight_arr = pa.ListArray.from_arrays(pa.array(offsets), pa.array(flat, type=pa.int32()),
                                          mask=pa.array(interior))
     return pa.StructArray.from_arrays([
@@ -70,7 +76,7 @@ def _certificates(code: np.ndarray, lam: np.ndarray, basis: np.ndarray, y: np.nd
         pa.array([layout]).take(pa.array(np.zeros(n, np.int8))),
         _list_array(lam, interior, CERTIFICATE.field("values").type),
         _list_array(basis.astype(np.int32), interior, CERTIFICATE.field("basis").type),
-        _list_array(y, far, CERTIFICATE.field("y").type),
+        _list_array(y, ~interior, CERTIFICATE.field("y").type),
         tight_arr,
         pa.array(lengths == nb, mask=interior),
         pa.nulls(n, pa.string()),
@@ -481,7 +487,8 @@ def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(
     do not settle.
     """
     cols = grasp_columns(table)
-    lines = np.asarray(lines, dtype=np.int64)
+    lines = (np.arange(lines.start, lines.stop, lines.step) if isinstance(lines, range)
+             else np.asarray(lines, dtype=np.int64))
     n = len(lines)
     done = np.zeros(n, dtype=bool)
     pieces, order = [], []
@@ -495,13 +502,16 @@ def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(
             rows = np.flatnonzero((planar | spatial) & (key == k))
             group = _planar_group if planar[rows[0]] else _spatial_group
             settled, out = group(cols, rows, options, tol)
-            if settled.any():
+            if settled.all():
+                sub = dict(out)
+            elif settled.any():
                 sub = {name: (value if name == "force_layout" else _take(value, settled))
                        for name, value in out.items() if name not in ("tight", "form_tight")}
                 new = np.cumsum(settled) - 1  # re-index the per-row tight lists to the settled rows
                 for name in ("tight", "form_tight"):
                     if name in out:
                         sub[name] = {int(new[r]): v for r, v in out[name].items() if settled[r]}
+            if settled.any():
                 pieces.append(_group_table(cols, rows[settled], lines[rows[settled]], sub, options))
                 order.append(rows[settled])
                 done[rows[settled]] = True
@@ -515,9 +525,13 @@ def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(
         return RESULT_SCHEMA.empty_table()
     result = pa.concat_tables(pieces)
     order = np.concatenate(order)
-    if (np.diff(order) > 0).all():  # a single group in input order: nothing to move
-        return result
-    return result.take(pa.array(np.argsort(order, kind="stable")))
+    perm = np.argsort(order, kind="stable")
+    starts = np.concatenate([[0], np.flatnonzero(np.diff(perm) != 1) + 1])
+    if len(starts) > 64:
+        return result.take(pa.array(perm))
+    # few runs (one group and a few rows left to the per-grasp path): zero-copy slices
+    ends = np.append(starts[1:], len(perm))
+    return pa.concat_tables([result.slice(perm[a], b - a) for a, b in zip(starts, ends)])
 
 
 def _take(value, mask):

@@ -16,7 +16,8 @@ import pyarrow.parquet as pq
 
 from .errors import CertifyError, GraspFileError
 from .grasp import Grasp, grasp_from_dict, grasp_to_dict
-from .table import chunk_values, grasps_table, is_parquet, iter_chunks, rows_to_table, table_to_rows
+from .table import (RESULT_WRITE_OPTIONS, chunk_values, grasps_table, is_parquet, iter_chunks,
+                    rows_to_table, table_to_rows)
 
 __all__ = ["read_grasps", "write_grasps", "read_results", "write_rows"]
 
@@ -51,12 +52,12 @@ def read_results(path: str | Path, chunk_size: int = 4096) -> Iterator[dict]:
 
 def write_rows(path: str | Path, rows: Iterable[dict[str, Any]]) -> int:
     """Write results rows; return how many were written."""
-    return _write(path, list(rows), rows_to_table)
+    return _write(path, list(rows), rows_to_table, RESULT_WRITE_OPTIONS)
 
 
-def _write(path: str | Path, rows: list[dict], to_table) -> int:
+def _write(path: str | Path, rows: list[dict], to_table, options: dict | None = None) -> int:
     if is_parquet(path):
-        pq.write_table(to_table(rows), path)
+        pq.write_table(to_table(rows), path, **(options or {}))
     else:
         with Path(path).open("w", encoding="utf-8") as fh:
             for row in rows:

@@ -632,11 +632,14 @@ def null_direction(C):
 
 
 @njit(cache=True)
-def _classify(Wb, Eb, combos, feas, margin, residual_tol, C, D, buf, R, used, lam, y, basis):
+def _classify(Wb, Eb, combos, feas, margin, residual_tol, C, D, buf, R, used, lam, y, basis,
+              rays, first, zeros2, zeros1, no_tight):
     """Verdict of one planar generator matrix, settled only where the per-grasp rules of
     :func:`certify.closure.decide` give it without exact arithmetic and the certificate is proved
     by the float re-check: 1 closure (``lam``, ``basis``), 2 strict Farkas (``y``), 3 null-space
-    Farkas (``y``, fewer than 3 generators), 0 not settled. Returns ``(code, t)``."""
+    Farkas (``y``, fewer than 3 generators), 0 not settled. Returns ``(code, t)``. The block
+    layout of the re-check (every generator a ray: ``rays`` 0, ``first`` 0..k-1, ``zeros2``
+    (k, 2), ``zeros1`` (k,), ``no_tight`` (k,) False) is passed in, not allocated per grasp."""
     k = Wb.shape[1]
     if k < 3:
         yy = null_direction(Wb)
@@ -647,9 +650,8 @@ def _classify(Wb, Eb, combos, feas, margin, residual_tol, C, D, buf, R, used, la
         return 0, t
     if t >= margin:
         _pivot_basis(Wb, R[:, :Wb.shape[1]], basis, used)
-        rays = np.zeros(k, dtype=np.int64)
-        ok = verify_interior_general(Wb, Eb, rays, np.arange(k), np.zeros((k, 2)), np.zeros(k),
-                                     np.zeros(k), lam, basis, residual_tol)
+        ok = verify_interior_general(Wb, Eb, rays[:k], first[:k], zeros2[:k], zeros1[:k],
+                                     zeros1[:k], lam, basis, residual_tol)
         return (1 if ok else 0), t
     if not has_y:
         return 0, t
@@ -665,9 +667,8 @@ def _classify(Wb, Eb, combos, feas, margin, residual_tol, C, D, buf, R, used, la
         a = Wb[0, j] * y[0] + Wb[1, j] * y[1] + Wb[2, j] * y[2]
         if abs(a) <= 1e-7 * scale or not a < -1e-9 * scale:
             return 0, t  # tight contacts or no strict separation: per-grasp path
-    rays = np.zeros(k, dtype=np.int64)
-    ok = verify_farkas_general(Wb, Eb, rays, np.arange(k), np.zeros((k, 2)), np.zeros(k),
-                               np.zeros(k), y, np.zeros(k, dtype=np.bool_), 0.0)
+    ok = verify_farkas_general(Wb, Eb, rays[:k], first[:k], zeros2[:k], zeros1[:k], zeros1[:k], y,
+                               no_tight[:k], 0.0)
     return (2 if ok else 0), t
 
 
@@ -711,10 +712,15 @@ def planar_batch(P, N, mu, c, L, owner, sgn, combos, owner_f, combos_f, form_sam
     R = np.empty((3, kk))
     used = np.empty(kk, dtype=np.bool_)
     zeros = np.zeros(kf, dtype=np.int64)
+    rays = np.zeros(kk, dtype=np.int64)
+    first = np.arange(kk)
+    zeros2 = np.zeros((kk, 2))
+    zeros1 = np.zeros(kk)
+    no_tight = np.zeros(kk, dtype=np.bool_)
     for b in range(B):
         _planar_generators(P[b], N[b], mu[b], c[b], L[b], owner, sgn, W, E)
         code[b], t[b] = _classify(W, E, combos, feas, margin, residual_tol, C, D, buf, R, used,
-                                  lam[b], y[b], basis[b])
+                                  lam[b], y[b], basis[b], rays, first, zeros2, zeros1, no_tight)
         if form_same:
             code_f[b], t_f[b] = code[b], t[b]
             lam_f[b, :] = lam[b, :kf]
@@ -723,7 +729,8 @@ def planar_batch(P, N, mu, c, L, owner, sgn, combos, owner_f, combos_f, form_sam
         else:
             _planar_generators(P[b], N[b], mu[b], c[b], L[b], owner_f, zeros, Wf, Ef)
             code_f[b], t_f[b] = _classify(Wf, Ef, combos_f, feas, margin, residual_tol, C, D, buf,
-                                          R, used, lam_f[b], y_f[b], basis_f[b])
+                                          R, used, lam_f[b], y_f[b], basis_f[b], rays, first,
+                                          zeros2, zeros1, no_tight)
         if quality and code[b] == 1:
             eps[b, 0] = _planar_epsilon_one(W, owner, m, False)[0]
             eps[b, 1] = _planar_epsilon_one(W, owner, m, True)[0]
