@@ -104,15 +104,20 @@ def farkas_certificate(C: np.ndarray, blocks, layout: str, y: np.ndarray,
                        rel: float = 1e-7) -> Certificate | None:
     """A Farkas certificate built from the dual direction ``y``, or None if ``y`` does not give one.
 
-    Blocks on which ``y`` vanishes (relative to ``rel``) are declared tight and ``y`` is projected
-    off their columns; every other block must then be strictly separated (float check with a
-    margin; the exact check is :func:`certify.certificates.verify`).
+    A ``y`` strictly separating every block is a certificate as it is. Otherwise blocks on which
+    ``y`` vanishes (relative to ``rel``) are declared tight and ``y`` is projected off their
+    columns; every other block must then be strictly separated (float check with a margin; the
+    exact check is :func:`certify.certificates.verify`).
     """
     norm = np.sqrt(np.sum(y * y))  # the columnar path normalises with the same operations
     if not (np.isfinite(norm) and norm > 0):
         return None
     y = y / norm
     scale = np.abs(C).max()
+    if polar_values(C, blocks, y).max() < -1e-9 * scale:
+        # strict on every contact: a certificate as it is, even if some products are small (a
+        # nearly singular system, e.g. three frictionless contacts with almost concurrent lines)
+        return Certificate("farkas", layout, y=_floats(y))
     tight = tuple(i for i, b in enumerate(blocks)
                   if np.abs(C[:, list(b.cols)].T @ y).max() <= rel * scale)
     if tight:

@@ -88,3 +88,24 @@ def test_certificate_json_round_trip():
         for v in (force_closure(g), form_closure(g)):
             c = Certificate.from_json(v.certificate.to_json())
             assert c == v.certificate
+
+
+def test_strict_separation_with_small_products_is_a_certificate():
+    # Found in a 10-million-row run: three frictionless contacts whose lines of action are
+    # almost concurrent (singular value ratio 7e-8). The dual direction separates every contact
+    # strictly, by about 6e-8 only; it used to be read as "all tight" and the verdict came out
+    # degenerate with no checkable evidence.
+    from certify import grasp_from_dict
+
+    grasp = grasp_from_dict({"contacts": [
+        {"p": [0.08487203384727166, -0.9607936621023784], "n": [-0.32560050505541177, 2.091382879951419],
+         "model": "point", "mu": 0.6920278061753009},
+        {"p": [0.6654720032440128, -0.4503054549567775], "n": [-0.8695851629374756, 0.12345552898877554],
+         "model": "point", "mu": 0.3179183556062011},
+        {"p": [-0.5094172464502014, 0.6504739073678544], "n": [0.4711621550474892, -0.9471897710793764],
+         "model": "point", "mu": 0.5529367462378985}]})
+    form = form_closure(grasp)
+    assert form.status == "no_closure" and form.certificate.tight == ()
+    assert verify(grasp, form.certificate, status="no_closure", frictionless=True).ok
+    report = certify_grasp(grasp, quality=False)
+    assert report.force.status == "closure" and report.verified
