@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 import pyarrow as pa
+import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
 from .errors import CertifyError, GraspFileError
@@ -128,22 +129,24 @@ def _finish(results, part: Path) -> tuple[dict[str, int], int]:
     """Write a chunk's results to ``part`` atomically; its status counts and unverified count."""
     _write_part(results, part)
     if isinstance(results, pa.Table):
-        return _counts(results.column("status").to_pylist(), results.column("verified").to_pylist())
+        return _counts(results.column("status"), results.column("verified"))
     return _counts([r["status"] for r in results], [r["verified"] for r in results])
 
 
-def _counts(statuses: list, verified: list) -> tuple[dict[str, int], int]:
-    """Rows per status, and rows (not errors) whose certificates were not verified."""
-    counts: dict[str, int] = {}
-    for status in statuses:
-        counts[status] = counts.get(status, 0) + 1
-    return counts, sum(1 for s, v in zip(statuses, verified) if s != "error" and not v)
+def _counts(statuses, verified) -> tuple[dict[str, int], int]:
+    """Rows per status, and rows (not errors) whose certificates were not verified (Arrow
+    columns or lists)."""
+    status = pa.chunked_array([pa.array(statuses, pa.string())]) if isinstance(statuses, list) else statuses
+    ok = pa.chunked_array([pa.array(verified, pa.bool_())]) if isinstance(verified, list) else verified
+    counts = {d["values"]: d["counts"] for d in pc.value_counts(status).to_pylist()}
+    bad = pc.and_(pc.not_equal(status, "error"), pc.invert(pc.fill_null(ok, False)))
+    return counts, int(pc.sum(bad).as_py() or 0)
 
 
 def _part_counts(part: Path) -> tuple[dict[str, int], int]:
     if part.suffix == ".arrow":
-        t = _read_part(part).select(["status", "verified"]).to_pydict()
-        return _counts(t["status"], t["verified"])
+        t = _read_part(part)
+        return _counts(t.column("status"), t.column("verified"))
     rows = [json.loads(line) for line in part.read_text(encoding="utf-8").splitlines()]
     return _counts([r["status"] for r in rows], [r["verified"] for r in rows])
 
