@@ -258,6 +258,53 @@ def _polyhedral_rows(P, N, c, L, options, tol: Tolerances):
     return (code, t, lam, basis, y), tight_rows
 
 
+def _polyhedral(P, N, c, L, options, tol: Tolerances):
+    """Form closure of spatial grasps with 6 or more contacts (also the force closure of
+    frictionless ones), by the fast solver's own route: LPs it solves by enumerating bases go
+    row by row (:func:`_polyhedral_rows`); larger ones, which it hands to the compiled barrier
+    method, are solved here by that method for the whole batch, and clear verdicts are proved
+    columnar. Rows near the boundary, thin, or with certificates not proved this way are decided
+    row by row. Returns ``(code, t, lam, basis, y)`` and the tight blocks of code-4 rows."""
+    from math import comb
+
+    from .kernels import barrier_batch, certify_rows, world_values
+    from .solvers import BARRIER_NEAR_ZERO, FastSolver
+    from .solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
+    from .wrench import generator_columns
+
+    B, m, d = P.shape
+    if comb(m, 2 * d) <= FastSolver.max_bases:
+        return _polyhedral_rows(P, N, c, L, options, tol)
+    models = ("frictionless",) * m
+    zeros = np.zeros((B, m))
+    W, _ = generator_columns(P, N, zeros, models, c, L, frictionless=True)
+    W = np.ascontiguousarray(W)  # (B, 6, m): one ray per contact, as barrier_arrays lays it out
+    status, t, y, xn, _ = barrier_batch(np.ascontiguousarray(np.swapaxes(W, 1, 2)),
+                                        np.zeros((B, m, 1, 2 * d)), np.zeros(m, dtype=np.int64),
+                                        np.ones((B, m)), EXIT_BELOW, GAP_TOL, MAX_NEWTON)
+    sv = np.linalg.svd(W, compute_uv=False)
+    thin = sv[:, -1] <= 1e-6 * sv[:, 0]  # conservative: the per-grasp rank test is sharper
+    near = (status == 2) | (np.abs(t) < BARRIER_NEAR_ZERO)  # what FastSolver hands to clarabel
+    closure = ~thin & ~near & (status == 0) & (t >= tol.margin) & (not options.quality)
+    farkas = ~thin & ~near & (t < tol.margin)
+    values = world_values(np.ascontiguousarray(np.broadcast_to(np.eye(m), (B, m, m))), xn)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        yn = np.nan_to_num(y / np.sqrt(np.sum(y * y, axis=1, keepdims=True)))
+    E = _force_column_error(P, N, models, c, L, m)
+    code, basis = certify_rows(W, E, np.zeros(m, dtype=np.int64), np.arange(m), np.ascontiguousarray(N),
+                               zeros, zeros, values, yn, closure, farkas, np.abs(W).max(axis=(1, 2)),
+                               tol.residual)
+    out = [code, np.where(code == 1, t, 0.0), values, basis, yn]
+    tight = {}
+    rest = np.flatnonzero(code == 0)
+    if len(rest):
+        sub, sub_tight = _polyhedral_rows(P[rest], N[rest], c[rest], L[rest], options, tol)
+        for arr, part in zip(out, sub):
+            arr[rest] = part
+        tight = {int(rest[r]): v for r, v in sub_tight.items()}
+    return tuple(out), tight
+
+
 def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances):
     """Certify the spatial grasps ``rows`` (one contact pattern with friction): force closure
     by the compiled dual barrier method, form closure by the null-space direction (fewer than 6
@@ -282,7 +329,7 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
     mu, tor, c, L = cols.mu[rows, :m], cols.torsion[rows, :m], cols.center[rows], cols.length[rows]
     B = len(rows)
     if all(name == "frictionless" for name in models):  # force closure is form closure
-        form, tight = _polyhedral_rows(P, N, c, L, options, tol)
+        form, tight = _polyhedral(P, N, c, L, options, tol)
         return form[0] > 0, {"force": form, "form": form, "tight": tight, "form_tight": tight}
     # force closure: the barrier method on the solver columns
     columns, rays, cones, to_values = conic_columns(P, N, mu, tor, models, c, L)
@@ -382,7 +429,7 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
         code_f = null_rows(Wf, Ef, y_f)
     form_tight = {}
     if m >= 6:
-        (code_f, t_f, lam_f, basis_f, y_f), form_tight = _polyhedral_rows(P, N, c, L, options, tol)
+        (code_f, t_f, lam_f, basis_f, y_f), form_tight = _polyhedral(P, N, c, L, options, tol)
     settled = (code > 0) & (code_f > 0)
     out = {"force": (code, t, values, basis, np.nan_to_num(yn)),
            "form": (code_f, t_f, lam_f, basis_f, y_f),

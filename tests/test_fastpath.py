@@ -128,7 +128,8 @@ def _spatial_dicts():
                                dict(n_contacts=4, model="point", spread=0.3),
                                dict(n_contacts=6, model="point", spread=0.5),
                                dict(n_contacts=7, model="frictionless"),
-                               dict(n_contacts=10, model="frictionless"))):
+                               dict(n_contacts=10, model="frictionless"),
+                               dict(n_contacts=9, model="point", spread=0.5))):
         out += [grasp_to_dict(g) for g in random_grasps(20 + seed, 80, dim=3, **kw)]
     for d in out[::4]:
         d.pop("center")
@@ -141,8 +142,9 @@ def _spatial_dicts():
 
 
 def test_spatial_columnar_rows_equal_per_grasp_rows():
-    """Spatial groups (exact cones, and frictionless or six-plus-contact LPs decided row by row
-    with float-proved certificates) give the per-grasp rows exactly."""
+    """Spatial groups (exact cones; frictionless or six-plus-contact LPs, by the batch barrier
+    method from nine contacts on, else row by row, with float-proved certificates) give the
+    per-grasp rows exactly."""
     table = grasps_table(_spatial_dicts())
     fast, ref, slow = _both(table, Options(quality=False))
     assert len(fast) == len(ref) == table.num_rows
@@ -151,3 +153,5 @@ def test_spatial_columnar_rows_equal_per_grasp_rows():
     assert len(slow) < 0.1 * table.num_rows
     statuses = {(r["n_contacts"], r["status"]) for r in fast}
     assert (10, "closure") in statuses and (10, "no_closure") in statuses
+    forms = {(r["n_contacts"], r["form_status"]) for r in fast}
+    assert (9, "closure") in forms and (9, "no_closure") in forms
