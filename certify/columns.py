@@ -160,13 +160,16 @@ def grasp_columns(table: pa.Table) -> GraspColumns:
         center, clen = np.zeros((n, 3)), np.full(n, -1)
     center_given = clen >= 0
     ok &= ~center_given | ((clen == dim) & np.isfinite(center).all(1))
-    # default centre: mean of the points, as Grasp computes it (sum in contact order / count)
-    centroid = P.sum(1) / np.maximum(count, 1)[:, None]
-    center = np.where(center_given[:, None], center, centroid)
+    if not center_given.all():
+        # default centre: mean of the points, as Grasp computes it (sum in contact order / count)
+        centroid = P.sum(1) / np.maximum(count, 1)[:, None]
+        center = np.where(center_given[:, None], center, centroid)
     length = _floats(table.column("length")) if "length" in table.column_names else np.full(n, np.nan)
     length_given = ~np.isnan(length)
     ok &= ~length_given | (np.isfinite(length) & (length > 0))
-    reach = np.sqrt(((P - center[:, None, :]) ** 2).sum(2))
-    reach = np.where(MODEL >= 0, reach, 0.0).max(1) if m else np.zeros(n)
-    length = np.where(length_given, length, np.where(reach > 0, reach, 1.0))
+    if not length_given.all():
+        # default length: the largest distance from the centre to a contact
+        reach = np.sqrt(((P - center[:, None, :]) ** 2).sum(2))
+        reach = np.where(MODEL >= 0, reach, 0.0).max(1) if m else np.zeros(n)
+        length = np.where(length_given, length, np.where(reach > 0, reach, 1.0))
     return GraspColumns(ok, dim, count, P, N, MU, TOR, MODEL, center, length, ids)
