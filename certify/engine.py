@@ -189,9 +189,14 @@ class _Assembler:
         self.parts, self.results = parts, results
         self.tmp = results.with_name(results.name + ".tmp")
         self.parquet = is_parquet(results)
-        self.out = (pq.ParquetWriter(self.tmp, RESULT_SCHEMA, **RESULT_WRITE_OPTIONS) if self.parquet
-                    else self.tmp.open("wb"))
+        self.out = None  # opened with the first part, so that nothing is left if no run starts
         self.next, self.ready = 0, set()
+
+    def _open(self):
+        if self.out is None:
+            self.out = (pq.ParquetWriter(self.tmp, RESULT_SCHEMA, **RESULT_WRITE_OPTIONS) if self.parquet
+                        else self.tmp.open("wb"))
+        return self.out
 
     def add(self, index: int) -> None:
         self.ready.add(index)
@@ -199,21 +204,22 @@ class _Assembler:
             self.ready.remove(self.next)
             part = self.parts / _part_name(self.next, self.results)
             if self.parquet:
-                self.out.write_table(_read_part(part))
+                self._open().write_table(_read_part(part))
             else:
                 with part.open("rb") as fh:
-                    shutil.copyfileobj(fh, self.out)
+                    shutil.copyfileobj(fh, self._open())
             self.next += 1
 
     def close(self, n_chunks: int) -> None:
-        self.out.close()
+        self._open().close()
         if self.next != n_chunks:
             raise CertifyError(f"internal error: {self.next} of {n_chunks} parts assembled")
         os.replace(self.tmp, self.results)
         shutil.rmtree(self.parts)
 
     def abort(self) -> None:
-        self.out.close()
+        if self.out is not None:
+            self.out.close()
         self.tmp.unlink(missing_ok=True)
 
 
