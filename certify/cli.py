@@ -63,6 +63,10 @@ def certify_command(
         if summary.resumed_chunks:
             table.add_row("chunks kept from the interrupted run", str(summary.resumed_chunks))
         console.print(table)
+        rate = summary.rows / summary.seconds if summary.seconds > 0 else 0.0
+        memory = "" if summary.peak_mb is None else f"; peak memory {summary.peak_mb:.0f} MB" + (
+            "" if summary.peak_worker_mb is None else f" (largest worker {summary.peak_worker_mb:.0f} MB)")
+        console.print(f"{summary.seconds:.1f} s, {rate:,.0f} grasps/s{memory}")
     if summary.errors or summary.unverified:
         raise typer.Exit(1)
 

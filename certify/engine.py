@@ -22,6 +22,8 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import sys
+import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -50,13 +52,17 @@ class Options:
 
 @dataclass
 class RunSummary:
-    """Counts of a certification run."""
+    """Counts of a certification run, its wall time (s) and peak resident memory (MB) of this
+    process and of the largest local worker process (None where the platform does not say)."""
 
     rows: int = 0
     statuses: dict[str, int] = field(default_factory=dict)
     unverified: int = 0
     chunks: int = 0
     resumed_chunks: int = 0
+    seconds: float = 0.0
+    peak_mb: float | None = None
+    peak_worker_mb: float | None = None
 
     @property
     def errors(self) -> int:
@@ -303,6 +309,7 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
     progress : callable, optional
         Called with the number of grasps of each chunk as it completes (or is found complete).
     """
+    start = time.perf_counter()
     grasps, results = Path(grasps), Path(results)
     if count_grasps(grasps) is None:
         raise GraspFileError(f"cannot read {grasps}")
@@ -351,4 +358,18 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
         if pool is not None:
             pool.close()
     summary.chunks = n_chunks
+    summary.seconds = time.perf_counter() - start
+    summary.peak_mb, summary.peak_worker_mb = _peak_memory()
     return summary
+
+
+def _peak_memory() -> tuple[float | None, float | None]:
+    """Peak RSS in MB of this process and of its largest finished child process."""
+    try:
+        import resource
+    except ImportError:  # not on this platform
+        return None, None
+    unit = 1 / 1024 if sys.platform != "darwin" else 1 / 2**20  # kB on Linux, bytes on macOS
+    own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * unit
+    child = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * unit
+    return own, (child or None)

@@ -53,6 +53,9 @@ def test_parquet_and_jsonl_give_the_same_results(grasp_files, tmp_path):
         assert x["certificate"] == y["certificate"]
     assert not verify_file(b, parquet, workers=2).failures
     assert not verify_file(a, jsonl).failures
+    assert 0 < sb.seconds and sb.chunks == -(-n // 50)
+    if sys.platform.startswith("linux"):  # peak memory as getrusage reports it
+        assert sb.peak_mb > 50 and sb.peak_worker_mb > 50
 
 
 def _start(args, cwd):
