@@ -142,7 +142,8 @@ class Agreement:
     same_status: int
     statuses: dict
     max_margin_diff: float
-    disagreements: tuple  # ids with different statuses
+    disagreements: tuple  # ids with contradicting statuses
+    resolved: tuple = ()  # ids one route left degenerate and the other proved (exact re-check)
 
     @property
     def rate(self) -> float:
@@ -152,21 +153,35 @@ class Agreement:
 def compare_routes(grasps, kind: str = "", a: str = "fast", b: str = "reference",
                    frictionless: bool = False) -> Agreement:
     """Compare the verdicts of routes ``a`` and ``b`` on ``grasps`` (form closure if
-    ``frictionless``): status counts of ``a``, agreement count and largest margin difference."""
+    ``frictionless``): status counts of ``a``, agreement count, largest margin difference, the
+    grasps on which they contradict each other, and those one route left degenerate (within
+    tolerance of the boundary) that the other decided with a certificate passing the exact
+    re-check."""
     from .closure import form_closure
 
     test = form_closure if frictionless else force_closure
     sa, sb = make_solver(a), make_solver(b)
-    same, diff, statuses, bad = 0, 0.0, {}, []
+    same, diff, statuses, bad, resolved = 0, 0.0, {}, [], []
     for g in grasps:
         va, vb = test(g, solver=sa), test(g, solver=sb)
         statuses[va.status] = statuses.get(va.status, 0) + 1
         if va.status == vb.status:
             same += 1
             diff = max(diff, abs(va.margin - vb.margin))
+        elif _proves(g, va if vb.status == "degenerate" else vb if va.status == "degenerate" else None,
+                     frictionless):
+            resolved.append(g.id)
         else:
             bad.append(g.id)
-    return Agreement(kind, len(grasps), same, statuses, diff, tuple(bad))
+    return Agreement(kind, len(grasps), same, statuses, diff, tuple(bad), tuple(resolved))
+
+
+def _proves(grasp, verdict, frictionless: bool) -> bool:
+    """A decisive verdict whose certificate passes the exact re-check (False for None)."""
+    from .certificates import verify
+
+    return verdict is not None and verdict.status != "degenerate" and verify(
+        grasp, verdict.certificate, status=verdict.status, frictionless=frictionless).ok
 
 
 @dataclass(frozen=True)

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import exact as ex
-from .certificates import Certificate, Tolerances, polar_values
+from .certificates import Certificate, Tolerances
 from .errors import GraspError, SolverError
 from .grasp import Grasp
 from .kernels import null_direction, pivot_basis, world_values
@@ -107,33 +107,20 @@ def farkas_certificate(C: np.ndarray, blocks, layout: str, y: np.ndarray,
     A ``y`` strictly separating every block is a certificate as it is. Otherwise blocks on which
     ``y`` vanishes (relative to ``rel``) are declared tight and ``y`` is projected off their
     columns; every other block must then be strictly separated (float check with a margin; the
-    exact check is :func:`certify.certificates.verify`).
+    exact check is :func:`certify.certificates.verify`). Compiled:
+    :func:`certify.kernels.farkas_direction`.
     """
-    norm = np.sqrt(np.sum(y * y))  # the columnar path normalises with the same operations
-    if not (np.isfinite(norm) and norm > 0):
+    from .kernels import farkas_direction
+    from .problem import block_arrays
+
+    dim = max((len(b.n) for b in blocks), default=2) or 2
+    ok, y, tight = farkas_direction(np.ascontiguousarray(C, dtype=float), *block_arrays(blocks, dim),
+                                    np.ascontiguousarray(y, dtype=float), rel)
+    if not ok:
         return None
-    y = y / norm
-    scale = np.abs(C).max()
-    if polar_values(C, blocks, y).max() < -1e-9 * scale:
-        # strict on every contact: a certificate as it is, even if some products are small (a
-        # nearly singular system, e.g. three frictionless contacts with almost concurrent lines)
-        return Certificate("farkas", layout, y=_floats(y))
-    tight = tuple(i for i, b in enumerate(blocks)
-                  if np.abs(C[:, list(b.cols)].T @ y).max() <= rel * scale)
-    if tight:
-        T = C[:, [j for i in tight for j in blocks[i].cols]]
-        Q, R = np.linalg.qr(T)
-        Q = Q[:, np.abs(np.diag(R)) > 1e-12 * scale] if R.size else Q[:, :0]
-        y = y - Q @ (Q.T @ y)
-        norm = np.linalg.norm(y)
-        if norm < 0.5:
-            return None
-        y = y / norm
-    others = [v for i, v in enumerate(polar_values(C, blocks, y)) if i not in tight]
-    if others and max(others) >= -1e-9 * scale:
-        return None
+    tight = tuple(int(i) for i in np.flatnonzero(tight))
     return Certificate("farkas", layout, y=_floats(y), tight=tight,
-                       null_space=len(tight) == len(blocks))
+                       null_space=bool(tight) and len(tight) == len(blocks))
 
 
 def force_closure(grasp: Grasp, *, method: str = "fast", solver=None, socp: bool = False,

@@ -14,6 +14,7 @@ per-grasp path, so the two agree by construction.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -378,8 +379,9 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
     # near the boundary the per-grasp rule re-solves with clarabel (tight contacts); settle those
     # verdicts here too, with the float re-check
     tight_rows = {}
-    # these rows are exactly those the fast solver hands from the barrier method to clarabel
-    solver = make_solver("clarabel")
+    # these rows are exactly those the fast solver hands from the barrier method to its
+    # near-boundary rule (the squeeze direction, else clarabel)
+    solver = SimpleNamespace(solve=make_solver("fast").solve_near_boundary)
 
     def grasp_of(i):
         return Grasp(tuple(Contact(P[i, j], N[i, j], models[j], mu[i, j],

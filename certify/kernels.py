@@ -1283,6 +1283,94 @@ def polar_values(C, kind, cols, n, mu, torsion, y):
 
 
 @njit(cache=True)
+def farkas_direction(C, kind, cols, n, mu, torsion, y, rel):
+    """The rule of :func:`certify.closure.farkas_certificate`, compiled: ``(ok, y, tight)``.
+
+    ``y`` is normalised; if every block's polar value is below ``-1e-9 scale`` (``scale`` the
+    largest ``abs(C)``) it is a strict certificate. Otherwise blocks whose functional
+    ``C_b' y`` is at most ``rel scale`` in absolute value are tight, ``y`` is projected off the
+    span of their columns (QR, columns with ``abs(R_ii) > 1e-12 scale``) and normalised again
+    (refused if the projection leaves less than half of it), and every other block must be
+    strictly separated."""
+    d = C.shape[0]
+    dim = n.shape[1]
+    nb = kind.shape[0]
+    tight = np.zeros(nb, dtype=np.bool_)
+    out = np.zeros(d)
+    ss = 0.0
+    for i in range(d):
+        ss += y[i] * y[i]
+    norm = np.sqrt(ss)
+    if not (np.isfinite(norm) and norm > 0.0):
+        return False, out, tight
+    for i in range(d):
+        out[i] = y[i] / norm
+    scale = 0.0
+    for i in range(d):
+        for j in range(C.shape[1]):
+            scale = max(scale, abs(C[i, j]))
+    pv = polar_values(C, kind, cols, n, mu, torsion, out)
+    if pv.max() < -1e-9 * scale:
+        return True, out, tight
+    width = np.empty(nb, dtype=np.int64)
+    ntc = 0
+    for b in range(nb):
+        width[b] = 1 if kind[b] == 0 else (dim if kind[b] == 1 else dim + 1)
+        big = 0.0
+        for c in range(width[b]):
+            acc = 0.0
+            for i in range(d):
+                acc += C[i, cols[b] + c] * out[i]
+            big = max(big, abs(acc))
+        if big <= rel * scale:
+            tight[b] = True
+            ntc += width[b]
+    if ntc > 0:
+        T = np.empty((d, ntc))
+        c0 = 0
+        for b in range(nb):
+            if tight[b]:
+                for c in range(width[b]):
+                    T[:, c0] = C[:, cols[b] + c]
+                    c0 += 1
+        Q, R = np.linalg.qr(T)
+        proj = out.copy()
+        for c in range(min(d, ntc)):
+            if abs(R[c, c]) > 1e-12 * scale:
+                dot = 0.0
+                for i in range(d):
+                    dot += Q[i, c] * out[i]
+                for i in range(d):
+                    proj[i] -= Q[i, c] * dot
+        ss = 0.0
+        for i in range(d):
+            ss += proj[i] * proj[i]
+        norm = np.sqrt(ss)
+        if norm < 0.5:
+            return False, out, tight
+        for i in range(d):
+            out[i] = proj[i] / norm
+        pv = polar_values(C, kind, cols, n, mu, torsion, out)
+    for b in range(nb):
+        if not tight[b] and not pv[b] < -1e-9 * scale:
+            return False, out, tight
+    return True, out, tight
+
+
+@njit(cache=True)
+def squeeze_direction(C, cols):
+    """The direction orthogonal to the columns ``cols`` of ``C`` (6, k) of two point contacts,
+    and whether they span exactly 5 dimensions (smallest singular value at most ``1e-12``,
+    next one above ``1e-6``, of the largest): see :mod:`certify.solvers.squeeze`."""
+    T = np.empty((C.shape[0], cols.shape[0]))
+    for c in range(cols.shape[0]):
+        T[:, c] = C[:, cols[c]]
+    U, sv, _ = np.linalg.svd(T)
+    ok = sv[-1] <= 1e-12 * sv[0] and sv[-2] > 1e-6 * sv[0]
+    return ok, U[:, -1].copy()
+
+
+@njit(cache=True)
 def certify_rows(C, E, kind, first, N, mu, torsion, values, y, closure, farkas, scale,
                  residual_tol):
     """Per row of a batch (B, d, k): for ``closure`` rows choose the basis and prove the

@@ -15,7 +15,11 @@ def test_fast_and_reference_routes_agree(kind):
     agreement = compare_routes(grasps, kind)
     print(kind, agreement.statuses, "agree", agreement.same_status, "max margin diff",
           agreement.max_margin_diff)
-    assert agreement.same_status == N, agreement.disagreements[:10]
+    assert not agreement.disagreements, agreement.disagreements[:10]
+    # a route may decide, with an exactly re-checked certificate, a boundary grasp the other
+    # leaves degenerate (the fast route's closed-form squeeze direction); that must stay rare
+    assert agreement.same_status + len(agreement.resolved) == N
+    assert len(agreement.resolved) <= N // 1000, agreement.resolved
     assert agreement.max_margin_diff < 1e-6
     # Both verdicts must be well represented, or agreement would say little.
     assert min(agreement.statuses.get("closure", 0), agreement.statuses.get("no_closure", 0)) > N // 20
