@@ -312,10 +312,11 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
     contacts) or the enumerated LP, every certificate re-checked in floating point with error
     bounds. Rows these rules do not settle (thin, near the boundary, tight contacts, unproved,
     or needing the spatial epsilon) are left to the per-grasp path."""
-    from .certificates import verify
+    from .certificates import Certificate, verify
     from .closure import decide
     from .grasp import Contact, Grasp
     from .problem import Block, ClosureProblem, System, grasp_system
+    from .solvers.squeeze import squeeze_farkas
     from .kernels import (barrier_batch, certify_rows, null_rows, verify_farkas_general,
                           verify_interior_general, world_values)
     from .problem import conic_columns
@@ -388,22 +389,29 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
                                    tor[i, j] if models[j] == "soft" else None) for j in range(m)),
                      center=c[i], length=L[i])
 
+    Nc, squeeze = np.ascontiguousarray(N), (kind == 1).sum() >= 2
     for i in np.flatnonzero(near & ~thin):
-        # the per-grasp decision on the columns already built (same arithmetic as grasp_problem)
-        system = System(C[i], tuple(Block(("ray", "point", "soft")[kind[b]],
-                                          tuple(np.flatnonzero(owner == b)), tuple(N[i, b]),
-                                          float(mu[i, b]), float(tor[i, b]) if kind[b] == 2 else 0)
-                                    for b in range(m)), "forces")
-        problem = ClosureProblem(columns[i], rays, tuple((st, sz, float(k[i])) for st, sz, k in cones),
-                                 to_values[i], system)
-        v = decide(problem, lambda i=i: grasp_system(grasp_of(i), exact=True).columns, solver, tol)
-        cert = v.certificate
-        if v.status == "closure" and not options.quality:
+        # the squeeze rule first, on the arrays (what the fast solver's near-boundary rule and
+        # decide make of it), then the per-grasp decision on the columns already built
+        found = squeeze_farkas(C[i], kind, first, Nc[i], mu[i], tor[i]) if squeeze else None
+        if found is not None:
+            status = "no_closure"
+            cert = Certificate("farkas", "forces", y=tuple(float(v) for v in found[1]), tight=found[2])
+        else:
+            system = System(C[i], tuple(Block(("ray", "point", "soft")[kind[b]],
+                                              tuple(np.flatnonzero(owner == b)), tuple(N[i, b]),
+                                              float(mu[i, b]), float(tor[i, b]) if kind[b] == 2 else 0)
+                                        for b in range(m)), "forces")
+            problem = ClosureProblem(columns[i], rays, tuple((st, sz, float(k[i])) for st, sz, k in cones),
+                                     to_values[i], system)
+            v = decide(problem, lambda i=i: grasp_system(grasp_of(i), exact=True).columns, solver, tol)
+            status, cert = v.status, v.certificate
+        if status == "closure" and not options.quality:
             values[i], basis[i], t[i] = cert.values, cert.basis, v.margin
             if verify_interior_general(C[i], E[i], kind, first, N[i], mu[i], tor[i], values[i],
                                        basis[i], tol.residual):
                 code[i] = 1
-        elif v.status == "no_closure" and not cert.null_space:
+        elif status == "no_closure" and not cert.null_space:
             yn[i] = cert.y
             mask = np.zeros(m, dtype=bool)
             mask[list(cert.tight)] = True

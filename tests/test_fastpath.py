@@ -155,3 +155,5 @@ def test_spatial_columnar_rows_equal_per_grasp_rows():
     assert (10, "closure") in statuses and (10, "no_closure") in statuses
     forms = {(r["n_contacts"], r["form_status"]) for r in fast}
     assert (9, "closure") in forms and (9, "no_closure") in forms
+    # two point contacts squeezing, decided by the closed-form squeeze direction on both routes
+    assert sum(1 for r in fast if r["dim"] == 3 and r["certificate"]["force"].get("tight")) >= 3

@@ -23,7 +23,7 @@ from ..kernels import farkas_direction, squeeze_direction
 from ..problem import ClosureProblem, block_arrays
 from . import Solution
 
-__all__ = ["squeeze_solution"]
+__all__ = ["squeeze_solution", "squeeze_farkas"]
 
 
 def squeeze_solution(problem: ClosureProblem) -> Solution | None:
@@ -36,17 +36,24 @@ def squeeze_solution(problem: ClosureProblem) -> Solution | None:
     C, blocks, _ = problem.system
     if C.shape[0] != 6:
         return None
-    points = [i for i, b in enumerate(blocks) if b.kind == "point" and len(b.cols) == 3]
-    if len(points) < 2:
-        return None
-    C = np.ascontiguousarray(C, dtype=float)
-    arrays = block_arrays(blocks, 3)
+    found = squeeze_farkas(np.ascontiguousarray(C, dtype=float), *block_arrays(blocks, 3))
+    return None if found is None else Solution("optimal", 0.0, None, found[0])
+
+
+def squeeze_farkas(C, kind, first, n, mu, torsion):
+    """The rule on a spatial certificate system given as block arrays
+    (:func:`certify.problem.block_arrays`): ``(y, certificate direction, (a, b))`` for the first
+    pair of point blocks whose squeeze direction ``y`` (or ``-y``) gives a Farkas certificate with
+    exactly that pair tight (the certificate direction is what
+    :func:`certify.closure.farkas_certificate` makes of ``y``), else None."""
+    points = np.flatnonzero(kind == 1)
     for a, b in combinations(points, 2):
-        ok, y = squeeze_direction(C, np.array(blocks[a].cols + blocks[b].cols, dtype=np.int64))
+        cols = np.concatenate([first[a] + np.arange(3), first[b] + np.arange(3)])
+        ok, y = squeeze_direction(C, cols)
         if not ok:
             continue
         for signed in (y, -y):
-            good, _, tight = farkas_direction(C, *arrays, signed, 1e-7)
+            good, direction, tight = farkas_direction(C, kind, first, n, mu, torsion, signed, 1e-7)
             if good and tight[a] and tight[b] and tight.sum() == 2:
-                return Solution("optimal", 0.0, None, signed)
+                return signed, direction, (int(a), int(b))
     return None
