@@ -16,7 +16,7 @@ from typing import Any, Callable, Iterable, Iterator
 import pyarrow as pa
 
 from .certificates import Tolerances
-from .engine import Options, RunSummary, run
+from .engine import Options, RunSummary, _counts, run
 from .errors import CertifyError, GraspFileError
 from .grasp import grasp_from_dict
 from .report import certify_grasp, error_row, verify_row
@@ -141,8 +141,7 @@ def _verify_tables(grasps, results, lines: list[int], tol: Tolerances):
         return failure is None
 
     recheck_table(grasps, results, lines, slow, tol)
-    counts = results.column("status").value_counts().to_pylist()
-    return {c["values"]: c["counts"] for c in counts}, failures
+    return _counts(results.column("status"), results.column("verified"))[0], failures
 
 
 def verify_file(results_path: str | Path, grasps_path: str | Path,

@@ -30,7 +30,8 @@ from .kernels import null_direction, pivot_basis, world_values
 from .problem import ClosureProblem, grasp_problem, grasp_system, span_problem, span_system
 from .solvers import make_solver
 
-__all__ = ["Verdict", "force_closure", "form_closure", "positive_span", "decide", "farkas_certificate"]
+__all__ = ["Verdict", "force_closure", "form_closure", "positive_span", "decide", "farkas_certificate",
+           "farkas_from_arrays"]
 
 
 @dataclass(frozen=True)
@@ -110,17 +111,25 @@ def farkas_certificate(C: np.ndarray, blocks, layout: str, y: np.ndarray,
     exact check is :func:`certify.certificates.verify`). Compiled:
     :func:`certify.kernels.farkas_direction`.
     """
-    from .kernels import farkas_direction
     from .problem import block_arrays
 
     dim = max((len(b.n) for b in blocks), default=2) or 2
-    ok, y, tight = farkas_direction(np.ascontiguousarray(C, dtype=float), *block_arrays(blocks, dim),
+    return farkas_from_arrays(C, block_arrays(blocks, dim), layout, y, rel)
+
+
+def farkas_from_arrays(C: np.ndarray, arrays, layout: str, y: np.ndarray,
+                       rel: float = 1e-7) -> Certificate | None:
+    """:func:`farkas_certificate` with the blocks given as ``(kind, first, n, mu, torsion)``
+    arrays (:func:`certify.problem.block_arrays`), as the columnar path holds them."""
+    from .kernels import farkas_direction
+
+    ok, y, tight = farkas_direction(np.ascontiguousarray(C, dtype=float), *arrays,
                                     np.ascontiguousarray(y, dtype=float), rel)
     if not ok:
         return None
     tight = tuple(int(i) for i in np.flatnonzero(tight))
     return Certificate("farkas", layout, y=_floats(y), tight=tight,
-                       null_space=bool(tight) and len(tight) == len(blocks))
+                       null_space=bool(tight) and len(tight) == len(arrays[0]))
 
 
 def force_closure(grasp: Grasp, *, method: str = "fast", solver=None, socp: bool = False,

@@ -142,8 +142,8 @@ def _finish(results, part: Path) -> tuple[dict[str, int], int]:
 def _counts(statuses, verified) -> tuple[dict[str, int], int]:
     """Rows per status, and rows (not errors) whose certificates were not verified (Arrow
     columns or lists)."""
-    status = pa.chunked_array([pa.array(statuses, pa.string())]) if isinstance(statuses, list) else statuses
-    ok = pa.chunked_array([pa.array(verified, pa.bool_())]) if isinstance(verified, list) else verified
+    status = pa.array(statuses, pa.string()) if isinstance(statuses, list) else statuses
+    ok = pa.array(verified, pa.bool_()) if isinstance(verified, list) else verified
     counts = {d["values"]: d["counts"] for d in pc.value_counts(status).to_pylist()}
     bad = pc.and_(pc.not_equal(status, "error"), pc.invert(pc.fill_null(ok, False)))
     return counts, int(pc.sum(bad).as_py() or 0)

@@ -14,7 +14,6 @@ per-grasp path, so the two agree by construction.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -94,6 +93,18 @@ def _layout(models, frictionless: bool):
             owner += [i, i]
             sign += [1, -1]
     return np.array(owner, dtype=np.int64), np.array(sign, dtype=np.float64)
+
+
+def _planar_kernel(P, N, mu, c, L, models, tol: Tolerances, quality: bool):
+    """:func:`certify.kernels.planar_batch` on grasps sharing the contact models ``models``:
+    force and form closure (verdict codes, margins, weights, bases, directions) and epsilons."""
+    owner, sign = _layout(models, False)
+    owner_f, _ = _layout(models, True)
+    same = all(name == "frictionless" for name in models)
+    return planar_batch(
+        np.ascontiguousarray(P), np.ascontiguousarray(N), np.ascontiguousarray(mu),
+        np.ascontiguousarray(c), np.ascontiguousarray(L), owner, sign, bases(len(owner), 3), owner_f,
+        bases(len(models), 3), same, tol.margin, _FEAS, tol.residual, quality)
 
 
 @dataclass(frozen=True, eq=False)
@@ -179,13 +190,7 @@ def planar_screen(P, N, mu, center, length, *, quality: bool = True,
         empty = np.zeros(0)
         return PlanarScreen(empty.astype(bool), empty.astype(bool), empty, empty, empty)
     models = tuple("point" if f else "frictionless" for f in pattern[0])
-    owner, sign = _layout(models, False)
-    owner_f, _ = _layout(models, True)
-    same = not pattern[0].any()
-    code, t, *_, code_f, _t_f, _lam_f, _basis_f, _y_f, eps = planar_batch(
-        np.ascontiguousarray(P), np.ascontiguousarray(N), np.ascontiguousarray(mu),
-        np.ascontiguousarray(center), np.ascontiguousarray(length), owner, sign,
-        bases(len(owner), 3), owner_f, bases(m, 3), same, tol.margin, _FEAS, tol.residual, quality)
+    code, t, *_, eps = _planar_kernel(P, N, mu, center, length, models, tol, quality)
     closure = code == 1
     return PlanarScreen(closure, code > 0, t, np.where(closure, eps[:, 0], 0.0),
                         np.where(closure, eps[:, 1], 0.0))
@@ -196,14 +201,9 @@ def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances
     return the settled rows and their result columns."""
     m = int(cols.count[rows[0]])
     models = tuple(_MODEL_NAMES[int(c)] for c in cols.model[rows[0], :m])
-    owner, sign = _layout(models, False)
-    owner_f, _ = _layout(models, True)
-    same = all(name == "frictionless" for name in models)
-    (code, t, lam, basis, y, code_f, t_f, lam_f, basis_f, y_f, eps) = planar_batch(
-        np.ascontiguousarray(cols.P[rows, :m, :2]), np.ascontiguousarray(cols.N[rows, :m, :2]),
-        np.ascontiguousarray(cols.mu[rows, :m]), np.ascontiguousarray(cols.center[rows, :2]),
-        np.ascontiguousarray(cols.length[rows]), owner, sign, bases(len(owner), 3), owner_f,
-        bases(m, 3), same, tol.margin, _FEAS, tol.residual, options.quality)
+    (code, t, lam, basis, y, code_f, t_f, lam_f, basis_f, y_f, eps) = _planar_kernel(
+        cols.P[rows, :m, :2], cols.N[rows, :m, :2], cols.mu[rows, :m], cols.center[rows, :2],
+        cols.length[rows], models, tol, options.quality)
     settled = (code > 0) & (code_f > 0)
     out = {"force": (code, t, lam, basis, y), "form": (code_f, t_f, lam_f, basis_f, y_f)}
     if options.quality:
@@ -211,26 +211,23 @@ def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances
     return settled, out
 
 
-def _polyhedral_rows(P, N, c, L, options, tol: Tolerances):
+def _polyhedral_rows(P, N, c, L, W, E, options, tol: Tolerances):
     """Form closure of spatial grasps (also the force closure of frictionless ones) whose LP has
     too many bases for a columnar rule: decided row by row exactly as the per-grasp path decides
     it (same problem, same fast solver, same certificate), with the certificate then proved by
     the rigorous float kernels instead of rationals (the exact checker only where floats cannot
-    decide). Returns ``(code, t, lam, basis, y)`` and the tight blocks of code-4 rows."""
+    decide). ``W`` and ``E`` are the frictionless generator columns and their error bounds
+    (:func:`_force_column_error`). Returns ``(code, t, lam, basis, y)`` and the tight blocks of
+    code-4 rows."""
     from .certificates import verify
     from .closure import decide
     from .grasp import Contact, Grasp
     from .kernels import verify_farkas_general, verify_interior_general
     from .problem import grasp_problem, grasp_system
     from .solvers import make_solver
-    from .wrench import generator_columns
 
     B, m, d = P.shape
-    models = ("frictionless",) * m
     zeros = np.zeros((B, m))
-    W, _ = generator_columns(P, N, zeros, models, c, L, frictionless=True)
-    W = np.ascontiguousarray(W)
-    E = _force_column_error(P, N, models, c, L, m)
     kind, first = np.zeros(m, dtype=np.int64), np.arange(m)
     code = np.zeros(B, dtype=np.int64)
     t, lam = np.zeros(B), np.zeros((B, m))
@@ -274,12 +271,13 @@ def _polyhedral(P, N, c, L, options, tol: Tolerances):
     from .wrench import generator_columns
 
     B, m, d = P.shape
-    if comb(m, 2 * d) <= FastSolver.max_bases:
-        return _polyhedral_rows(P, N, c, L, options, tol)
     models = ("frictionless",) * m
     zeros = np.zeros((B, m))
     W, _ = generator_columns(P, N, zeros, models, c, L, frictionless=True)
     W = np.ascontiguousarray(W)  # (B, 6, m): one ray per contact, as barrier_arrays lays it out
+    E = _force_column_error(P, N, models, c, L, m)
+    if comb(m, 2 * d) <= FastSolver.max_bases:
+        return _polyhedral_rows(P, N, c, L, W, E, options, tol)
     status, t, y, xn, _ = barrier_batch(np.ascontiguousarray(np.swapaxes(W, 1, 2)),
                                         np.zeros((B, m, 1, 2 * d)), np.zeros(m, dtype=np.int64),
                                         np.ones((B, m)), EXIT_BELOW, GAP_TOL, MAX_NEWTON)
@@ -291,7 +289,6 @@ def _polyhedral(P, N, c, L, options, tol: Tolerances):
     values = world_values(np.ascontiguousarray(np.broadcast_to(np.eye(m), (B, m, m))), xn)
     with np.errstate(invalid="ignore", divide="ignore"):
         yn = np.nan_to_num(y / np.sqrt(np.sum(y * y, axis=1, keepdims=True)))
-    E = _force_column_error(P, N, models, c, L, m)
     code, basis = certify_rows(W, E, np.zeros(m, dtype=np.int64), np.arange(m), np.ascontiguousarray(N),
                                zeros, zeros, values, yn, closure, farkas, np.abs(W).max(axis=(1, 2)),
                                tol.residual)
@@ -299,7 +296,8 @@ def _polyhedral(P, N, c, L, options, tol: Tolerances):
     tight = {}
     rest = np.flatnonzero(code == 0)
     if len(rest):
-        sub, sub_tight = _polyhedral_rows(P[rest], N[rest], c[rest], L[rest], options, tol)
+        sub, sub_tight = _polyhedral_rows(P[rest], N[rest], c[rest], L[rest], W[rest], E[rest],
+                                          options, tol)
         for arr, part in zip(out, sub):
             arr[rest] = part
         tight = {int(rest[r]): v for r, v in sub_tight.items()}
@@ -312,8 +310,8 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
     contacts) or the enumerated LP, every certificate re-checked in floating point with error
     bounds. Rows these rules do not settle (thin, near the boundary, tight contacts, unproved,
     or needing the spatial epsilon) are left to the per-grasp path."""
-    from .certificates import Certificate, verify
-    from .closure import decide
+    from .certificates import verify
+    from .closure import decide, farkas_from_arrays
     from .grasp import Contact, Grasp
     from .problem import Block, ClosureProblem, System, grasp_system
     from .solvers.squeeze import squeeze_farkas
@@ -381,8 +379,8 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
     # verdicts here too, with the float re-check
     tight_rows = {}
     # these rows are exactly those the fast solver hands from the barrier method to its
-    # near-boundary rule (the squeeze direction, else clarabel)
-    solver = SimpleNamespace(solve=make_solver("fast").solve_near_boundary)
+    # near-boundary rule: the squeeze direction (tried below on the arrays), else clarabel
+    solver = make_solver("clarabel")
 
     def grasp_of(i):
         return Grasp(tuple(Contact(P[i, j], N[i, j], models[j], mu[i, j],
@@ -391,12 +389,12 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
 
     Nc, squeeze = np.ascontiguousarray(N), (kind == 1).sum() >= 2
     for i in np.flatnonzero(near & ~thin):
-        # the squeeze rule first, on the arrays (what the fast solver's near-boundary rule and
-        # decide make of it), then the per-grasp decision on the columns already built
-        found = squeeze_farkas(C[i], kind, first, Nc[i], mu[i], tor[i]) if squeeze else None
-        if found is not None:
-            status = "no_closure"
-            cert = Certificate("farkas", "forces", y=tuple(float(v) for v in found[1]), tight=found[2])
+        # the squeeze rule first, on the arrays (the certificate decide makes of its direction),
+        # then the per-grasp decision on the columns already built
+        arrays = (kind, first, Nc[i], mu[i], tor[i])
+        y_sq = squeeze_farkas(C[i], *arrays) if squeeze else None
+        if y_sq is not None:
+            status, cert = "no_closure", farkas_from_arrays(C[i], arrays, "forces", y_sq)
         else:
             system = System(C[i], tuple(Block(("ray", "point", "soft")[kind[b]],
                                               tuple(np.flatnonzero(owner == b)), tuple(N[i, b]),

@@ -711,8 +711,7 @@ def planar_batch(P, N, mu, c, L, owner, sgn, combos, owner_f, combos_f, form_sam
     buf = np.empty(kk + 2 * max(combos.shape[0], combos_f.shape[0]))
     R = np.empty((3, kk))
     used = np.empty(kk, dtype=np.bool_)
-    zeros = np.zeros(kf, dtype=np.int64)
-    rays = np.zeros(kk, dtype=np.int64)
+    rays = np.zeros(kk, dtype=np.int64)  # also the edge signs of frictionless generators
     first = np.arange(kk)
     zeros2 = np.zeros((kk, 2))
     zeros1 = np.zeros(kk)
@@ -727,7 +726,7 @@ def planar_batch(P, N, mu, c, L, owner, sgn, combos, owner_f, combos_f, form_sam
             basis_f[b, :] = basis[b, :]
             y_f[b, :] = y[b, :]
         else:
-            _planar_generators(P[b], N[b], mu[b], c[b], L[b], owner_f, zeros, Wf, Ef)
+            _planar_generators(P[b], N[b], mu[b], c[b], L[b], owner_f, rays[:kf], Wf, Ef)
             code_f[b], t_f[b] = _classify(Wf, Ef, combos_f, feas, margin, residual_tol, C, D, buf,
                                           R, used, lam_f[b], y_f[b], basis_f[b], rays, first,
                                           zeros2, zeros1, no_tight)

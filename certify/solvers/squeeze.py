@@ -36,16 +36,15 @@ def squeeze_solution(problem: ClosureProblem) -> Solution | None:
     C, blocks, _ = problem.system
     if C.shape[0] != 6:
         return None
-    found = squeeze_farkas(np.ascontiguousarray(C, dtype=float), *block_arrays(blocks, 3))
-    return None if found is None else Solution("optimal", 0.0, None, found[0])
+    y = squeeze_farkas(np.ascontiguousarray(C, dtype=float), *block_arrays(blocks, 3))
+    return None if y is None else Solution("optimal", 0.0, None, y)
 
 
-def squeeze_farkas(C, kind, first, n, mu, torsion):
+def squeeze_farkas(C, kind, first, n, mu, torsion) -> np.ndarray | None:
     """The rule on a spatial certificate system given as block arrays
-    (:func:`certify.problem.block_arrays`): ``(y, certificate direction, (a, b))`` for the first
-    pair of point blocks whose squeeze direction ``y`` (or ``-y``) gives a Farkas certificate with
-    exactly that pair tight (the certificate direction is what
-    :func:`certify.closure.farkas_certificate` makes of ``y``), else None."""
+    (:func:`certify.problem.block_arrays`): the squeeze direction ``y`` (or ``-y``) of the first
+    pair of point blocks for which :func:`certify.closure.farkas_certificate` gives a certificate
+    with exactly that pair tight, else None."""
     points = np.flatnonzero(kind == 1)
     for a, b in combinations(points, 2):
         cols = np.concatenate([first[a] + np.arange(3), first[b] + np.arange(3)])
@@ -53,7 +52,7 @@ def squeeze_farkas(C, kind, first, n, mu, torsion):
         if not ok:
             continue
         for signed in (y, -y):
-            good, direction, tight = farkas_direction(C, kind, first, n, mu, torsion, signed, 1e-7)
+            good, _, tight = farkas_direction(C, kind, first, n, mu, torsion, signed, 1e-7)
             if good and tight[a] and tight[b] and tight.sum() == 2:
-                return signed, direction, (int(a), int(b))
+                return signed
     return None
