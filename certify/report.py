@@ -34,6 +34,16 @@ class Report:
     verified: bool
     epsilons: dict[str, Epsilon] | None = None
 
+    @property
+    def certified(self) -> bool:
+        """Force closure certified: status ``closure`` and both certificates re-checked."""
+        return self.force.status == "closure" and self.verified
+
+    @property
+    def eps_l1(self) -> float:
+        """Upper bound of the L1 epsilon of a certified grasp (computed with quality), else 0."""
+        return float(self.epsilons["L1"].hi) if self.certified and self.epsilons else 0.0
+
     def row(self, line: int | None = None) -> dict[str, Any]:
         g = self.grasp
         eps = {}

@@ -51,12 +51,12 @@ from certify.fastpath import planar_screen
 from qualitative.candidates import object_frame
 from qualitative.errors import QualitativeError
 from qualitative.outline import Outline, outline_contour, resample
+from qualitative.synthesis import MU
 from qualitative.vision import ImageSource, extract_contour
 
 __all__ = ["MU", "Budget", "Boundary", "BaselineResult", "boundary", "boundary_of", "search",
            "baseline", "screen_grasps"]
 
-MU = 0.5
 _CHUNK = 50_000  # rows per screening call (bounds memory)
 _SAMPLES, _SMOOTHING = 1024, 0.004  # outline_contour's defaults (the fallback below uses them)
 
@@ -157,7 +157,7 @@ class BaselineResult:
     @property
     def certified(self) -> tuple[bool, ...]:
         """Per grasp: force closure certified and both certificates verified."""
-        return tuple(r.force.status == "closure" and r.verified for r in self.reports)
+        return tuple(r.certified for r in self.reports)
 
 
 def boundary_of(outline: Outline) -> Boundary:
@@ -193,10 +193,9 @@ def boundary(image: ImageSource, *, threshold: float | None = None, largest: boo
 def _screen(points, normals, mu, center, length, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Screened L1 epsilon and force-closure margin of the index tuples ``idx`` (B, m)."""
     eps, margin = np.zeros(len(idx)), np.full(len(idx), -np.inf)
-    m = idx.shape[1]
     for a in range(0, len(idx), _CHUNK):
         rows = idx[a:a + _CHUNK]
-        out = planar_screen(points[rows], normals[rows], np.full((len(rows), m), mu), center, length)
+        out = planar_screen(points[rows], normals[rows], mu, center, length)
         eps[a:a + _CHUNK], margin[a:a + _CHUNK] = out.eps_l1, out.margin
     return eps, margin
 
@@ -218,8 +217,10 @@ def _improve(evaluate, idx: np.ndarray, eps: np.ndarray, n: int, rounds: int):
             trial = np.repeat(current[:, None, :], n, axis=1)  # (S, n, m)
             trial[:, :, j] = others
             trial = trial.reshape(-1, idx.shape[1])
-            dup = (np.sort(trial, axis=1)[:, 1:] == np.sort(trial, axis=1)[:, :-1]).any(axis=1)
-            e = np.where(dup, -1.0, evaluate(trial)[0])
+            ordered = np.sort(trial, axis=1)
+            dup = (ordered[:, 1:] == ordered[:, :-1]).any(axis=1)  # a contact used twice
+            e = np.full(len(trial), -1.0)
+            e[~dup] = evaluate(trial[~dup])[0]
             seen_idx.append(trial[~dup])
             seen_eps.append(e[~dup])
             e = e.reshape(len(current), n)
@@ -356,8 +357,7 @@ def baseline(image: ImageSource | Boundary, fingers: int, mu: float | None = MU,
     grasps = tuple(_grasp(points, normals, rows, friction, bound.center, bound.length,
                           f"{name}-base{fingers}-{k:04d}") for k, rows in enumerate(idx))
     reports = tuple(certify_grasp(g) for g in grasps)
-    certified = [r.force.status == "closure" and r.verified for r in reports]
-    epsilons = tuple(float(r.epsilons["L1"].hi) if ok else 0.0 for r, ok in zip(reports, certified))
+    epsilons = tuple(r.eps_l1 for r in reports)
     return BaselineResult(fingers, None if fingers == 4 else float(mu), grasps, reports, epsilons,
                           tuple(float(e) for e in eps), evaluated, time.perf_counter() - start, bound)
 
@@ -392,6 +392,5 @@ def screen_grasps(grasps: Sequence[Grasp]) -> tuple[np.ndarray, np.ndarray]:
                 certified[i], eps[i] = out.closure[r], out.eps_l1[r]
             else:
                 report = certify_grasp(grasps[i])
-                certified[i] = report.force.status == "closure" and report.verified
-                eps[i] = report.epsilons["L1"].hi if certified[i] else 0.0
+                certified[i], eps[i] = report.certified, report.eps_l1
     return certified, eps

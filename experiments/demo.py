@@ -25,14 +25,13 @@ from certify.engine import RunSummary
 from certify.io import write_grasps
 from certify.samples import textbook_grasps
 from qualitative.objects import render
-from qualitative.synthesis import synthesize
+from qualitative.synthesis import MU, synthesize
 
 from .study import BUILTINS, StudyResult, compare, workload
 
 __all__ = ["DemoResult", "SynthesisRow", "run_demo", "demo_steps"]
 
 FINGERS = (4, 2, 3)
-MU = 0.5
 
 
 @dataclass(frozen=True)
@@ -74,7 +73,9 @@ class DemoResult:
 
 def demo_steps(objects: int = len(BUILTINS)) -> int:
     """Number of progress messages :func:`run_demo` sends (for a progress bar's total)."""
-    return 6 + objects * len(FINGERS) + 2 + workload(objects, "quick")
+    from .figures import STEMS
+
+    return len(STEMS) + objects * len(FINGERS) + 2 + workload(objects, "quick")
 
 
 def _synthesise(progress: Callable[[str], None]) -> tuple[list, list[SynthesisRow]]:
@@ -113,7 +114,7 @@ def run_demo(out: str | Path = "qualgrasp-demo", *,
     tick = progress or (lambda message: None)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    figures = tuple(p for p in make_figures(out / "figures", progress=tick))
+    figures = tuple(make_figures(out / "figures", progress=tick))
     grasps, rows = _synthesise(tick)
     folder = out / "grasps"
     folder.mkdir(exist_ok=True)

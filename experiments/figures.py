@@ -44,14 +44,15 @@ from matplotlib.patches import Circle, Patch, Polygon as MplPolygon, Wedge
 from shapely.geometry import Polygon as ShapelyPolygon
 
 from certify import Contact, Grasp, Report, Verdict, certify_grasp, positive_span
-from qualitative.forcegrasp import GAP, ForceGrasp, friction_zone, nguyen_angles, positively_spans, span_margin
+from qualitative.candidates import separated
+from qualitative.forcegrasp import GAP, ForceGrasp, friction_zone, positively_spans, span_margin
 from qualitative.formgrasp import zone_steps
 from qualitative.grasp_plot import plot_form_step, plot_grasp
 from qualitative.objects import render
 from qualitative.outline import NAMES, Outline, outline_image
 from qualitative.plot import curvature_handles, plot_outline, plot_regions
 from qualitative.regions import ALPHA, feasible_regions
-from qualitative.synthesis import Synthesis, synthesize
+from qualitative.synthesis import MU, Synthesis, synthesize
 from qualitative.zones import Zones
 
 from . import style
@@ -61,7 +62,6 @@ __all__ = ["OBJECT", "MU", "NEAR_BEST", "STEMS", "Spanning", "best_grasp", "form
            "fig7_three_fingers", "fig8_spanning", "make_figures"]
 
 OBJECT = "polygon"
-MU = 0.5
 NEAR_BEST = 0.05
 THETA_MIN = r"$\theta_{\min}$"
 FIG4_OBJECTS = (("polygon", "polygon"), ("nut", "hexagonal nut"), ("disc", "circular contour"))
@@ -167,7 +167,7 @@ def spanning_examples(synth: Synthesis) -> tuple[Spanning, Spanning]:
     good = _spanning(synth, g.points, g.normals, synth.grasps[k].id)
     P, N = np.asarray(synth.candidates.points), np.asarray(synth.candidates.normals)
     # ForceGrasp's own spacing between fingers
-    far = np.linalg.norm(P[:, None] - g.points[None, :2], axis=2).min(axis=1) >= GAP * synth.outline.size
+    far = separated(P, GAP, synth.outline.size)[:, list(g.contacts[:2])].all(axis=1)
     trials = np.concatenate([np.broadcast_to(g.normals[:2], (len(N), 2, 2)), N[:, None]], axis=1)
     margins = span_margin(trials)
     for c in np.argsort(margins):  # farthest inside a half-plane first
@@ -419,14 +419,19 @@ def _force_synthesis(synth: Synthesis | None, image: np.ndarray | None,
     return (synthesize(image, fingers, mu=MU, name=OBJECT) if synth is None else synth), image
 
 
-def _grasp_axes(synth: Synthesis, k: int, image: np.ndarray | None, inset: bool) -> tuple[Figure, Axes]:
-    """A one-panel figure with grasp ``k`` drawn over the camera image (inside ``style.context``)."""
+def _grasp_figure(synth: Synthesis, k: int, image: np.ndarray | None, heading: str,
+                  handles: list) -> tuple[Figure, Axes]:
+    """A one-panel figure with grasp ``k`` drawn over the camera image, the cone legend plus
+    ``handles`` below it and ``heading`` (with mu and the grasp's id) on top (inside
+    ``style.context``)."""
     fig = style.new_figure(5.6, 6.6)
     ax = fig.subplots()
-    plot_grasp(ax, synth, k, inset=inset)
+    plot_grasp(ax, synth, k, inset=False)
     if image is not None:
         style.show_image(ax, image)
     style.clean(ax)
+    fig.legend(handles=_cone_handles(synth) + handles, loc="outside lower center", ncols=2)
+    fig.suptitle(f"{heading}, $\\mu$ = {synth.mu:g}: {synth.grasps[k].id}")
     return fig, ax
 
 
@@ -447,10 +452,11 @@ def fig6_two_fingers(synth: Synthesis | None = None, image: np.ndarray | None = 
     synth, image = _force_synthesis(synth, image, 2)
     k = nguyen_example(synth)
     g, report = synth.found[k], synth.reports[k]
-    t1, t2 = nguyen_angles(g.points[0], g.normals[0], g.points[1], g.normals[1])
+    t1, t2 = g.angles
     ok = max(t1, t2) < synth.theta_min
     with style.context():
-        fig, ax = _grasp_axes(synth, k, image, inset=True)
+        fig, ax = _grasp_figure(synth, k, image, "Two fingers",
+                                [Line2D([], [], color=style.GRASP_LINE, label="grasp line F1 F2")])
         for i, theta in enumerate((t1, t2)):
             p, q = g.points[i], g.points[1 - i]
             _angle_arc(ax, p, g.normals[i], q - p, 0.16 * synth.outline.size,
@@ -460,9 +466,6 @@ def fig6_two_fingers(synth: Synthesis | None = None, image: np.ndarray | None = 
                      f"{THETA_MIN} = {math.degrees(synth.theta_min):.1f}°: the grasp line "
                      f"{'lies inside' if ok else 'leaves'} both cones\n{_verdict(report)}",
                      color=style.GOOD if ok else style.BAD)
-        handles = _cone_handles(synth) + [Line2D([], [], color=style.GRASP_LINE, label="grasp line F1 F2")]
-        fig.legend(handles=handles, loc="outside lower center", ncols=2)
-        fig.suptitle(f"Two fingers, $\\mu$ = {synth.mu:g}: {synth.grasps[k].id}")
     return fig
 
 
@@ -485,15 +488,12 @@ def fig7_three_fingers(synth: Synthesis | None = None, image: np.ndarray | None 
     g, report = synth.found[k], synth.reports[k]
     share = zone_share(synth, g.points, g.normals)
     with style.context():
-        fig, ax = _grasp_axes(synth, k, image, inset=False)
+        fig, ax = _grasp_figure(synth, k, image, "Three fingers", [
+            Patch(label="friction zone (the cones' intersection)", **style.ZONE),
+            Line2D([], [], ls="none", marker="*", color=style.MEET, ms=10, label="where the forces meet")])
         state = f"non-empty, {100 * share:.0f} % of the object's area" if share > 0 else "empty"
         ax.set_title(f"friction zone {state};\nangular margin {math.degrees(g.margin):.1f}°; {_verdict(report)}",
                      color=style.GOOD if share > 0 else style.BAD)
-        handles = _cone_handles(synth) + [
-            Patch(label="friction zone (the cones' intersection)", **style.ZONE),
-            Line2D([], [], ls="none", marker="*", color=style.MEET, ms=10, label="where the forces meet")]
-        fig.legend(handles=handles, loc="outside lower center", ncols=2)
-        fig.suptitle(f"Three fingers, $\\mu$ = {synth.mu:g}: {synth.grasps[k].id}")
     return fig
 
 

@@ -416,7 +416,7 @@ def _plan(image: np.ndarray, method: str, fingers: int, settings: Settings, name
                    largest=True)
     if final:
         ok = np.array(s.certified, dtype=bool)
-        eps = np.array([r.epsilons["L1"].hi if c else 0.0 for r, c in zip(s.reports, ok)])
+        eps = np.array([r.eps_l1 for r in s.reports])
     else:
         ok, eps = screen_grasps(s.grasps)
     return s.grasps, ok, eps, time.perf_counter() - start, None, s.outline.contour

@@ -68,7 +68,6 @@ def plot_outline(ax: Axes, outline: Outline, image: np.ndarray | None = None, la
     matplotlib.axes.Axes
     """
     _frame(ax, outline, image)
-    n = len(outline.contour)
     normals = outline.normals()
     offset = 0.05 * outline.size
     for seg in outline.segments:

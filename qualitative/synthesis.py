@@ -98,7 +98,7 @@ class Synthesis:
     @property
     def certified(self) -> tuple[bool, ...]:
         """Per grasp: force closure certified (status ``closure`` and both certificates verified)."""
-        return tuple(r.force.status == "closure" and r.verified for r in self.reports)
+        return tuple(r.certified for r in self.reports)
 
     @property
     def certified_fraction(self) -> float | None:
