@@ -5,7 +5,7 @@ the plane (friction cones have exactly two edges) and a second-order-cone progra
 (exact Lorentz cones, no linearisation). Every verdict carries a certificate that
 :func:`verify` re-checks with exact rational arithmetic, without any solver.
 
->>> from certify import Contact, Grasp, force_closure
+>>> from qualgrasp.certify import Contact, Grasp, force_closure
 >>> g = Grasp((Contact((1, 0), (-1, 0), "point", 0.5), Contact((-1, 0), (1, 0), "point", 0.5)))
 >>> force_closure(g).status
 'closure'

@@ -1,6 +1,6 @@
 """Certify and re-verify whole grasp-set files (JSON Lines or Parquet, chosen by extension).
 
-:func:`certify_file` streams the input in chunks through :mod:`certify.engine` (parallel,
+:func:`certify_file` streams the input in chunks through :mod:`qualgrasp.certify.engine` (parallel,
 resumable); :func:`certify_values` is what happens to one chunk; :func:`verify_file` re-checks a
 results file against its grasps, in parallel, without any solver.
 """
@@ -50,7 +50,7 @@ def certify_file(grasps_path: str | Path, results_path: str | Path, *, method: s
                  dask: str | None = None, resume: bool = False, chunk_size: int = 4096,
                  quality: bool = True, eps_gap: float = 0.01, eps_budget: int = 200_000) -> RunSummary:
     """Certify every grasp of ``grasps_path`` into ``results_path``: one results row per grasp,
-    in input order. See :func:`certify.engine.run` for ``workers``, ``dask``, ``resume`` and
+    in input order. See :func:`qualgrasp.certify.engine.run` for ``workers``, ``dask``, ``resume`` and
     ``chunk_size`` (``workers=None`` uses every core)."""
     options = Options(method=method, quality=quality, eps_gap=eps_gap, eps_budget=eps_budget)
     return run(grasps_path, results_path, options=options, workers=workers, dask=dask,
@@ -127,7 +127,7 @@ def _verify_chunk(grasp_values: list, lines: list[int], rows, tol: Tolerances):
 
 def _verify_tables(grasps, results, lines: list[int], tol: Tolerances):
     """Verify one chunk of aligned Arrow tables: the common certificates are proved in bulk
-    (:func:`certify.recheck.recheck_table`); only the other rows are turned into Python values
+    (:func:`qualgrasp.certify.recheck.recheck_table`); only the other rows are turned into Python values
     and re-checked one by one."""
     from .recheck import recheck_table
 

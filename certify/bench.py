@@ -3,10 +3,10 @@
 For each kind of grasp every route answers force closure, with its certificate, on the same
 grasps (a prefix of them for the slow routes):
 
-* **qualgrasp batch**: :func:`certify.fastpath.certify_table` on an Arrow table of the grasps,
+* **qualgrasp batch**: :func:`qualgrasp.certify.fastpath.certify_table` on an Arrow table of the grasps,
   the path ``qualgrasp certify`` takes on Parquet input, per worker process. It does more than the
   others: force *and* form closure, both certificates and their rigorous re-check (epsilon off).
-* **per-grasp fast route**: :func:`certify.closure.force_closure` with the fast solver.
+* **per-grasp fast route**: :func:`qualgrasp.certify.closure.force_closure` with the fast solver.
 * **clarabel direct**: the same programme through clarabel's API with prebuilt structure.
 * **scipy linprog (HiGHS)**: polyhedral kinds only.
 * **cvxpy + Parameters** (the reference route) and **cvxpy rebuilt per grasp**.
@@ -30,7 +30,7 @@ from .solvers.reference import CvxpySolver
 
 __all__ = ["KINDS", "BenchRow", "run_bench", "print_bench"]
 
-#: name -> keyword arguments of :func:`certify.samples.random_grasp`
+#: name -> keyword arguments of :func:`qualgrasp.certify.samples.random_grasp`
 #: (sizes chosen so that both verdicts are frequent: 17 % to 40 % of the grasps are in closure)
 KINDS = {
     "planar frictionless, 5 contacts": dict(dim=2, n_contacts=5, model="frictionless"),

@@ -1,7 +1,7 @@
 """Certificates of closure verdicts and their independent verification.
 
 A certificate is re-checked against the grasp with exact rational arithmetic on the float data
-(:mod:`certify.exact`) and no solver:
+(:mod:`qualgrasp.certify.exact`) and no solver:
 
 ``interior`` (closure)
     Values ``x`` over the certificate columns ``C`` (generator weights, or world-frame contact

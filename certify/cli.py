@@ -1,7 +1,7 @@
-"""Command-line layer of :mod:`certify`: ``qualgrasp certify``, ``verify`` and ``bench``.
+"""Command-line layer of :mod:`qualgrasp.certify`: ``qualgrasp certify``, ``verify`` and ``bench``.
 
-Each command is a thin wrapper over a public function (:func:`certify.batch.certify_file`,
-:func:`certify.batch.verify_file`, :func:`certify.bench.run_bench`).
+Each command is a thin wrapper over a public function (:func:`qualgrasp.certify.batch.certify_file`,
+:func:`qualgrasp.certify.batch.verify_file`, :func:`qualgrasp.certify.bench.run_bench`).
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Closure verdicts: form closure, force closure and positive spanning, each with a certificate.
 
-Every verdict follows the same steps on the closure programme of :mod:`certify.problem`:
+Every verdict follows the same steps on the closure programme of :mod:`qualgrasp.certify.problem`:
 
 1. Solve for ``t*``. With full rank and ``t* >= tol.margin``: ``closure`` (interior certificate).
    Otherwise, if the dual direction separates (strictly on every contact, or exactly orthogonal
@@ -44,7 +44,7 @@ class Verdict:
     margin : float
         Min-weight margin ``t*`` when in closure, else 0.
     certificate : Certificate
-        Evidence re-checkable by :func:`certify.certificates.verify`.
+        Evidence re-checkable by :func:`qualgrasp.certify.certificates.verify`.
     """
 
     status: str
@@ -108,8 +108,8 @@ def farkas_certificate(C: np.ndarray, blocks, layout: str, y: np.ndarray,
     A ``y`` strictly separating every block is a certificate as it is. Otherwise blocks on which
     ``y`` vanishes (relative to ``rel``) are declared tight and ``y`` is projected off their
     columns; every other block must then be strictly separated (float check with a margin; the
-    exact check is :func:`certify.certificates.verify`). Compiled:
-    :func:`certify.kernels.farkas_direction`.
+    exact check is :func:`qualgrasp.certify.certificates.verify`). Compiled:
+    :func:`qualgrasp.certify.kernels.farkas_direction`.
     """
     from .problem import block_arrays
 
@@ -120,7 +120,7 @@ def farkas_certificate(C: np.ndarray, blocks, layout: str, y: np.ndarray,
 def farkas_from_arrays(C: np.ndarray, arrays, layout: str, y: np.ndarray,
                        rel: float = 1e-7) -> Certificate | None:
     """:func:`farkas_certificate` with the blocks given as ``(kind, first, n, mu, torsion)``
-    arrays (:func:`certify.problem.block_arrays`), as the columnar path holds them."""
+    arrays (:func:`qualgrasp.certify.problem.block_arrays`), as the columnar path holds them."""
     from .kernels import farkas_direction
 
     ok, y, tight = farkas_direction(np.ascontiguousarray(C, dtype=float), *arrays,
@@ -138,7 +138,7 @@ def force_closure(grasp: Grasp, *, method: str = "fast", solver=None, socp: bool
 
     Planar friction cones are exact two-edge cones (an LP); spatial point and soft contacts use
     exact second-order cones (an SOCP). ``method`` is ``'fast'`` or ``'reference'`` (cvxpy); pass a
-    ``solver`` from :func:`certify.solvers.make_solver` to reuse prebuilt structure across calls.
+    ``solver`` from :func:`qualgrasp.certify.solvers.make_solver` to reuse prebuilt structure across calls.
     ``socp=True`` solves a planar grasp with 2-D second-order cones instead of edges (same
     verdict, margin on the cone scale ``mu f_n - abs(f_t)``; a cross-check of the LP).
     """

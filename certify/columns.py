@@ -1,8 +1,8 @@
 """Grasp sets as columns: Arrow grasp tables turned into padded numpy arrays, validated in bulk.
 
-:func:`grasp_columns` reads a grasp table (:data:`certify.table.GRASP_SCHEMA`) into
+:func:`grasp_columns` reads a grasp table (:data:`qualgrasp.certify.table.GRASP_SCHEMA`) into
 :class:`GraspColumns`: one row per grasp, contacts padded to the largest count. Rows that
-:func:`certify.grasp.grasp_from_dict` would accept, under exactly the same rules (normal
+:func:`qualgrasp.certify.grasp.grasp_from_dict` would accept, under exactly the same rules (normal
 normalisation, model defaults, ``mu = 0`` meaning frictionless, default ``center`` and
 ``length``), are marked ``ok`` and carry the values it would store; every other row is left to
 the per-grasp path, which produces the error message.
@@ -29,11 +29,11 @@ class GraspColumns:
     Attributes
     ----------
     ok : (n,) bool
-        Rows valid for the columnar path (the rest go through :mod:`certify.grasp`).
+        Rows valid for the columnar path (the rest go through :mod:`qualgrasp.certify.grasp`).
     dim, count : (n,) int
         Coordinates (2 or 3) and number of contacts.
     P, N : (n, m, 3) float
-        Points and stored normals (unit, as :class:`certify.grasp.Contact` stores them); the
+        Points and stored normals (unit, as :class:`qualgrasp.certify.grasp.Contact` stores them); the
         third coordinate is 0 for planar rows; padding is 0.
     mu, torsion : (n, m) float
     model : (n, m) int
@@ -88,7 +88,7 @@ def _vectors(arr: pa.Array, n: int):
 
 
 def _contact_codes(model: pa.Array, mu_given: np.ndarray) -> np.ndarray:
-    """Model codes as :func:`certify.grasp.grasp_from_dict` reads them: a missing model is
+    """Model codes as :func:`qualgrasp.certify.grasp.grasp_from_dict` reads them: a missing model is
     ``point`` when ``mu`` is given and ``frictionless`` otherwise; -1 for an unknown name."""
     idx = pc.index_in(model, value_set=_NAMES)
     codes = np.asarray(idx.to_numpy(zero_copy_only=False), dtype=float)

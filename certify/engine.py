@@ -1,6 +1,6 @@
 """Resumable, parallel certification of large grasp sets.
 
-The input is read in chunks of a fixed number of grasps (:func:`certify.table.iter_chunks`).
+The input is read in chunks of a fixed number of grasps (:func:`qualgrasp.certify.table.iter_chunks`).
 Each chunk is certified by a worker (local processes by default, or a dask.distributed cluster)
 and its results are written to ``RESULTS.parts/part-NNNNNN.EXT`` under a temporary name, renamed
 atomically when complete (local workers write their own parts; dask workers send their results

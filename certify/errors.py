@@ -1,4 +1,4 @@
-"""Exceptions raised by :mod:`certify`.
+"""Exceptions raised by :mod:`qualgrasp.certify`.
 
 Every error a user can cause derives from :class:`CertifyError`, so a caller can catch one class;
 the subclasses say which kind of input was wrong.
@@ -16,7 +16,7 @@ __all__ = [
 
 
 class CertifyError(Exception):
-    """Base class of every error raised by :mod:`certify`."""
+    """Base class of every error raised by :mod:`qualgrasp.certify`."""
 
 
 class GraspError(CertifyError, ValueError):

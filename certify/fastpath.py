@@ -1,9 +1,9 @@
 """Columnar certification of a chunk of grasps: compiled kernels for whole groups at once.
 
-:func:`certify_table` takes a grasp table (:data:`certify.table.GRASP_SCHEMA`) and returns the
-results table (:data:`certify.table.RESULT_SCHEMA`), row for row equal to what
-:func:`certify.report.certify_grasp` gives grasp by grasp. Valid planar grasps are grouped by
-contact pattern and each group goes through the compiled kernels of :mod:`certify.kernels`:
+:func:`certify_table` takes a grasp table (:data:`qualgrasp.certify.table.GRASP_SCHEMA`) and returns the
+results table (:data:`qualgrasp.certify.table.RESULT_SCHEMA`), row for row equal to what
+:func:`qualgrasp.certify.report.certify_grasp` gives grasp by grasp. Valid planar grasps are grouped by
+contact pattern and each group goes through the compiled kernels of :mod:`qualgrasp.certify.kernels`:
 the LP (the same kernel the per-grasp path calls), the certificate, its rigorous re-check in
 floating point with error bounds, and the exact planar epsilon. Every row the columnar rules do
 not settle (invalid input, spatial grasps, numerically thin or near-degenerate problems, Farkas
@@ -96,7 +96,7 @@ def _layout(models, frictionless: bool):
 
 
 def _planar_kernel(P, N, mu, c, L, models, tol: Tolerances, quality: bool):
-    """:func:`certify.kernels.planar_batch` on grasps sharing the contact models ``models``:
+    """:func:`qualgrasp.certify.kernels.planar_batch` on grasps sharing the contact models ``models``:
     force and form closure (verdict codes, margins, weights, bases, directions) and epsilons."""
     owner, sign = _layout(models, False)
     owner_f, _ = _layout(models, True)
@@ -119,7 +119,7 @@ class PlanarScreen:
     settled : numpy.ndarray
         ``(B,)`` bool: the columnar rules settled the verdict (closure proved, or a strict or
         null-space Farkas certificate proved); unsettled rows (near-degenerate, tight contacts)
-        are what :func:`certify.certify_grasp` decides grasp by grasp.
+        are what :func:`qualgrasp.certify.certify_grasp` decides grasp by grasp.
     margin : numpy.ndarray
         ``(B,)`` min-weight margin ``t*`` of force closure (``-inf`` when infeasible).
     eps_l1, eps_linf : numpy.ndarray
@@ -138,11 +138,11 @@ def planar_screen(P, N, mu, center, length, *, quality: bool = True,
                   tol: Tolerances = Tolerances()) -> PlanarScreen:
     """Force closure and epsilon of many planar grasps sharing one contact pattern, columnar.
 
-    The same compiled kernels as :func:`certify_table` (:func:`certify.kernels.planar_batch`:
+    The same compiled kernels as :func:`certify_table` (:func:`qualgrasp.certify.kernels.planar_batch`:
     min-weight LP by basis enumeration, certificate re-checked in floating point, exact planar
     epsilon), called directly on arrays, without building grasp tables or certificates. Use it
     to screen large candidate sets (a grasp search); a grasp retained is then certified with
-    :func:`certify.certify_grasp`, which decides exactly the rows left unsettled here.
+    :func:`qualgrasp.certify.certify_grasp`, which decides exactly the rows left unsettled here.
 
     Parameters
     ----------
@@ -158,7 +158,7 @@ def planar_screen(P, N, mu, center, length, *, quality: bool = True,
     quality : bool
         Compute the epsilons (otherwise they are 0).
     tol : Tolerances
-        Verdict tolerances (as for :func:`certify.certify_grasp`).
+        Verdict tolerances (as for :func:`qualgrasp.certify.certify_grasp`).
 
     Returns
     -------
@@ -538,7 +538,7 @@ def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(
     """Results table of a grasp table (rows in input order).
 
     ``slow(row_indices) -> list of results rows`` certifies rows grasp by grasp (the per-grasp
-    path of :func:`certify.batch.certify_values`); it receives every row that the columnar rules
+    path of :func:`qualgrasp.certify.batch.certify_values`); it receives every row that the columnar rules
     do not settle.
     """
     cols = grasp_columns(table)

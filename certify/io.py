@@ -1,8 +1,8 @@
 """Reading and writing grasp sets and results, JSON Lines or Parquet by file extension.
 
 Grasp line: ``{"id": "g1", "contacts": [{"p": [x, y], "n": [nx, ny], "model": "point", "mu": 0.5}],
-"center": [cx, cy], "length": 1.0}`` (see :func:`certify.grasp.grasp_from_dict`); Parquet holds
-the same fields (:data:`certify.table.GRASP_SCHEMA`). In JSON Lines, blank lines are skipped and
+"center": [cx, cy], "length": 1.0}`` (see :func:`qualgrasp.certify.grasp.grasp_from_dict`); Parquet holds
+the same fields (:data:`qualgrasp.certify.table.GRASP_SCHEMA`). In JSON Lines, blank lines are skipped and
 line numbers count from 1 and include them; in Parquet the line number is the row number.
 """
 

@@ -1,9 +1,9 @@
 """Compiled kernels (numba) for the hot paths: many small closure programmes at once.
 
 * :func:`lp_enumerate`: the polyhedral min-weight LP by exact basis enumeration (the method of
-  :mod:`certify.solvers.enumeration`), one compiled loop per grasp.
+  :mod:`qualgrasp.certify.solvers.enumeration`), one compiled loop per grasp.
 * :func:`socp_dual_barrier`: the spatial closure SOCP solved through its dual, a barrier method
-  in the ``d = 6`` dual variables (see :mod:`certify.solvers.barrier`).
+  in the ``d = 6`` dual variables (see :mod:`qualgrasp.certify.solvers.barrier`).
 
 Kernels take plain float arrays and return plain arrays; the decisions (closure, Farkas,
 degenerate, fallback) are made by the callers, so that there is one rule for every route.
@@ -551,7 +551,7 @@ def planar_epsilon(W, owner, m, linf):
 @njit(cache=True)
 def _planar_generators(P, N, mu, c, L, owner, sgn, W, E):
     """Generator wrenches ``W`` (3, k) of one planar grasp, with the arithmetic of
-    :func:`certify.wrench.generator_columns` (same operations, same order, so the same floats),
+    :func:`qualgrasp.certify.wrench.generator_columns` (same operations, same order, so the same floats),
     and bounds ``E`` on their distance to the exact values on the same data:
     forces exact for a frictionless generator and within ``gamma_2 (|n_x| + mu |n_y|)`` (resp.
     ``y``) for a friction edge ``n +- mu t``; torque within ``gamma_10 (|dx| a_y + |dy| a_x) / L``
@@ -635,7 +635,7 @@ def null_direction(C):
 def _classify(Wb, Eb, combos, feas, margin, residual_tol, C, D, buf, R, used, lam, y, basis,
               rays, first, zeros2, zeros1, no_tight):
     """Verdict of one planar generator matrix, settled only where the per-grasp rules of
-    :func:`certify.closure.decide` give it without exact arithmetic and the certificate is proved
+    :func:`qualgrasp.certify.closure.decide` give it without exact arithmetic and the certificate is proved
     by the float re-check: 1 closure (``lam``, ``basis``), 2 strict Farkas (``y``), 3 null-space
     Farkas (``y``, fewer than 3 generators), 0 not settled. Returns ``(code, t)``. The block
     layout of the re-check (every generator a ray: ``rays`` 0, ``first`` 0..k-1, ``zeros2``
@@ -803,7 +803,7 @@ def _barrier_terms(y, Pm, T, rk, kappa, K, q, u, psi, Ty):
 
 @njit(cache=True)
 def socp_dual_barrier(Pm, T, rk, kappa, exit_below, gap_tol, max_newton):
-    """The spatial closure SOCP (see :mod:`certify.problem`) through its dual, by a barrier method.
+    """The spatial closure SOCP (see :mod:`qualgrasp.certify.problem`) through its dual, by a barrier method.
 
     Per contact block ``b`` the support of its unit-normal-force wrenches along ``y`` is
     ``c_b(y) = p_b . y + kappa_b norm(T_b y)`` (``p_b`` the normal-force column, ``T_b`` the
@@ -1249,7 +1249,7 @@ def barrier_batch(Pm, T, rk, kappa, exit_below, gap_tol, max_newton):
 def polar_values(C, kind, cols, n, mu, torsion, y):
     """Float polar value ``a_n + mu |a_t|`` (``a_n`` for rays) of each block for the functional
     ``a = C_b' y``: the largest ``y . w`` over the block's unit-normal-force wrenches (the same
-    formula for every route: see :func:`certify.certificates.polar_values`)."""
+    formula for every route: see :func:`qualgrasp.certify.certificates.polar_values`)."""
     d = C.shape[0]
     dim = n.shape[1]
     out = np.empty(kind.shape[0])
@@ -1283,7 +1283,7 @@ def polar_values(C, kind, cols, n, mu, torsion, y):
 
 @njit(cache=True)
 def farkas_direction(C, kind, cols, n, mu, torsion, y, rel):
-    """The rule of :func:`certify.closure.farkas_certificate`, compiled: ``(ok, y, tight)``.
+    """The rule of :func:`qualgrasp.certify.closure.farkas_certificate`, compiled: ``(ok, y, tight)``.
 
     ``y`` is normalised; if every block's polar value is below ``-1e-9 scale`` (``scale`` the
     largest ``abs(C)``) it is a strict certificate. Otherwise blocks whose functional
@@ -1360,7 +1360,7 @@ def farkas_direction(C, kind, cols, n, mu, torsion, y, rel):
 def squeeze_direction(C, cols):
     """The direction orthogonal to the columns ``cols`` of ``C`` (6, k) of two point contacts,
     and whether they span exactly 5 dimensions (smallest singular value at most ``1e-12``,
-    next one above ``1e-6``, of the largest): see :mod:`certify.solvers.squeeze`."""
+    next one above ``1e-6``, of the largest): see :mod:`qualgrasp.certify.solvers.squeeze`."""
     T = np.empty((C.shape[0], cols.shape[0]))
     for c in range(cols.shape[0]):
         T[:, c] = C[:, cols[c]]
@@ -1374,7 +1374,7 @@ def certify_rows(C, E, kind, first, N, mu, torsion, values, y, closure, farkas, 
                  residual_tol):
     """Per row of a batch (B, d, k): for ``closure`` rows choose the basis and prove the
     interior certificate ``values``; for ``farkas`` rows check the strict separation rule of
-    :func:`certify.closure.farkas_certificate` (every polar value below ``-1e-9 scale``) and prove
+    :func:`qualgrasp.certify.closure.farkas_certificate` (every polar value below ``-1e-9 scale``) and prove
     it. Returns codes (1 closure, 2 strict Farkas, 0 not settled) and the bases."""
     B, d, k = C.shape
     code = np.zeros(B, dtype=np.int64)

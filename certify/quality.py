@@ -13,7 +13,7 @@ at most 1). Epsilon is the radius of the largest ball centred at the origin insi
 Torque scaling is explicit: wrenches are ``(f, (p - center) x f / length)``, so epsilon depends on
 ``center`` and ``length`` (every :class:`Epsilon` states both). Scaling the object, the contacts,
 ``center`` and ``length`` together leaves epsilon unchanged; dividing ``length`` by ``s`` multiplies
-the torque coordinates by ``s``. The min-weight margin of :mod:`certify.closure` depends on neither.
+the torque coordinates by ``s``. The min-weight margin of :mod:`qualgrasp.certify.closure` depends on neither.
 
 Planar grasps: the cones are polyhedral, so epsilon is exact: the minimum of ``h`` over a finite
 set of directions that contains every facet normal of the GWS (normals of triples of generator
@@ -118,7 +118,7 @@ def support(system: System, U, norm: str = "L1") -> np.ndarray:
     """Exact support function ``h(u)`` of the GWS at the rows of ``U`` (unit directions).
 
     ``system`` is the certificate system with one block per contact
-    (:func:`certify.problem.grasp_system` with ``socp=True`` for planar friction).
+    (:func:`qualgrasp.certify.problem.grasp_system` with ``socp=True`` for planar friction).
     """
     _check_norm(norm)
     U = np.atleast_2d(np.asarray(U, dtype=float))

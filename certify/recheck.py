@@ -1,12 +1,12 @@
 """Columnar re-check of a results table against its grasps: the independent checker at scale.
 
-:func:`recheck_table` re-checks every row of a results table (:data:`certify.table.RESULT_SCHEMA`)
+:func:`recheck_table` re-checks every row of a results table (:data:`qualgrasp.certify.table.RESULT_SCHEMA`)
 against the grasp table it came from. The common certificates are proved in bulk with the
-rigorous floating-point kernels of :mod:`certify.kernels` (error bounds instead of rationals):
+rigorous floating-point kernels of :mod:`qualgrasp.certify.kernels` (error bounds instead of rationals):
 planar generator certificates (interior, strict Farkas, null space) and spatial ones (interior
 forces, strict Farkas, null-space form certificates). Each row's claims are checked as
-:func:`certify.report.verify_row` checks them (status against certificate kind, closure flags,
-margins). Every row not proved in bulk goes through :func:`certify.report.verify_row`, which uses
+:func:`qualgrasp.certify.report.verify_row` checks them (status against certificate kind, closure flags,
+margins). Every row not proved in bulk goes through :func:`qualgrasp.certify.report.verify_row`, which uses
 exact rational arithmetic; a row fails only if that fails. No solver is involved anywhere.
 """
 
@@ -150,7 +150,7 @@ def _certified_margin(C, kind, first, n, mu, torsion, x) -> float:
 
 def _generator_error(P, N, mu, models, c, L, frictionless, shape) -> np.ndarray:
     """Error bounds of planar or spatial generator columns (see :func:`_planar_generators` and
-    :func:`certify.fastpath._force_column_error`)."""
+    :func:`qualgrasp.certify.fastpath._force_column_error`)."""
     B, d, k = shape
     if d == 3:
         from .fastpath import _layout

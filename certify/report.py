@@ -77,7 +77,7 @@ def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
                   eps_budget: int = 200_000) -> Report:
     """Force closure, form closure, the re-check of both certificates and, with ``quality``,
     the L1 and L-infinity epsilon of ``grasp`` (spatial bounds refined to ``eps_gap`` or
-    ``eps_budget`` cells of directions per norm, see :func:`certify.quality.epsilon`)."""
+    ``eps_budget`` cells of directions per norm, see :func:`qualgrasp.certify.quality.epsilon`)."""
     force = force_closure(grasp, method=method, solver=solver, tol=tol)
     form = force if grasp.frictionless else form_closure(grasp, method=method, solver=solver, tol=tol)
     ok = all(

@@ -103,7 +103,7 @@ def random_grasp_table(seed: int, count: int, *, dim: int = 2, n_contacts: int =
                        model: str = "point", mu: tuple[float, float] = (0.2, 1.0),
                        torsion: tuple[float, float] = (0.05, 0.5), spread: float = 0.7,
                        start: int = 0):
-    """An Arrow grasp table (:data:`certify.table.GRASP_SCHEMA`) of ``count`` random grasps drawn
+    """An Arrow grasp table (:data:`qualgrasp.certify.table.GRASP_SCHEMA`) of ``count`` random grasps drawn
     like :func:`random_grasp` (same distribution, vectorised; not the same draws), ids
     ``r{start}, r{start+1}, ...``; ``center`` and ``length`` left to their defaults."""
     import pyarrow as pa

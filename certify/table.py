@@ -1,11 +1,11 @@
 """Grasp sets and results as Arrow tables: the Parquet schema, and streaming in fixed-size chunks.
 
-Parquet files hold the same schema as the JSON Lines files of :mod:`certify.io`:
+Parquet files hold the same schema as the JSON Lines files of :mod:`qualgrasp.certify.io`:
 
 * grasps: ``id`` (string), ``contacts`` (list of struct ``p``, ``n`` (lists of float64),
   ``model`` (string), ``mu``, ``torsion`` (float64, nullable)), ``center`` (list of float64,
   nullable), ``length`` (float64, nullable);
-* results: the columns of :meth:`certify.report.Report.row`, with ``certificate`` a struct
+* results: the columns of :meth:`qualgrasp.certify.report.Report.row`, with ``certificate`` a struct
   ``{force, form}`` of certificate structs.
 
 The format of a file is chosen by its extension: ``.parquet`` / ``.pq`` for Parquet, anything

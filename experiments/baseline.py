@@ -1,10 +1,10 @@
 """Quantitative baseline: grasps of maximal certified epsilon on a densely sampled boundary.
 
 The baseline sees exactly what the qualitative route sees: the object's contour extracted from the
-image (:func:`boundary`: :func:`qualitative.vision.extract_contour`, resampled and smoothed by
-:func:`qualitative.outline.outline_contour`, inward normals of the smoothed contour), and uses the
-same torque scaling as :func:`qualitative.synthesis.synthesize`: ``center`` = the contour's area
-centroid, ``length`` = its radius (:func:`qualitative.candidates.object_frame`). Epsilons of both
+image (:func:`boundary`: :func:`qualgrasp.qualitative.vision.extract_contour`, resampled and smoothed by
+:func:`qualgrasp.qualitative.outline.outline_contour`, inward normals of the smoothed contour), and uses the
+same torque scaling as :func:`qualgrasp.qualitative.synthesis.synthesize`: ``center`` = the contour's area
+centroid, ``length`` = its radius (:func:`qualgrasp.qualitative.candidates.object_frame`). Epsilons of both
 routes are therefore comparable.
 
 Search (:func:`search`), on ``Budget.samples`` contacts evenly spaced by arc length:
@@ -18,11 +18,11 @@ Search (:func:`search`), on ``Budget.samples`` contacts evenly spaced by arc len
   coordinate ascent: for each finger in turn try every other sample in its place and keep the best
   if it improves epsilon; at most ``Budget.rounds`` rounds.
 
-Every candidate is screened by :func:`certify.fastpath.planar_screen` (the compiled columnar
+Every candidate is screened by :func:`qualgrasp.certify.fastpath.planar_screen` (the compiled columnar
 kernels of certify: force closure proved by the float re-check, exact planar L1 epsilon; 0 when not
 proved). The ``Budget.keep`` best **distinct** candidates (each differing from every better one by
 at least ``Budget.separation`` samples at some finger) are then certified one by one with
-:func:`certify.certify_grasp`; their certified L1 epsilon (0 unless force closure is certified and
+:func:`qualgrasp.certify.certify_grasp`; their certified L1 epsilon (0 unless force closure is certified and
 both certificates re-verify) is what the baseline reports.
 
 Default budget (:class:`Budget`, the study's ``full`` setting): 192 samples; 2 fingers: 18 336
@@ -46,13 +46,13 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from certify import Contact, Grasp, Report, certify_grasp
-from certify.fastpath import planar_screen
-from qualitative.candidates import object_frame
-from qualitative.errors import QualitativeError
-from qualitative.outline import Outline, outline_contour, resample
-from qualitative.synthesis import MU
-from qualitative.vision import ImageSource, extract_contour
+from qualgrasp.certify import Contact, Grasp, Report, certify_grasp
+from qualgrasp.certify.fastpath import planar_screen
+from qualgrasp.qualitative.candidates import object_frame
+from qualgrasp.qualitative.errors import QualitativeError
+from qualgrasp.qualitative.outline import Outline, outline_contour, resample
+from qualgrasp.qualitative.synthesis import MU
+from qualgrasp.qualitative.vision import ImageSource, extract_contour
 
 __all__ = ["MU", "Budget", "Boundary", "BaselineResult", "boundary", "boundary_of", "search",
            "baseline", "screen_grasps"]
@@ -169,8 +169,8 @@ def boundary_of(outline: Outline) -> Boundary:
 def boundary(image: ImageSource, *, threshold: float | None = None, largest: bool = True) -> Boundary:
     """The boundary the qualitative route sees in an image.
 
-    The contour of :func:`qualitative.vision.extract_contour` described by
-    :func:`qualitative.outline.outline_contour` (resampled at 1024 points, smoothed at 0.4 % of the
+    The contour of :func:`qualgrasp.qualitative.vision.extract_contour` described by
+    :func:`qualgrasp.qualitative.outline.outline_contour` (resampled at 1024 points, smoothed at 0.4 % of the
     perimeter). When no well-formed qualitative description exists, the same resampling and
     smoothing are applied without it, so the baseline still runs where the qualitative route
     cannot.
@@ -341,7 +341,7 @@ def baseline(image: ImageSource | Boundary, fingers: int, mu: float | None = MU,
     name : str
         Used in grasp ids ``<name>-base<fingers>-<k>``.
     threshold, largest
-        Segmentation (:func:`qualitative.vision.extract_contour`).
+        Segmentation (:func:`qualgrasp.qualitative.vision.extract_contour`).
 
     Returns
     -------
@@ -366,9 +366,9 @@ def screen_grasps(grasps: Sequence[Grasp]) -> tuple[np.ndarray, np.ndarray]:
     """Certified force closure and L1 epsilon of many planar grasps.
 
     Grasps are grouped by contact pattern and screened columnar
-    (:func:`certify.fastpath.planar_screen`); the rows it does not settle are certified one by one
-    with :func:`certify.certify_grasp`. A grasp counts as certified when force closure is proved
-    (columnar) or certified and verified (per grasp), as in :func:`certify.fastpath.certify_table`.
+    (:func:`qualgrasp.certify.fastpath.planar_screen`); the rows it does not settle are certified one by one
+    with :func:`qualgrasp.certify.certify_grasp`. A grasp counts as certified when force closure is proved
+    (columnar) or certified and verified (per grasp), as in :func:`qualgrasp.certify.fastpath.certify_table`.
 
     Returns
     -------

@@ -1,4 +1,5 @@
-"""The ``qualgrasp`` command: one application, subcommands from every half of the toolkit."""
+"""Command-line layer of :mod:`qualgrasp.experiments`: ``demo``, ``figures``, ``compare`` and
+``silhouettes``; each command is a thin wrapper over a public function."""
 
 from __future__ import annotations
 
@@ -8,17 +9,19 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-import certify.cli
-import qualitative.cli
+__all__ = ["register"]
 
-app = typer.Typer(add_completion=False, no_args_is_help=True,
-                  help="Qualitative grasp synthesis and convex certification of closure grasps.")
-certify.cli.register(app)
-qualitative.cli.register(app)
 console = Console()
 
 
-@app.command("demo")
+def register(app: typer.Typer) -> None:
+    """Add the experiments' commands to the ``qualgrasp`` application."""
+    app.command("demo")(demo_command)
+    app.command("figures")(figures_command)
+    app.command("compare")(compare_command)
+    app.command("silhouettes")(silhouettes_command)
+
+
 def demo_command(out: Path = typer.Option(Path("qualgrasp-demo"), "--out", help="Output folder.")) -> None:
     """Run the main job on the built-in objects and say what was written where.
 
@@ -56,7 +59,6 @@ def demo_command(out: Path = typer.Option(Path("qualgrasp-demo"), "--out", help=
         raise typer.Exit(1)
 
 
-@app.command("figures")
 def figures_command(out: Path = typer.Option(Path("qualgrasp-figures"), "--out", help="Output folder."),
                     formats: str = typer.Option("pdf,png", "--formats",
                                                 help="Comma-separated file formats, e.g. pdf,png,svg.")) -> None:
@@ -77,7 +79,6 @@ def figures_command(out: Path = typer.Option(Path("qualgrasp-figures"), "--out",
 _IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp")
 
 
-@app.command("compare")
 def compare_command(
         folder: Path | None = typer.Argument(None, help="Folder of object images (PNG, JPEG, TIFF, BMP), "
                                                         "one object per image."),
@@ -133,7 +134,6 @@ def compare_command(
         console.print(f"wrote {path}", soft_wrap=True)
 
 
-@app.command("silhouettes")
 def silhouettes_command(out: Path = typer.Option(Path("qualgrasp-silhouettes"), "--out", help="Output folder."),
                         n: int = typer.Option(24, "--n", help="Number of cell outlines."),
                         horse: bool = typer.Option(True, "--horse/--no-horse",
@@ -147,11 +147,3 @@ def silhouettes_command(out: Path = typer.Option(Path("qualgrasp-silhouettes"), 
         console.print(f"[red]{exc}[/red]")
         raise typer.Exit(1) from None
     console.print(f"wrote {len(paths)} images into {out}", soft_wrap=True)
-
-
-def main() -> None:
-    app()
-
-
-if __name__ == "__main__":
-    main()

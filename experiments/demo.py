@@ -1,6 +1,6 @@
 """``qualgrasp demo``: the main job on the built-in objects, end to end.
 
-1. The paper's figures 3 to 8 (:func:`experiments.figures.make_figures`) into ``OUT/figures``.
+1. The paper's figures 3 to 8 (:func:`qualgrasp.experiments.figures.make_figures`) into ``OUT/figures``.
 2. Synthesis on the built-in camera images (polygon, hexagonal nut, circular contour, figure-3
    object): FormGrasp (4 frictionless fingers) and ForceGrasp (2 and 3 fingers, ``mu = 0.5``);
    every grasp written in certify's grasp format (``OUT/grasps/grasps.jsonl``, with the
@@ -9,7 +9,7 @@
    re-checked without a solver -- the same steps as ``qualgrasp synthesize``, ``certify`` and
    ``verify``.
 3. The qualitative-versus-quantitative study on the built-in objects at the ``quick`` setting
-   (:func:`experiments.study.compare`) into ``OUT/study``.
+   (:func:`qualgrasp.experiments.study.compare`) into ``OUT/study``.
 4. ``OUT/report.md``: the headline numbers, with links to everything written.
 """
 
@@ -20,12 +20,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from certify.batch import Summary, certify_file, verify_file
-from certify.engine import RunSummary
-from certify.io import write_grasps
-from certify.samples import textbook_grasps
-from qualitative.objects import render
-from qualitative.synthesis import MU, synthesize
+from qualgrasp.certify.batch import Summary, certify_file, verify_file
+from qualgrasp.certify.engine import RunSummary
+from qualgrasp.certify.io import write_grasps
+from qualgrasp.certify.samples import textbook_grasps
+from qualgrasp.qualitative.objects import render
+from qualgrasp.qualitative.synthesis import MU, synthesize
 
 from .study import BUILTINS, StudyResult, compare, workload
 

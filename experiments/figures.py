@@ -1,12 +1,12 @@
 """The paper's figures 3 to 8, drawn from the project's own computations.
 
 Every figure starts from a synthetic camera image of a built-in object
-(:func:`qualitative.objects.render`, 512 x 512 pixels) and shows what the toolkit computes from it:
+(:func:`qualgrasp.qualitative.objects.render`, 512 x 512 pixels) and shows what the toolkit computes from it:
 the qualitative outline and its canonical string (figure 3), feasible grasp regions (figure 4),
 the zones of freedom of a synthesised FormGrasp grasp contact by contact (figure 5), ForceGrasp
 grasps with two and three fingers and their friction cones (figures 6 and 7), and the
 positive-spanning test on normals (figure 8). Numbers in the titles (strings, angles, margins,
-epsilons) are read from those computations and from :mod:`certify`, never typed in.
+epsilons) are read from those computations and from :mod:`qualgrasp.certify`, never typed in.
 
 Choices
 -------
@@ -20,7 +20,7 @@ Choices
   normal lines cross closest to the object's centroid (:func:`form_example`).
 * Figure 8b replaces the third contact of figure 8a's grasp by the candidate contact (a point of a
   feasible region, away from the other two fingers) that leaves the three normals farthest inside
-  a half-plane, among those for which :func:`certify.certify_grasp` finds no force closure
+  a half-plane, among those for which :func:`qualgrasp.certify.certify_grasp` finds no force closure
   (:func:`spanning_examples`).
 
 Conventions: pixel coordinates of the image (x = column, y = row, y pointing down), so
@@ -43,17 +43,17 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Patch, Polygon as MplPolygon, Wedge
 from shapely.geometry import Polygon as ShapelyPolygon
 
-from certify import Contact, Grasp, Report, Verdict, certify_grasp, positive_span
-from qualitative.candidates import separated
-from qualitative.forcegrasp import GAP, ForceGrasp, friction_zone, positively_spans, span_margin
-from qualitative.formgrasp import zone_steps
-from qualitative.grasp_plot import plot_form_step, plot_grasp
-from qualitative.objects import render
-from qualitative.outline import NAMES, Outline, outline_image
-from qualitative.plot import curvature_handles, plot_outline, plot_regions
-from qualitative.regions import ALPHA, feasible_regions
-from qualitative.synthesis import MU, Synthesis, synthesize
-from qualitative.zones import Zones
+from qualgrasp.certify import Contact, Grasp, Report, Verdict, certify_grasp, positive_span
+from qualgrasp.qualitative.candidates import separated
+from qualgrasp.qualitative.forcegrasp import GAP, ForceGrasp, friction_zone, positively_spans, span_margin
+from qualgrasp.qualitative.formgrasp import zone_steps
+from qualgrasp.qualitative.grasp_plot import plot_form_step, plot_grasp
+from qualgrasp.qualitative.objects import render
+from qualgrasp.qualitative.outline import NAMES, Outline, outline_image
+from qualgrasp.qualitative.plot import curvature_handles, plot_outline, plot_regions
+from qualgrasp.qualitative.regions import ALPHA, feasible_regions
+from qualgrasp.qualitative.synthesis import MU, Synthesis, synthesize
+from qualgrasp.qualitative.zones import Zones
 
 from . import style
 
@@ -126,13 +126,13 @@ class Spanning:
     points, normals : numpy.ndarray
         ``(3, 2)`` contact points and inward unit normals, pixels.
     spans : bool
-        :func:`qualitative.forcegrasp.positively_spans` of the normals (angular-gap rule).
+        :func:`qualgrasp.qualitative.forcegrasp.positively_spans` of the normals (angular-gap rule).
     gap : float
         Largest angular gap between the normals, radians (``spans`` iff below pi).
     certified : Verdict
-        :func:`certify.positive_span` of the normals (linear programme, certificate).
+        :func:`qualgrasp.certify.positive_span` of the normals (linear programme, certificate).
     report : Report
-        :func:`certify.certify_grasp` of the grasp with friction ``mu``.
+        :func:`qualgrasp.certify.certify_grasp` of the grasp with friction ``mu``.
     zone : float
         Area of the friction zone (the cones' intersection), fraction of the object's area.
     """

@@ -34,11 +34,11 @@ Selection rule (deterministic)
 
 Rendering
 ---------
-Each outline is normalised to a unit minimum bounding circle (:func:`qualitative.objects.normalise`)
-and drawn like the built-in objects (:func:`qualitative.objects.render_polygon`: anti-aliased,
+Each outline is normalised to a unit minimum bounding circle (:func:`qualgrasp.qualitative.objects.normalise`)
+and drawn like the built-in objects (:func:`qualgrasp.qualitative.objects.render_polygon`: anti-aliased,
 dark object ``FOREGROUND`` on a light background ``BACKGROUND``), in a 512 x 512 image, its minimum
 bounding circle of radius ``RADIUS * 512`` (about 108 pixels) centred in the image (the fraction
-used for the built-ins, :data:`qualitative.objects.RADIUS`).
+used for the built-ins, :data:`qualgrasp.qualitative.objects.RADIUS`).
 """
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ import shapely
 from scipy import ndimage
 from shapely.geometry import Polygon
 
-from qualitative.objects import normalise, place, render_polygon
+from qualgrasp.qualitative.objects import normalise, place, render_polygon
 
 __all__ = ["MIN_EXTENT", "THIN", "SMOOTHING", "SIZE", "Silhouette", "cells_path", "read_cells",
            "smooth_outline", "select_cells", "horse", "silhouettes", "write_silhouettes"]
@@ -84,7 +84,7 @@ class Silhouette:
         ``cell-NNN-<line>-<treatment>`` (``NNN`` the index in ``cells.txt``) or ``horse``.
     template : shapely.geometry.Polygon
         The outline with a unit minimum bounding circle centred at the origin, positively oriented
-        (:func:`qualitative.objects.normalise`); :func:`qualitative.objects.place` puts it into an
+        (:func:`qualgrasp.qualitative.objects.normalise`); :func:`qualgrasp.qualitative.objects.place` puts it into an
         image.
     source : str
         Where it comes from (package and file).
@@ -99,12 +99,12 @@ class Silhouette:
 
     def polygon(self, size: int = SIZE, rotation: float = 0.0,
                 offset: tuple[float, float] = (0.0, 0.0)) -> Polygon:
-        """Exact geometry in pixels of a ``size`` image (see :func:`qualitative.objects.place`)."""
+        """Exact geometry in pixels of a ``size`` image (see :func:`qualgrasp.qualitative.objects.place`)."""
         return place(self.template, size, rotation, 1.0, offset)
 
     def image(self, size: int = SIZE, rotation: float = 0.0, offset: tuple[float, float] = (0.0, 0.0),
               noise: float = 0.0, seed: int = 0) -> np.ndarray:
-        """``(size, size)`` uint8 synthetic camera image (:func:`qualitative.objects.render_polygon`)."""
+        """``(size, size)`` uint8 synthetic camera image (:func:`qualgrasp.qualitative.objects.render_polygon`)."""
         return render_polygon(self.polygon(size, rotation, offset), size, noise=noise, seed=seed)
 
 

@@ -4,21 +4,21 @@
 
 Routes
 ------
-* qualitative: :func:`qualitative.synthesis.synthesize`, FormGrasp with 4 frictionless fingers and
+* qualitative: :func:`qualgrasp.qualitative.synthesis.synthesize`, FormGrasp with 4 frictionless fingers and
   ForceGrasp with 2 and 3 point contacts at ``mu`` (0.5);
-* baseline: :func:`experiments.baseline.baseline` for the same finger counts and contact models,
+* baseline: :func:`qualgrasp.experiments.baseline.baseline` for the same finger counts and contact models,
   the grasps of largest certified L1 epsilon on a densely sampled boundary (its docstring states
   the search and its budget).
 
 Both see the same contour and use the same torque scaling (object centroid and radius), so their
 L1 epsilons are comparable. A grasp is **certified** when force closure is certified (and its
-certificates re-verify) by :mod:`certify`; uncertified grasps have epsilon 0. ``seconds`` is image
+certificates re-verify) by :mod:`qualgrasp.certify`; uncertified grasps have epsilon 0. ``seconds`` is image
 to certified grasps (vision, search, certification) for both routes.
 
 Robustness model
 ----------------
 The **true object** is the boundary perceived in the unperturbed image
-(:func:`experiments.baseline.boundary`: contour and smoothed inward normals; on the built-in and
+(:func:`qualgrasp.experiments.baseline.boundary`: contour and smoothed inward normals; on the built-in and
 silhouette images it lies within a few hundredths of a pixel of the exact shape, with corners
 rounded at the outline's smoothing scale, 0.4 % of the perimeter). Each perturbation changes the
 image the routes plan on; the plans are then executed on the true object:
@@ -57,7 +57,7 @@ Outputs (in ``out``)
 ``objects.csv``/``.md`` (:data:`OBJECT_COLUMNS`), ``overall.csv``/``.md``
 (:data:`OVERALL_COLUMNS`), ``robustness.csv``/``.md`` (:data:`ROBUSTNESS_COLUMNS`, aggregated) and
 ``robustness-trials.csv`` (one row per route and trial), ``grasps.csv`` (:data:`GRASP_COLUMNS`,
-one row per nominal grasp) and the plots of :mod:`experiments.study_plots` (PNG and PDF).
+one row per nominal grasp) and the plots of :mod:`qualgrasp.experiments.study_plots` (PNG and PDF).
 """
 
 from __future__ import annotations
@@ -73,12 +73,12 @@ from typing import Any, Callable, Iterable, Mapping, Sequence
 import cv2
 import numpy as np
 
-from certify import Contact, Grasp
-from qualitative.errors import QualitativeError
-from qualitative.formgrasp import ray_edges
-from qualitative.objects import NAMES, render
-from qualitative.synthesis import synthesize
-from qualitative.vision import read_image, segment
+from qualgrasp.certify import Contact, Grasp
+from qualgrasp.qualitative.errors import QualitativeError
+from qualgrasp.qualitative.formgrasp import ray_edges
+from qualgrasp.qualitative.objects import NAMES, render
+from qualgrasp.qualitative.synthesis import synthesize
+from qualgrasp.qualitative.vision import read_image, segment
 
 from .baseline import MU, Boundary, Budget, baseline, boundary, screen_grasps
 from .silhouettes import Silhouette
@@ -233,8 +233,8 @@ def subjects(images: Iterable[Any]) -> list[Subject]:
     Parameters
     ----------
     images : iterable
-        Each a built-in object name (:data:`qualitative.objects.NAMES`, rendered at 512 x 512), an
-        image path (name: the file's stem), a :class:`experiments.silhouettes.Silhouette`, a
+        Each a built-in object name (:data:`qualgrasp.qualitative.objects.NAMES`, rendered at 512 x 512), an
+        image path (name: the file's stem), a :class:`qualgrasp.experiments.silhouettes.Silhouette`, a
         :class:`Subject`, a ``(name, array)`` pair or an array (named ``image-<k>``).
 
     Returns

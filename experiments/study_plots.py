@@ -1,6 +1,6 @@
-"""Plots of the comparison study (:mod:`experiments.study`), in the figures' style.
+"""Plots of the comparison study (:mod:`qualgrasp.experiments.study`), in the figures' style.
 
-Every plot is written as PNG and PDF with :func:`experiments.style.save`:
+Every plot is written as PNG and PDF with :func:`qualgrasp.experiments.style.save`:
 
 * ``study-epsilon``: certified L1 epsilon of every certified grasp returned (the baseline returns
   its best few per object), per route, one panel per finger count (boxes: qualitative and

@@ -1,6 +1,6 @@
-"""Tables of the comparison study (:mod:`experiments.study`): aggregation, CSV and Markdown.
+"""Tables of the comparison study (:mod:`qualgrasp.experiments.study`): aggregation, CSV and Markdown.
 
-Column meanings are documented with the column tuples in :mod:`experiments.study`. Empty cells
+Column meanings are documented with the column tuples in :mod:`qualgrasp.experiments.study`. Empty cells
 (CSV) and ``-`` (Markdown) mark values that are undefined (no grasp, no baseline grasp, no trial).
 """
 

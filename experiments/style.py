@@ -1,9 +1,9 @@
-"""The one style of the paper's figures (:mod:`experiments.figures`): fonts, colours, line widths.
+"""The one style of the paper's figures (:mod:`qualgrasp.experiments.figures`): fonts, colours, line widths.
 
 Colours are shared with the plotting helpers so that a symbol, a zone sign or a friction cone has
 the same colour in every figure the project draws: curvature types come from
-:data:`qualitative.plot.STYLE`, zones of freedom and friction cones from
-:mod:`qualitative.grasp_plot`. Settings are applied with :func:`context`, a
+:data:`qualgrasp.qualitative.plot.STYLE`, zones of freedom and friction cones from
+:mod:`qualgrasp.qualitative.grasp_plot`. Settings are applied with :func:`context`, a
 :func:`matplotlib.rc_context`, around building **and** saving a figure (some settings, such as
 the hatch width and the PDF font type, are read only when the figure is drawn), so nothing leaks
 into the caller's matplotlib state. Figures are plain :class:`matplotlib.figure.Figure` objects bound
@@ -22,9 +22,9 @@ from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from qualitative.grasp_plot import CONE, TCOLOR, ZMINUS, ZPLUS
-from qualitative.objects import BACKGROUND, FOREGROUND
-from qualitative.plot import STYLE as CURVATURE
+from qualgrasp.qualitative.grasp_plot import CONE, TCOLOR, ZMINUS, ZPLUS
+from qualgrasp.qualitative.objects import BACKGROUND, FOREGROUND
+from qualgrasp.qualitative.plot import STYLE as CURVATURE
 
 __all__ = ["RC", "DPI", "CURVATURE", "ZPLUS", "ZMINUS", "TCOLOR", "CONE", "GOOD", "BAD", "GRASP_LINE",
            "ZONE", "MEET", "OBJECT", "context", "new_figure", "show_image", "clean", "check_formats", "save"]

@@ -78,7 +78,7 @@ def candidates(outline: Outline, regions: Sequence[Region], step: float = STEP,
     outline : Outline
         The outline the regions belong to (gives the object's size and the sample spacing).
     regions : sequence of Region
-        Feasible regions (:func:`qualitative.regions.feasible_regions`).
+        Feasible regions (:func:`qualgrasp.qualitative.regions.feasible_regions`).
     step : float
         Spacing of the candidates along a region, fraction of the object's size.
     inset : float

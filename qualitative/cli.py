@@ -1,4 +1,4 @@
-"""Command-line layer of :mod:`qualitative`: each command is a thin wrapper over a public function."""
+"""Command-line layer of :mod:`qualgrasp.qualitative`: each command is a thin wrapper over a public function."""
 
 from __future__ import annotations
 
@@ -137,7 +137,7 @@ def synthesize_command(
     """
     import math
 
-    from certify.io import write_grasps
+    from qualgrasp.certify.io import write_grasps
 
     from .errors import QualitativeError
     from .synthesis import synthesize

@@ -1,4 +1,4 @@
-"""Exceptions raised by :mod:`qualitative`.
+"""Exceptions raised by :mod:`qualgrasp.qualitative`.
 
 Every error a user can cause derives from :class:`QualitativeError`; the subclasses say which kind
 of input was wrong. Messages name the problem and, where there is one, the fix.
@@ -22,7 +22,7 @@ __all__ = [
 
 
 class QualitativeError(Exception):
-    """Base class of every error raised by :mod:`qualitative`."""
+    """Base class of every error raised by :mod:`qualgrasp.qualitative`."""
 
 
 class ImageError(QualitativeError, ValueError):

@@ -11,7 +11,7 @@ Two fingers (Nguyen 1988; paper definitions 14-15)
     ``theta_2 = angle(n_2, F_1 - F_2) < theta_min``. A **feasible region pair** holds such a pair,
     one point on each region (the same region twice is allowed: two points of a disc's single
     curve). For each pair of regions we choose, among the candidate points
-    (:mod:`qualitative.candidates`), the pair **farthest from the cone boundaries**: largest margin
+    (:mod:`qualgrasp.qualitative.candidates`), the pair **farthest from the cone boundaries**: largest margin
     ``theta_min - max(theta_1, theta_2)``; among pairs within 1 % of ``theta_min`` of the best, the
     one farthest from the regions' ends. One grasp per region pair.
 

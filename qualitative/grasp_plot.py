@@ -10,7 +10,7 @@
   (figure 8).
 
 Functions draw on a given :class:`matplotlib.axes.Axes` in the image's pixel frame (x = column,
-y = row, y axis pointing down, equal aspect), like :mod:`qualitative.plot`; the figure builders use
+y = row, y axis pointing down, equal aspect), like :mod:`qualgrasp.qualitative.plot`; the figure builders use
 the object-oriented API and the Agg canvas (no pyplot, no display).
 """
 
@@ -78,7 +78,7 @@ def plot_zones(ax: Axes, zones: Zones, bounds: tuple[float, float, float, float]
     ax : matplotlib.axes.Axes
         Where to draw (pixel frame).
     zones : Zones
-        Zones of freedom (:func:`qualitative.zones.zones`).
+        Zones of freedom (:func:`qualgrasp.qualitative.zones.zones`).
     bounds : (xmin, ymin, xmax, ymax)
         Box the unbounded zones are clipped to, pixels.
     size : float
@@ -272,7 +272,7 @@ def synthesis_figure(synth: Synthesis, image: np.ndarray | None = None, count: i
     Parameters
     ----------
     synth : Synthesis
-        Result of :func:`qualitative.synthesis.synthesize`.
+        Result of :func:`qualgrasp.qualitative.synthesis.synthesize`.
     image : numpy.ndarray, optional
         The image, drawn faintly underneath.
     count : int

@@ -749,7 +749,7 @@ def outline_image(src: ImageSource, *, threshold: float | None = None, largest: 
     Parameters
     ----------
     src : str, pathlib.Path or numpy.ndarray
-        Image file or array (see :func:`qualitative.vision.read_image`).
+        Image file or array (see :func:`qualgrasp.qualitative.vision.read_image`).
     threshold : float, optional
         Grey level separating object and background, in the input's units; default Otsu's.
     largest : bool

@@ -131,7 +131,7 @@ def plot_regions(ax: Axes, outline: Outline, regions: Sequence[Region], image: n
     outline : Outline
         The outline the regions belong to.
     regions : sequence of Region
-        Feasible regions (:func:`qualitative.regions.feasible_regions`).
+        Feasible regions (:func:`qualgrasp.qualitative.regions.feasible_regions`).
     image : numpy.ndarray, optional
         Image drawn faintly underneath (pixel frame).
     normals : int

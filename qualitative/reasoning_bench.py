@@ -5,7 +5,7 @@ Rows (one run, wall-clock seconds, best of ``repeats``):
 - ST0 on a random ``n_frames`` trace of three regions: a formula using every operator, and each
   operator on its own, both end to end (reading the relations out of the frames, then the
   dynamic programme) and for the operator alone on relations already read;
-- the naive per-instant evaluator (:func:`qualitative.st0.evaluate_reference`) against the fast
+- the naive per-instant evaluator (:func:`qualgrasp.qualitative.st0.evaluate_reference`) against the fast
   route on a shorter trace, for the ratio;
 - RCC-8 on ``n_regions`` random discs and boxes: reading the network off the geometry, path
   consistency of that network, and path consistency and a consistent scenario after loosening

@@ -128,7 +128,7 @@ def feasible_regions(outline: Outline, alpha: float = ALPHA, finger_width: float
     Parameters
     ----------
     outline : Outline
-        A qualitative outline (:func:`qualitative.outline.outline_image`).
+        A qualitative outline (:func:`qualgrasp.qualitative.outline.outline_image`).
     alpha : float
         Threshold on the bounding-circle diameter ``rho`` of curves, fraction of the object's size
         ``outline.size``; a curve point is feasible when ``rho > alpha * size``.
@@ -199,11 +199,11 @@ def regions_image(src: ImageSource, *, alpha: float = ALPHA, finger_width: float
     Parameters
     ----------
     src : str, pathlib.Path or numpy.ndarray
-        Image file or array (see :func:`qualitative.vision.read_image`).
+        Image file or array (see :func:`qualgrasp.qualitative.vision.read_image`).
     alpha, finger_width, margin : float
         See :func:`feasible_regions` (fractions of the object's size).
     threshold, largest, **options
-        See :func:`qualitative.outline.outline_image`.
+        See :func:`qualgrasp.qualitative.outline.outline_image`.
 
     Returns
     -------

@@ -2,17 +2,17 @@
 
 :func:`synthesize` is the public function behind ``qualgrasp synthesize``:
 
-* ``fingers=4``: FormGrasp (:mod:`qualitative.formgrasp`), frictionless contacts;
-* ``fingers=2`` or ``3``: ForceGrasp (:mod:`qualitative.forcegrasp`), ``point`` contacts with
+* ``fingers=4``: FormGrasp (:mod:`qualgrasp.qualitative.formgrasp`), frictionless contacts;
+* ``fingers=2`` or ``3``: ForceGrasp (:mod:`qualgrasp.qualitative.forcegrasp`), ``point`` contacts with
   Coulomb friction ``mu`` (from ``mu``, or ``mu = tan(theta_min)``).
 
-Every grasp found is converted to a :class:`certify.Grasp` -- contacts in pixels of the input image
+Every grasp found is converted to a :class:`qualgrasp.certify.Grasp` -- contacts in pixels of the input image
 (x = column, y = row) with inward unit normals, ``center`` = the object's area centroid and
 ``length`` = its radius (largest distance from the centroid to the contour), so that epsilons are
 comparable across procedures -- with the id ``<name>-form-0007``, ``<name>-force2-0003`` or
 ``<name>-force3-0001`` and the extra fields ``procedure``, ``fingers``, ``regions`` (indices into
 the feasible regions list) and the procedure's own margin (``zone_depth`` for FormGrasp,
-``cone_margin`` in radians for ForceGrasp). Each is then certified by :func:`certify.certify_grasp`;
+``cone_margin`` in radians for ForceGrasp). Each is then certified by :func:`qualgrasp.certify.certify_grasp`;
 a synthesised grasp that does not certify is a bug of the synthesis, and is reported, not dropped.
 """
 
@@ -26,7 +26,7 @@ from typing import Any, Union
 
 import numpy as np
 
-from certify import Contact, Grasp, Report, certify_grasp
+from qualgrasp.certify import Contact, Grasp, Report, certify_grasp
 
 from .candidates import INSET, PER_REGION, STEP, Candidates, candidates, object_frame
 from .errors import SynthesisError
@@ -160,7 +160,7 @@ def synthesize(image: ImageSource, fingers: int = 2, mu: float | None = None, th
     Parameters
     ----------
     image : str, pathlib.Path or numpy.ndarray
-        Image file or array (see :func:`qualitative.vision.read_image`).
+        Image file or array (see :func:`qualgrasp.qualitative.vision.read_image`).
     fingers : {2, 3, 4}
         2 or 3: ForceGrasp with friction; 4: FormGrasp, frictionless.
     mu : float, optional
@@ -169,19 +169,19 @@ def synthesize(image: ImageSource, fingers: int = 2, mu: float | None = None, th
         Friction cone half-angle, **radians** (``mu = tan(theta_min)``); instead of ``mu``.
     alpha : float
         Curvature threshold of feasible regions, fraction of the object's size
-        (:func:`qualitative.regions.feasible_regions`).
+        (:func:`qualgrasp.qualitative.regions.feasible_regions`).
     name : str, optional
         Name used in grasp ids (default: the file's stem, or ``image`` for an array).
     certify : bool
-        Certify every grasp (:func:`certify.certify_grasp`).
+        Certify every grasp (:func:`qualgrasp.certify.certify_grasp`).
     quality : bool
         With ``certify``, compute the epsilon quality too.
     threshold, largest
-        Segmentation (:func:`qualitative.outline.outline_image`).
+        Segmentation (:func:`qualgrasp.qualitative.outline.outline_image`).
     finger_width, region_margin
-        Feasible regions (:func:`qualitative.regions.feasible_regions`), fractions of the size.
+        Feasible regions (:func:`qualgrasp.qualitative.regions.feasible_regions`), fractions of the size.
     step, inset, per_region
-        Candidate contacts (:func:`qualitative.candidates.candidates`).
+        Candidate contacts (:func:`qualgrasp.qualitative.candidates.candidates`).
     error : float
         FormGrasp: position error (pixels) the grasps must survive.
     margin : float
@@ -196,7 +196,7 @@ def synthesize(image: ImageSource, fingers: int = 2, mu: float | None = None, th
     SynthesisError
         Bad parameters (finger count, friction given for FormGrasp, both ``mu`` and ``theta_min``).
     ImageError, SegmentationError, ContourError
-        Unusable image (see :func:`qualitative.outline.outline_image`).
+        Unusable image (see :func:`qualgrasp.qualitative.outline.outline_image`).
     """
     if fingers not in PROCEDURES:
         raise SynthesisError(f"fingers must be 2 or 3 (ForceGrasp) or 4 (FormGrasp), got {fingers}")

@@ -22,9 +22,9 @@ Conventions
   boolean masks, the array's values for float images; colour is first converted to luminance).
   A given threshold is also the level of the sub-pixel edge; by default the edge is placed
   half-way between the object's and the background's grey levels.
-* Errors: :class:`~qualitative.errors.ImageError` (missing, unreadable, empty or constant image),
-  :class:`~qualitative.errors.SegmentationError` (no object, several objects, object cut by the
-  border), :class:`~qualitative.errors.ContourError` (object smaller than :data:`MIN_AREA`).
+* Errors: :class:`~qualgrasp.qualitative.errors.ImageError` (missing, unreadable, empty or constant image),
+  :class:`~qualgrasp.qualitative.errors.SegmentationError` (no object, several objects, object cut by the
+  border), :class:`~qualgrasp.qualitative.errors.ContourError` (object smaller than :data:`MIN_AREA`).
 """
 
 from __future__ import annotations

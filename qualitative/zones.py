@@ -14,7 +14,7 @@ Intersected over the contacts (no forces involved):
 ``T = {v != 0 : v . n_i >= 0 for all i}``.
 
 The grasp is in first-order form closure iff all three are empty; that is the strict positive
-spanning of the contact wrenches that :func:`certify.form_closure` decides with a linear programme
+spanning of the contact wrenches that :func:`qualgrasp.certify.form_closure` decides with a linear programme
 (a free motion is exactly a Farkas direction of that programme).
 
 Conventions
@@ -55,11 +55,11 @@ the plane through three ``a_i`` (equal values on all three), both signs each. Fo
 is ``sin((G - pi) / 2)``. A zone is ``empty`` when its depth is below ``-tol``, ``nonempty`` above
 ``tol`` and ``degenerate`` in between (empty or non-empty only within rounding of the boundary,
 e.g. three normal lines meeting in a point). ``tol`` defaults to ``1e-7``, the margin tolerance of
-:class:`certify.Tolerances`: on grasps built at known distances from the boundary, every grasp
+:class:`qualgrasp.certify.Tolerances`: on grasps built at known distances from the boundary, every grasp
 the linear programme calls degenerate has a depth below ``1e-7`` in magnitude
 (``tests/test_zones.py`` counts the agreement). The verdict of the grasp is ``closure`` when all
 three zones are empty, ``no_closure`` when one is non-empty, else ``degenerate``, like
-:class:`certify.Verdict`. The depths, their signs, and hence the verdicts do not depend on
+:class:`qualgrasp.certify.Verdict`. The depths, their signs, and hence the verdicts do not depend on
 ``center``; their magnitudes do, through the metric on twists (``L``), which is why a grasp set
 synthesised from one image uses one ``center`` and ``length``.
 """
@@ -76,7 +76,7 @@ import shapely
 from shapely.geometry import MultiPoint
 from shapely.geometry.base import BaseGeometry
 
-from certify.wrench import wrench
+from qualgrasp.certify.wrench import wrench
 
 from .errors import ZoneError
 
@@ -302,7 +302,7 @@ def twist_constraints(points, normals, center=None, length=None) -> tuple[np.nda
 
 
 def unit_wrenches(points, normals, center, length) -> np.ndarray:
-    """The frictionless contacts' wrenches (certify's :func:`certify.wrench.wrench` of the unit
+    """The frictionless contacts' wrenches (certify's :func:`qualgrasp.certify.wrench.wrench` of the unit
     inward normals, torques about ``center`` divided by ``length``), each scaled to unit norm:
     the constraint vectors ``a_i`` of the free twists, ``(..., 3)``."""
     a = wrench(np.asarray(points, dtype=np.float64), np.asarray(normals, dtype=np.float64),
@@ -505,7 +505,7 @@ def zones(points, normals, *, center=None, length=None, tol: float = TOL) -> Zon
 
 
 def grasp_zones(grasp, *, tol: float = TOL) -> Zones:
-    """:func:`zones` of a planar :class:`certify.Grasp`, every contact taken as frictionless,
+    """:func:`zones` of a planar :class:`qualgrasp.certify.Grasp`, every contact taken as frictionless,
     about the grasp's own ``center`` and ``length``."""
     if grasp.dim != 2:
         raise ZoneError("zones of freedom are planar; this grasp is spatial")

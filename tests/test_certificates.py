@@ -5,9 +5,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from certify import Certificate, certify_grasp, force_closure, form_closure, verify
-from certify.bench import KINDS
-from certify.samples import random_grasps, textbook_grasps
+from qualgrasp.certify import Certificate, certify_grasp, force_closure, form_closure, verify
+from qualgrasp.certify.bench import KINDS
+from qualgrasp.certify.samples import random_grasps, textbook_grasps
 
 KIND_GRASPS = {kind: random_grasps(7, 150, **kw) for kind, kw in KINDS.items()}
 
@@ -95,7 +95,7 @@ def test_strict_separation_with_small_products_is_a_certificate():
     # almost concurrent (singular value ratio 7e-8). The dual direction separates every contact
     # strictly, by about 6e-8 only; it used to be read as "all tight" and the verdict came out
     # degenerate with no checkable evidence.
-    from certify import grasp_from_dict
+    from qualgrasp.certify import grasp_from_dict
 
     grasp = grasp_from_dict({"contacts": [
         {"p": [0.08487203384727166, -0.9607936621023784], "n": [-0.32560050505541177, 2.091382879951419],

@@ -5,10 +5,10 @@ import json
 import pytest
 from typer.testing import CliRunner
 
-from certify.batch import certify_file, verify_file
-from certify.io import write_grasps
-from certify.samples import random_grasps, textbook_grasps
-from experiments.cli import app
+from qualgrasp.certify.batch import certify_file, verify_file
+from qualgrasp.certify.io import write_grasps
+from qualgrasp.certify.samples import random_grasps, textbook_grasps
+from qualgrasp.cli import app
 
 runner = CliRunner()
 

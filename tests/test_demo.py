@@ -6,8 +6,8 @@ import re
 import pytest
 from typer.testing import CliRunner
 
-from experiments.cli import app
-from experiments.study import BUILTINS
+from qualgrasp.cli import app
+from qualgrasp.experiments.study import BUILTINS
 
 runner = CliRunner()
 

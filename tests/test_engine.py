@@ -10,10 +10,10 @@ import time
 import pyarrow.parquet as pq
 import pytest
 
-from certify import Grasp
-from certify.batch import certify_file, verify_file
-from certify.io import read_results, write_grasps
-from certify.samples import random_grasps, textbook_grasps
+from qualgrasp.certify import Grasp
+from qualgrasp.certify.batch import certify_file, verify_file
+from qualgrasp.certify.io import read_results, write_grasps
+from qualgrasp.certify.samples import random_grasps, textbook_grasps
 
 BAD = '{"id": "bad", "contacts": [{"p": [0, 0], "n": [0, 0]}]}\n'
 
@@ -59,7 +59,7 @@ def test_parquet_and_jsonl_give_the_same_results(grasp_files, tmp_path):
 
 
 def _start(args, cwd):
-    return subprocess.Popen([sys.executable, "-m", "experiments.cli", *args], cwd=cwd,
+    return subprocess.Popen([sys.executable, "-m", "qualgrasp.cli", *args], cwd=cwd,
                             start_new_session=True, stdout=subprocess.DEVNULL,
                             stderr=subprocess.PIPE)
 
@@ -105,7 +105,7 @@ def test_resume_refuses_other_options(grasp_files, tmp_path):
     parts = tmp_path / "o.jsonl.parts"
     parts.mkdir()
     (parts / "manifest.json").write_text(json.dumps({"chunk_size": 3}))
-    from certify.errors import CertifyError
+    from qualgrasp.certify.errors import CertifyError
 
     with pytest.raises(CertifyError, match="cannot resume"):
         certify_file(jsonl, out, resume=True, quality=False)

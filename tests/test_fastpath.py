@@ -6,15 +6,15 @@ import numpy as np
 import pyarrow as pa
 import pytest
 
-from certify import Contact, Grasp
-from certify.batch import certify_values, verify_file
-from certify.engine import Options
-from certify.table import table_values
-from certify.fastpath import certify_table
-from certify.grasp import grasp_to_dict
-from certify.io import write_rows
-from certify.samples import random_grasp_table, random_grasps, textbook_grasps
-from certify.table import grasps_table, rows_to_table, table_to_rows
+from qualgrasp.certify import Contact, Grasp
+from qualgrasp.certify.batch import certify_values, verify_file
+from qualgrasp.certify.engine import Options
+from qualgrasp.certify.table import table_values
+from qualgrasp.certify.fastpath import certify_table
+from qualgrasp.certify.grasp import grasp_to_dict
+from qualgrasp.certify.io import write_rows
+from qualgrasp.certify.samples import random_grasp_table, random_grasps, textbook_grasps
+from qualgrasp.certify.table import grasps_table, rows_to_table, table_to_rows
 
 
 def _both(table, options):
@@ -90,13 +90,13 @@ def test_bulk_recheck_rejects_tampered_rows(tmp_path):
     """The columnar re-check catches the same tampering as the exact one, planar and spatial."""
     import pyarrow.parquet as pq
 
-    from certify.batch import certify_file
+    from qualgrasp.certify.batch import certify_file
 
     grasps = random_grasps(4, 150, dim=2, n_contacts=3) + [
         Grasp(g.contacts, id=f"s{i}") for i, g in enumerate(
             random_grasps(5, 60, dim=3, n_contacts=3, model="point", spread=0.3))]
     gpath, rpath = tmp_path / "g.parquet", tmp_path / "r.parquet"
-    from certify.io import write_grasps
+    from qualgrasp.certify.io import write_grasps
 
     write_grasps(gpath, grasps)
     certify_file(gpath, rpath, quality=False, chunk_size=64)

@@ -13,16 +13,16 @@ from matplotlib.path import Path as MplPath
 from PIL import Image
 from typer.testing import CliRunner
 
-from experiments import figures, style
-from experiments.cli import app
-from experiments.figures import (STEMS, fig3_outline, fig4_regions, fig5_zones, fig6_two_fingers,
+from qualgrasp.experiments import figures, style
+from qualgrasp.cli import app
+from qualgrasp.experiments.figures import (STEMS, fig3_outline, fig4_regions, fig5_zones, fig6_two_fingers,
                                  fig7_three_fingers, fig8_spanning, form_example, make_figures,
                                  nguyen_example, spanning_examples)
-from qualitative.forcegrasp import friction_zone, nguyen_angles, positively_spans
-from qualitative.objects import render
-from qualitative.outline import outline_image
-from qualitative.regions import feasible_regions
-from qualitative.synthesis import synthesize
+from qualgrasp.qualitative.forcegrasp import friction_zone, nguyen_angles, positively_spans
+from qualgrasp.qualitative.objects import render
+from qualgrasp.qualitative.outline import outline_image
+from qualgrasp.qualitative.regions import feasible_regions
+from qualgrasp.qualitative.synthesis import synthesize
 
 
 @pytest.fixture(scope="module")

@@ -6,15 +6,15 @@ import numpy as np
 import pytest
 import shapely
 
-from certify import Contact, Grasp, force_closure, positive_span
+from qualgrasp.certify import Contact, Grasp, force_closure, positive_span
 from helpers import nguyen
-from qualitative.candidates import candidates, object_frame
-from qualitative.errors import SynthesisError
-from qualitative.forcegrasp import (GAP, MARGIN, friction, friction_cone, friction_zone, nguyen_angles,
+from qualgrasp.qualitative.candidates import candidates, object_frame
+from qualgrasp.qualitative.errors import SynthesisError
+from qualgrasp.qualitative.forcegrasp import (GAP, MARGIN, friction, friction_cone, friction_zone, nguyen_angles,
                                     pair_grasps, positively_spans, span_margin, triplet_grasps)
-from qualitative.objects import render
-from qualitative.outline import outline_image
-from qualitative.regions import feasible_regions
+from qualgrasp.qualitative.objects import render
+from qualgrasp.qualitative.outline import outline_image
+from qualgrasp.qualitative.regions import feasible_regions
 
 THETA = math.atan(0.5)
 

@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 import shapely
 
-from certify import Contact, Grasp, form_closure
-from qualitative.candidates import Candidates, candidates, object_frame
-from qualitative.errors import SynthesisError
-from qualitative.formgrasp import ERROR, GAP, closure_depth4, form_grasps, line_of_action_exit, zone_steps
-from qualitative.objects import render, shape
-from qualitative.outline import outline_image
-from qualitative.regions import feasible_regions
-from qualitative.zones import free_depth, zones
+from qualgrasp.certify import Contact, Grasp, form_closure
+from qualgrasp.qualitative.candidates import Candidates, candidates, object_frame
+from qualgrasp.qualitative.errors import SynthesisError
+from qualgrasp.qualitative.formgrasp import ERROR, GAP, closure_depth4, form_grasps, line_of_action_exit, zone_steps
+from qualgrasp.qualitative.objects import render, shape
+from qualgrasp.qualitative.outline import outline_image
+from qualgrasp.qualitative.regions import feasible_regions
+from qualgrasp.qualitative.zones import free_depth, zones
 
 
 def setup(name, **pose):

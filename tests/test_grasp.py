@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from certify import Contact, Grasp, GraspError, grasp_from_dict, grasp_to_dict
+from qualgrasp.certify import Contact, Grasp, GraspError, grasp_from_dict, grasp_to_dict
 
 
 @pytest.mark.parametrize(

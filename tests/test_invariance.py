@@ -5,9 +5,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from certify import Contact, Grasp, force_closure, form_closure
-from certify.bench import KINDS
-from certify.samples import random_grasp
+from qualgrasp.certify import Contact, Grasp, force_closure, form_closure
+from qualgrasp.certify.bench import KINDS
+from qualgrasp.certify.samples import random_grasp
 from helpers import rotation
 
 kinds = st.sampled_from(list(KINDS))

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from certify import Contact, Grasp, force_closure, verify
-from certify.samples import random_grasps
-from certify.solvers import make_solver
+from qualgrasp.certify import Contact, Grasp, force_closure, verify
+from qualgrasp.certify.samples import random_grasps
+from qualgrasp.certify.solvers import make_solver
 
 from helpers import nguyen
 

@@ -11,12 +11,12 @@ from matplotlib.figure import Figure
 from skimage import data
 from typer.testing import CliRunner
 
-from experiments.cli import app
-from qualitative.errors import QualitativeError
-from qualitative.objects import BACKGROUND, FOREGROUND, NAMES, RADIUS, render, shape
-from qualitative.outline import outline_image
-from qualitative.plot import outline_figure, plot_outline, plot_regions
-from qualitative.regions import feasible_regions
+from qualgrasp.cli import app
+from qualgrasp.qualitative.errors import QualitativeError
+from qualgrasp.qualitative.objects import BACKGROUND, FOREGROUND, NAMES, RADIUS, render, shape
+from qualgrasp.qualitative.outline import outline_image
+from qualgrasp.qualitative.plot import outline_figure, plot_outline, plot_regions
+from qualgrasp.qualitative.regions import feasible_regions
 
 runner = CliRunner()
 

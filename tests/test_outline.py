@@ -10,11 +10,11 @@ from hypothesis import strategies as st
 from skimage import data
 from skimage.transform import rescale, rotate
 
-from qualitative.errors import ContourError, OutlineError
-from qualitative.objects import NAMES, RADIUS, render, shape
-from qualitative.outline import (SYMBOLS, Outline, canonical, is_well_formed, outline_contour,
+from qualgrasp.qualitative.errors import ContourError, OutlineError
+from qualgrasp.qualitative.objects import NAMES, RADIUS, render, shape
+from qualgrasp.qualitative.outline import (SYMBOLS, Outline, canonical, is_well_formed, outline_contour,
                                  outline_image, validate)
-from qualitative.vision import signed_area
+from qualgrasp.qualitative.vision import signed_area
 
 ORDER = "/)(><}{"  # the documented canonical symbol order
 

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from certify import Contact, Grasp, certify_grasp
-from certify.fastpath import planar_screen
+from qualgrasp.certify import Contact, Grasp, certify_grasp
+from qualgrasp.certify.fastpath import planar_screen
 
 
 def _random_batch(rng, m, count):

@@ -10,10 +10,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial import ConvexHull
 
-from certify import Contact, Grasp, force_closure
-from certify.quality import epsilon, epsilon_linearised
-from certify.samples import random_grasp, random_grasps
-from certify.steinitz import boundary_epsilon, efficiency, steinitz_bound
+from qualgrasp.certify import Contact, Grasp, force_closure
+from qualgrasp.certify.quality import epsilon, epsilon_linearised
+from qualgrasp.certify.samples import random_grasp, random_grasps
+from qualgrasp.certify.steinitz import boundary_epsilon, efficiency, steinitz_bound
 from helpers import rotation
 
 
@@ -76,7 +76,7 @@ def test_planar_epsilon_equals_qhull():
         for g in random_grasps(21, 150, dim=2, **kw):
             if force_closure(g).status != "closure":
                 continue
-            from certify.wrench import generator_columns, grasp_arrays
+            from qualgrasp.certify.wrench import generator_columns, grasp_arrays
 
             P, N, mu, _, c, L = grasp_arrays(g)
             W, owner = generator_columns(P, N, mu, tuple(x.model for x in g.contacts), c, L)
@@ -227,7 +227,7 @@ def test_efficiency_never_exceeds_one(seed):
     rng = np.random.default_rng(seed)
     angles = np.sort(rng.uniform(0, 2 * np.pi, 7))
     poly = np.column_stack([np.cos(angles), np.sin(angles)]) * rng.uniform(0.5, 2.0)
-    from certify.steinitz import boundary_contacts
+    from qualgrasp.certify.steinitz import boundary_contacts
 
     cs = boundary_contacts(poly, 0.05, model="point", mu=0.4)
     pick = rng.choice(len(cs), 3, replace=False)

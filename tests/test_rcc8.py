@@ -9,8 +9,8 @@ from shapely import affinity
 from shapely.geometry import LineString, Point, Polygon, box
 from shapely.ops import unary_union
 
-from qualitative.errors import NetworkError, RegionError
-from qualitative.rcc8 import (DE9IM_PATTERNS, RELATIONS, _relation_from_matrix, _relation_tolerant,
+from qualgrasp.qualitative.errors import NetworkError, RegionError
+from qualgrasp.qualitative.rcc8 import (DE9IM_PATTERNS, RELATIONS, _relation_from_matrix, _relation_tolerant,
                               compose, consistent, consistent_scenario, converse, path_consistency,
                               relation, relations_among)
 

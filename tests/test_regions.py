@@ -9,9 +9,9 @@ import shapely
 from shapely.geometry import LineString
 from skimage import data
 
-from qualitative.objects import RADIUS, render, shape
-from qualitative.outline import outline_image
-from qualitative.regions import (ALPHA, FINGER_WIDTH, MARGIN, feasible_regions, regions_image,
+from qualgrasp.qualitative.objects import RADIUS, render, shape
+from qualgrasp.qualitative.outline import outline_image
+from qualgrasp.qualitative.regions import (ALPHA, FINGER_WIDTH, MARGIN, feasible_regions, regions_image,
                                  regions_to_dict)
 
 

@@ -2,8 +2,8 @@
 
 import pytest
 
-from certify.bench import KINDS, compare_routes
-from certify.samples import random_grasps
+from qualgrasp.certify.bench import KINDS, compare_routes
+from qualgrasp.certify.samples import random_grasps
 
 N = 10_000
 

@@ -7,12 +7,12 @@ import pytest
 from hypothesis import given, settings, strategies as st
 from shapely.geometry import Polygon, box
 
-from qualitative.errors import FormulaError, RegionError
-from qualitative.phases import (PHASES, grasp_trace, no_penetration, phase_formulas, phase_sequence,
+from qualgrasp.qualitative.errors import FormulaError, RegionError
+from qualgrasp.qualitative.phases import (PHASES, grasp_trace, no_penetration, phase_formulas, phase_sequence,
                                 phases_of, placement_order)
-from qualitative.rcc8 import path_consistency
-from qualitative.scene import grasp_scene, scene_regions
-from qualitative.st0 import evaluate_file, parse, write_trace
+from qualgrasp.qualitative.rcc8 import path_consistency
+from qualgrasp.qualitative.scene import grasp_scene, scene_regions
+from qualgrasp.qualitative.st0 import evaluate_file, parse, write_trace
 
 RADIUS = 4.0
 SQUARE = box(0, 0, 100, 100)

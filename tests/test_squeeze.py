@@ -4,9 +4,9 @@ about their line. The fast route proves no closure with the pair tight, in close
 import numpy as np
 import pytest
 
-from certify import Contact, Grasp, force_closure, verify
-from certify.problem import grasp_problem
-from certify.solvers.squeeze import squeeze_solution
+from qualgrasp.certify import Contact, Grasp, force_closure, verify
+from qualgrasp.certify.problem import grasp_problem
+from qualgrasp.certify.solvers.squeeze import squeeze_solution
 
 
 def _grasp(R=np.eye(3), shift=np.zeros(3), mu=0.5):

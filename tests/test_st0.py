@@ -8,10 +8,10 @@ import typer
 from hypothesis import given, strategies as st
 from typer.testing import CliRunner
 
-from qualitative.cli import st0_command
-from qualitative.errors import FormulaError, TraceError
-from qualitative.rcc8 import RELATIONS
-from qualitative.st0 import (Always, And, Atom, Const, Historically, Implies, Next, Not, Once, Or,
+from qualgrasp.qualitative.cli import st0_command
+from qualgrasp.qualitative.errors import FormulaError, TraceError
+from qualgrasp.qualitative.rcc8 import RELATIONS
+from qualgrasp.qualitative.st0 import (Always, And, Atom, Const, Historically, Implies, Next, Not, Once, Or,
                              Previous, Since, Sometime, Until, evaluate_file, evaluate_reference,
                              parse, read_trace, write_trace)
 

@@ -11,16 +11,16 @@ import pytest
 import shapely
 from shapely.geometry import Polygon
 
-from certify import Contact, Grasp, certify_grasp
-from certify.quality import epsilon
-from experiments.baseline import Boundary, Budget, baseline, boundary, search
-from experiments.silhouettes import horse, select_cells, write_silhouettes
-from experiments.study import (GRASP_COLUMNS, OBJECT_COLUMNS, OVERALL_COLUMNS, ROBUSTNESS_COLUMNS,
+from qualgrasp.certify import Contact, Grasp, certify_grasp
+from qualgrasp.certify.quality import epsilon
+from qualgrasp.experiments.baseline import Boundary, Budget, baseline, boundary, search
+from qualgrasp.experiments.silhouettes import horse, select_cells, write_silhouettes
+from qualgrasp.experiments.study import (GRASP_COLUMNS, OBJECT_COLUMNS, OVERALL_COLUMNS, ROBUSTNESS_COLUMNS,
                                ROUTES, Settings, compare, execute, perturb, robustness_trial,
                                subjects)
-from qualitative.objects import render, render_polygon, shape
-from qualitative.synthesis import synthesize
-from qualitative.vision import extract_contour, segment
+from qualgrasp.qualitative.objects import render, render_polygon, shape
+from qualgrasp.qualitative.synthesis import synthesize
+from qualgrasp.qualitative.vision import extract_contour, segment
 
 TINY = Budget(samples=48, extend=8, random=300, starts=3, rounds=2, keep=3)
 
@@ -272,7 +272,7 @@ def test_study_result_and_files(study):
 def test_silhouettes_and_compare_commands(tmp_path):
     from typer.testing import CliRunner
 
-    from experiments.cli import app
+    from qualgrasp.cli import app
 
     runner = CliRunner()
     result = runner.invoke(app, ["silhouettes", "--out", str(tmp_path / "sil"), "--n", "2", "--no-horse"])

@@ -11,14 +11,14 @@ from matplotlib.figure import Figure
 from skimage import data
 from typer.testing import CliRunner
 
-from certify import grasp_from_dict
-from certify.io import read_results
-from experiments.cli import app
-from qualitative.candidates import object_frame
-from qualitative.errors import QualitativeError, SynthesisError
-from qualitative.grasp_plot import plot_grasp, synthesis_figure
-from qualitative.objects import render, shape
-from qualitative.synthesis import synthesize
+from qualgrasp.certify import grasp_from_dict
+from qualgrasp.certify.io import read_results
+from qualgrasp.cli import app
+from qualgrasp.qualitative.candidates import object_frame
+from qualgrasp.qualitative.errors import QualitativeError, SynthesisError
+from qualgrasp.qualitative.grasp_plot import plot_grasp, synthesis_figure
+from qualgrasp.qualitative.objects import render, shape
+from qualgrasp.qualitative.synthesis import synthesize
 
 runner = CliRunner()
 OBJECTS = ("polygon", "nut", "figure3", "disc")
@@ -73,7 +73,7 @@ def test_grasp_format(results, name):
 
 
 def _dict(g):
-    from certify import grasp_to_dict
+    from qualgrasp.certify import grasp_to_dict
 
     return grasp_to_dict(g)
 

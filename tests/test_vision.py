@@ -6,9 +6,9 @@ import pytest
 import shapely
 from skimage import data
 
-from qualitative.errors import ContourError, ImageError, QualitativeError, SegmentationError
-from qualitative.objects import render, shape
-from qualitative.vision import MIN_AREA, extract_contour, read_image, segment, signed_area
+from qualgrasp.qualitative.errors import ContourError, ImageError, QualitativeError, SegmentationError
+from qualgrasp.qualitative.objects import render, shape
+from qualgrasp.qualitative.vision import MIN_AREA, extract_contour, read_image, segment, signed_area
 
 
 def _distances(contour, polygon):

@@ -10,10 +10,10 @@ import shapely
 from scipy.optimize import minimize
 from shapely.geometry import Polygon
 
-from certify import Contact, Grasp, form_closure
-from qualitative.errors import QualitativeError, ZoneError
-from qualitative.formgrasp import closure_depth4
-from qualitative.zones import TOL, free_depth, grasp_zones, twist_constraints, zones
+from qualgrasp.certify import Contact, Grasp, form_closure
+from qualgrasp.qualitative.errors import QualitativeError, ZoneError
+from qualgrasp.qualitative.formgrasp import closure_depth4
+from qualgrasp.qualitative.zones import TOL, free_depth, grasp_zones, twist_constraints, zones
 
 # Band used when one route calls a grasp degenerate: the other must be degenerate too, or the case
 # must lie within this band on its own scale (zone depth, or the LP's min-weight margin).

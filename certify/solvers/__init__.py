@@ -1,4 +1,4 @@
-"""Solver routes for the closure programme of :mod:`certify.problem`.
+"""Solver routes for the closure programme of :mod:`qualgrasp.certify.problem`.
 
 Three routes solve the same programme and return a :class:`Solution`:
 
@@ -56,7 +56,7 @@ class FastSolver:
     solution is within :data:`BARRIER_NEAR_ZERO` of the closure boundary, where the
     interior-point solver's sharper duals tell tight contacts apart), except where the
     closed-form squeeze direction of two point contacts proves ``t* = 0``
-    (:func:`certify.solvers.squeeze.squeeze_solution`)."""
+    (:func:`qualgrasp.certify.solvers.squeeze.squeeze_solution`)."""
 
     #: Largest number of bases (``k choose d``) enumerated before handing over to clarabel.
     max_bases = 64

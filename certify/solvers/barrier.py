@@ -1,5 +1,5 @@
 """Spatial closure programmes through their dual, by the compiled barrier method of
-:func:`certify.kernels.socp_dual_barrier`: a few dozen Newton steps in the ``d = 6`` wrench
+:func:`qualgrasp.certify.kernels.socp_dual_barrier`: a few dozen Newton steps in the ``d = 6`` wrench
 coordinates, tens of microseconds per grasp, no solver library call."""
 
 from __future__ import annotations

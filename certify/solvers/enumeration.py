@@ -38,7 +38,7 @@ def bases(k: int, d: int) -> np.ndarray:
 
 
 def enumerate_lp(W: np.ndarray):
-    """Solve a batch of min-weight LPs exactly (compiled kernels of :mod:`certify.kernels`).
+    """Solve a batch of min-weight LPs exactly (compiled kernels of :mod:`qualgrasp.certify.kernels`).
 
     Parameters
     ----------

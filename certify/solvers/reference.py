@@ -1,6 +1,6 @@
 """The readable reference formulation of the closure programme, in cvxpy (CLARABEL backend).
 
-This is the programme of :mod:`certify.problem` written as it reads::
+This is the programme of :mod:`qualgrasp.certify.problem` written as it reads::
 
     maximise t
     subject to  columns @ x == 0, normal @ x == 1,

@@ -10,7 +10,7 @@ with those two contacts tight, and ``t* = 0``.
 
 An interior-point solution near ``t* = 0`` tells tight contacts apart only to the solver's
 accuracy, at a few hundred microseconds a grasp; this rule gives the direction in closed form, so
-:class:`certify.solvers.FastSolver` tries it before handing a near-boundary programme to clarabel.
+:class:`qualgrasp.certify.solvers.FastSolver` tries it before handing a near-boundary programme to clarabel.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ __all__ = ["squeeze_solution", "squeeze_farkas"]
 
 def squeeze_solution(problem: ClosureProblem) -> Solution | None:
     """``t* = 0`` with the squeeze direction of the first pair of point contacts (in index order)
-    that gives a Farkas certificate (:func:`certify.closure.farkas_certificate`) with exactly
+    that gives a Farkas certificate (:func:`qualgrasp.certify.closure.farkas_certificate`) with exactly
     that pair tight; None if no pair does, or the system is not spatial.
 
     ``x`` is not returned: a verdict against closure does not use it.
@@ -42,8 +42,8 @@ def squeeze_solution(problem: ClosureProblem) -> Solution | None:
 
 def squeeze_farkas(C, kind, first, n, mu, torsion) -> np.ndarray | None:
     """The rule on a spatial certificate system given as block arrays
-    (:func:`certify.problem.block_arrays`): the squeeze direction ``y`` (or ``-y``) of the first
-    pair of point blocks for which :func:`certify.closure.farkas_certificate` gives a certificate
+    (:func:`qualgrasp.certify.problem.block_arrays`): the squeeze direction ``y`` (or ``-y``) of the first
+    pair of point blocks for which :func:`qualgrasp.certify.closure.farkas_certificate` gives a certificate
     with exactly that pair tight, else None."""
     points = np.flatnonzero(kind == 1)
     for a, b in combinations(points, 2):

@@ -1,0 +1,36 @@
+"""qualgrasp: qualitative grasp synthesis from images and convex certification of closure grasps.
+
+The package has three halves, each importable on its own:
+
+* :mod:`qualgrasp.certify`: grasps, closure verdicts with re-checkable certificates, quality;
+* :mod:`qualgrasp.qualitative`: vision, qualitative outlines, feasible regions, RCC-8, ST0 and the
+  synthesis procedures;
+* :mod:`qualgrasp.experiments`: the paper's figures, the comparison study, the demo.
+
+The names below are the main API, re-exported from the halves.
+
+Examples
+--------
+>>> import qualgrasp as qg
+>>> g = qg.Grasp((qg.Contact((1, 0), (-1, 0), "point", 0.5),
+...               qg.Contact((-1, 0), (1, 0), "point", 0.5)))
+>>> v = qg.force_closure(g)
+>>> v.status, bool(qg.verify(g, v.certificate, status=v.status, margin=v.margin))
+('closure', True)
+"""
+
+from .certify import (Certificate, Check, Contact, Grasp, Report, Verdict, certify_grasp, force_closure,
+                      form_closure, grasp_from_dict, grasp_to_dict, positive_span, verify)
+from .certify.errors import CertificateError, CertifyError, GraspError, GraspFileError, SolverError
+from .certify.quality import Epsilon, epsilon
+from .qualitative.synthesis import Synthesis, synthesize
+
+__all__ = [
+    "Contact", "Grasp", "grasp_from_dict", "grasp_to_dict",
+    "Verdict", "force_closure", "form_closure", "positive_span",
+    "Certificate", "Check", "verify",
+    "Report", "certify_grasp",
+    "Epsilon", "epsilon",
+    "Synthesis", "synthesize",
+    "CertifyError", "GraspError", "GraspFileError", "CertificateError", "SolverError",
+]
