@@ -65,7 +65,7 @@ def _time(fn, items, progress=None) -> float:
 
 def _batch_seconds(grasps) -> float:
     """Seconds of the columnar batch path on ``grasps`` (table built outside the timing)."""
-    from .engine import Options
+    from .chunk import Options
     from .fastpath import certify_table
     from .grasp import grasp_to_dict
     from .report import certify_grasp

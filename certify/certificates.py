@@ -35,10 +35,12 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from . import cones
 from . import exact as ex
+from ._kernels.cones import polar_values as kernel_polar_values
 from .errors import CertificateError
 from .grasp import Grasp
-from .problem import Block, grasp_system, span_system
+from .problem import Block, block_arrays, grasp_system, span_system
 from .wrench import to_exact
 
 __all__ = [
@@ -128,60 +130,31 @@ class Check:
         return self.ok
 
 
-# --- cone tests, written once for exact (Fraction) and float numbers --------------------------
-
-def _dot(a, b):
-    return sum(x * y for x, y in zip(a, b))
-
+# --- cone tests of a block (the formulas are :mod:`qualgrasp.certify.cones`') --------------------
 
 def strictly_inside(block: Block, v: Sequence) -> bool:
-    """Is the force ``v`` (values on the block's columns) strictly inside the block's cone?"""
-    if block.kind == "ray":
-        return v[0] > 0
-    n, mu = block.n, block.mu
-    f = v[: len(n)]
-    fn, nn, ff = _dot(f, n), _dot(n, n), _dot(f, f)
-    tang = nn * ff - fn * fn  # nn * |f_t|^2
-    if block.kind == "soft":
-        tang += (v[len(n)] * nn / block.torsion) ** 2
-    return fn > 0 and tang < mu * mu * fn * fn
+    """Is the value ``v`` (on the block's columns) strictly inside the block's cone? Exact on
+    Fractions."""
+    return cones.inside(block.cone, v, block.n, block.mu, block.g)
 
 
 def strictly_polar(block: Block, a: Sequence) -> bool:
-    """Is ``a`` (the functional ``y . w`` on the block's columns) in the cone's strict polar,
-    i.e. ``a_n + mu norm(a_t) < 0``, squared to stay rational?"""
-    if block.kind == "ray":
-        return a[0] < 0
-    n, mu = block.n, block.mu
-    an, nn = _dot(a[: len(n)], n), _dot(n, n)
-    tang = nn * _dot(a[: len(n)], a[: len(n)]) - an * an
-    if block.kind == "soft":
-        tang += (a[len(n)] * block.torsion) ** 2
-    return an < 0 and mu * mu * tang < an * an
+    """Is ``a`` (the functional ``y . w`` on the block's columns) in the cone's strict polar?
+    Exact on Fractions."""
+    return cones.polar(block.cone, a, block.n, block.mu, block.g)
 
 
 def slack(block: Block, v: Sequence[float]) -> tuple[float, float]:
-    """Float ``(slack, normal force)`` of a force: ``mu f_n - norm(f_t)`` (``f_n`` for rays)."""
-    if block.kind == "ray":
-        return float(v[0]), float(v[0])
-    n = np.array(block.n, dtype=float) / math.sqrt(_dot(block.n, block.n))
-    f = np.array(v[: len(n)], dtype=float)
-    fn = float(f @ n)
-    ft = list(f - fn * n)
-    if block.kind == "soft":
-        ft.append(float(v[len(n)]) / float(block.torsion))
-    return float(block.mu) * fn - float(np.linalg.norm(ft)), fn
+    """Float ``(slack, normal force)`` of a value on the block (:func:`qualgrasp.certify.cones.slack`)."""
+    return cones.slack(block.cone, v, block.n, block.mu, block.g)
 
 
 def polar_values(C, blocks, y) -> np.ndarray:
-    """Float ``a_n + mu norm(a_t)`` of every block for ``a = C_b' y``: the largest ``y . w`` over
-    the block's unit-normal-force wrenches (compiled; shared by every route)."""
-    from .kernels import polar_values as kernel
-    from .problem import block_arrays
-
+    """Float polar value of every block for ``a = C_b' y``: the largest ``y . w`` over the
+    block's unit-normal-force wrenches (compiled; shared by every route)."""
     C = np.ascontiguousarray(C, dtype=float)
     dim = max((len(b.n) for b in blocks), default=2) or 2
-    return kernel(C, *block_arrays(blocks, dim), np.ascontiguousarray(y, dtype=float))
+    return kernel_polar_values(C, *block_arrays(blocks, dim), np.ascontiguousarray(y, dtype=float))
 
 
 def margin_of(blocks, x) -> float:
@@ -210,7 +183,10 @@ def verify(grasp: Grasp, certificate: Certificate, *, status: str | None = None,
         Check form closure (every contact frictionless) instead of force closure.
     """
     socp = certificate.layout == "forces"  # a planar grasp may be certified by its 2-D cones
-    Cx, blocks, layout = grasp_system(grasp, frictionless=frictionless, socp=socp, exact=True)
+    try:
+        Cx, blocks, layout = grasp_system(grasp, frictionless=frictionless, socp=socp, exact=True)
+    except ValueError as err:  # a layout the grasp's contacts do not have (pads are polyhedral)
+        return Check(False, f"certificate layout {certificate.layout!r}: {err}")
     return verify_system(Cx, blocks, layout, certificate, status=status, margin=margin, tol=tol)
 
 

@@ -26,8 +26,9 @@ from . import exact as ex
 from .certificates import Certificate, Tolerances
 from .errors import GraspError, SolverError
 from .grasp import Grasp
-from .kernels import null_direction, pivot_basis, world_values
-from .problem import ClosureProblem, grasp_problem, grasp_system, span_problem, span_system
+from ._kernels.cones import farkas_direction
+from ._kernels.linalg import null_direction, pivot_basis, world_values
+from .problem import ClosureProblem, block_arrays, grasp_problem, grasp_system, span_problem, span_system
 from .solvers import make_solver
 
 __all__ = ["Verdict", "force_closure", "form_closure", "positive_span", "decide", "farkas_certificate",
@@ -109,20 +110,16 @@ def farkas_certificate(C: np.ndarray, blocks, layout: str, y: np.ndarray,
     ``y`` vanishes (relative to ``rel``) are declared tight and ``y`` is projected off their
     columns; every other block must then be strictly separated (float check with a margin; the
     exact check is :func:`qualgrasp.certify.certificates.verify`). Compiled:
-    :func:`qualgrasp.certify.kernels.farkas_direction`.
+    :func:`qualgrasp.certify._kernels.cones.farkas_direction`.
     """
-    from .problem import block_arrays
-
     dim = max((len(b.n) for b in blocks), default=2) or 2
     return farkas_from_arrays(C, block_arrays(blocks, dim), layout, y, rel)
 
 
 def farkas_from_arrays(C: np.ndarray, arrays, layout: str, y: np.ndarray,
                        rel: float = 1e-7) -> Certificate | None:
-    """:func:`farkas_certificate` with the blocks given as ``(kind, first, n, mu, torsion)``
+    """:func:`farkas_certificate` with the blocks given as ``(cone, first, width, n, mu, g)``
     arrays (:func:`qualgrasp.certify.problem.block_arrays`), as the columnar path holds them."""
-    from .kernels import farkas_direction
-
     ok, y, tight = farkas_direction(np.ascontiguousarray(C, dtype=float), *arrays,
                                     np.ascontiguousarray(y, dtype=float), rel)
     if not ok:

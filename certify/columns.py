@@ -1,80 +1,207 @@
-"""Grasp sets as columns: Arrow grasp tables turned into padded numpy arrays, validated in bulk.
+"""Grasp sets as columns: Arrow tables and parsed JSON values turned into checked, padded arrays.
 
-:func:`grasp_columns` reads a grasp table (:data:`qualgrasp.certify.table.GRASP_SCHEMA`) into
-:class:`GraspColumns`: one row per grasp, contacts padded to the largest count. Rows that
-:func:`qualgrasp.certify.grasp.grasp_from_dict` would accept, under exactly the same rules (normal
-normalisation, model defaults, ``mu = 0`` meaning frictionless, default ``center`` and
-``length``), are marked ``ok`` and carry the values it would store; every other row is left to
-the per-grasp path, which produces the error message.
+:func:`grasp_columns` reads an Arrow grasp table (Parquet, or an in-memory table), and
+:func:`value_columns` a list of parsed JSON values, into the same :class:`GraspColumns`: one row
+per grasp, contacts padded to the largest count, every rule of
+:mod:`qualgrasp.certify.validation` applied once, vectorised, with its messages. The columnar
+kernels take the valid rows from the arrays; :meth:`GraspColumns.grasps` builds
+:class:`qualgrasp.certify.Grasp` objects of any valid rows for the per-grasp route, and
+:meth:`GraspColumns.message` gives the error of an invalid one. Both routes therefore read every
+row under the same rules.
+
+Arrow layouts other tools write are read, not rejected: vectors as ``list``, ``large_list`` or
+``fixed_size_list`` of any float or integer width; dictionary-encoded or large strings; any
+optional field (``model``, ``mu``, ``torsion``, ``width``, ``center``, ``length``, ``id``) absent.
+A column of the wrong kind (strings where numbers belong) makes every row that gives a value in
+it an error naming the field.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any, Sequence
 
 import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
-__all__ = ["FRICTIONLESS", "POINT", "SOFT", "GraspColumns", "grasp_columns"]
+from . import models as registry
+from .grasp import Grasp, grasps_from_checked
+from .validation import (ABSENT, MAX_CONTACTS, UNKNOWN, CheckedGrasps, ContactData, GraspData, check_grasps,
+                         contact_data, grasp_data, param_names, show)
 
-FRICTIONLESS, POINT, SOFT = 0, 1, 2
-_NAMES = pa.array(["frictionless", "point", "soft"])
+__all__ = ["GraspColumns", "grasp_columns", "value_columns"]
 
 
 @dataclass
 class GraspColumns:
-    """Padded arrays of a grasp table (``m`` = the most contacts of a row).
+    """Checked grasps as padded arrays (``m`` = the most contacts of a row).
 
     Attributes
     ----------
+    checked : CheckedGrasps
+        The validation's output (errors, stored values, flattened contacts).
     ok : (n,) bool
-        Rows valid for the columnar path (the rest go through :mod:`qualgrasp.certify.grasp`).
+        Valid rows.
     dim, count : (n,) int
         Coordinates (2 or 3) and number of contacts.
     P, N : (n, m, 3) float
-        Points and stored normals (unit, as :class:`qualgrasp.certify.grasp.Contact` stores them); the
-        third coordinate is 0 for planar rows; padding is 0.
-    mu, torsion : (n, m) float
-    model : (n, m) int
-        Effective model codes (``mu = 0`` is frictionless), -1 for padding.
+        Points and stored normals; the third coordinate is 0 for planar rows; padding is 0.
+    params : dict of str to (n, m) float
+        Model parameters (0 where a model does not take one, and in padding).
+    model, variant : (n, m) int
+        Effective model codes and variants, -1 for padding.
     center : (n, 3) float
     length : (n,) float
-    ids : pyarrow array
+    ids : list or pyarrow.Array
+        Grasp ids (str, int or None; an Arrow array for Arrow input, see :meth:`id_of`).
+    meta : list of dict or None
+        Other top-level fields of each grasp (JSON input).
     """
 
+    checked: CheckedGrasps
     ok: np.ndarray
     dim: np.ndarray
     count: np.ndarray
     P: np.ndarray
     N: np.ndarray
-    mu: np.ndarray
-    torsion: np.ndarray
+    params: dict
     model: np.ndarray
+    variant: np.ndarray
     center: np.ndarray
     length: np.ndarray
-    ids: pa.Array
+    ids: Any
+    meta: list | None = None
 
+    def message(self, i: int) -> str | None:
+        """The error of row ``i`` (None when valid)."""
+        e = self.checked.error[i]
+        return None if e is None else str(e)
+
+    def id_of(self, i: int) -> Any:
+        """The id of row ``i`` (str, int or None)."""
+        value = self.ids[i]
+        return value.as_py() if isinstance(value, pa.Scalar) else value
+
+    def id_column(self, rows: np.ndarray) -> pa.Array:
+        """The results' ``id`` column (strings) of ``rows``."""
+        if isinstance(self.ids, pa.Array):
+            ids = self.ids if len(rows) == len(self.ids) else self.ids.take(pa.array(rows))
+            return ids.cast(pa.string())
+        return pa.array([None if self.ids[i] is None else str(self.ids[i]) for i in rows], pa.string())
+
+    def grasps(self, rows: Sequence[int]) -> list[Grasp]:
+        """:class:`Grasp` objects of the valid ``rows``."""
+        ids = {int(i): self.id_of(i) for i in rows}
+        return grasps_from_checked(self.checked, rows, ids, self.meta)
+
+    def pattern(self) -> np.ndarray:
+        """Group label of every valid row: rows with equal labels share dimension, contact count
+        and each contact's model and variant (the key of the columnar kernels); -1 for invalid
+        rows."""
+        n = len(self.ok)
+        if not self.ok.any():
+            return np.full(n, -1)
+        key = np.concatenate([self.dim[:, None], self.count[:, None], self.model * 8 + self.variant], axis=1)
+        _, label = np.unique(key[self.ok], axis=0, return_inverse=True)
+        out = np.full(n, -1)
+        out[self.ok] = label.ravel()
+        return out
+
+    def models_of(self, row: int) -> tuple[str, ...]:
+        """Model names of the contacts of ``row``."""
+        return tuple(registry.get(int(c)).name for c in self.model[row, : self.count[row]])
+
+    def variants_of(self, row: int) -> tuple[int, ...]:
+        return tuple(int(v) for v in self.variant[row, : self.count[row]])
+
+
+def _padded(checked: CheckedGrasps, count: np.ndarray, ids: list, meta) -> GraspColumns:
+    n = len(count)
+    c = checked.contacts
+    ok = checked.error == None  # noqa: E711  (elementwise)
+    m = int(count.max()) if n else 0
+    total = int(checked.offsets[-1])
+    row = np.repeat(np.arange(n), count)
+    slot = np.arange(total) - np.repeat(checked.offsets[:-1], count)
+    P = np.zeros((n, m, 3))
+    N = np.zeros((n, m, 3))
+    model = np.full((n, m), -1, dtype=np.int64)
+    variant = np.full((n, m), -1, dtype=np.int64)
+    params = {name: np.zeros((n, m)) for name in c.params}
+    if n and total == n * m:  # the common, uniform case
+        P[:], N[:] = c.p.reshape(n, m, 3), c.n.reshape(n, m, 3)
+        model[:], variant[:] = c.model.reshape(n, m), c.variant.reshape(n, m)
+        for name, values in c.params.items():
+            params[name][:] = values.reshape(n, m)
+    else:
+        P[row, slot], N[row, slot] = c.p, c.n
+        model[row, slot], variant[row, slot] = c.model, c.variant
+        for name, values in c.params.items():
+            params[name][row, slot] = values
+    model[~ok] = -1
+    return GraspColumns(checked, ok, checked.dim, np.asarray(count), P, N, params, model, variant,
+                        checked.center, checked.length, ids, meta)
+
+
+def value_columns(values: Sequence[Any]) -> GraspColumns:
+    """Columns of grasps given as parsed JSON values (a value that is an exception, such as a
+    line that did not parse, becomes an error row with its message)."""
+    failed = {i: v for i, v in enumerate(values) if isinstance(v, Exception)}
+    data, contacts = grasp_data([None if i in failed else v for i, v in enumerate(values)])
+    for i, err in failed.items():
+        data.errors[i] = str(err)
+    checked = check_grasps(data, contacts)
+    return _padded(checked, data.count, data.ids, data.meta)
+
+
+# --- Arrow --------------------------------------------------------------------------------------
 
 def _lists(arr: pa.Array):
-    """(offsets from 0, flattened values, row validity) of a possibly sliced list array."""
-    offsets = np.asarray(arr.offsets, dtype=np.int64)
-    offsets = offsets - offsets[0]
-    valid = np.asarray(arr.is_valid(), dtype=bool) if arr.null_count else np.ones(len(arr), bool)
-    return offsets, arr.flatten(), valid
+    """``(offsets from 0 (len + 1,), flattened values, row validity)`` of a list, large list or
+    fixed-size list array (possibly sliced); None when ``arr`` is not a list."""
+    n = len(arr)
+    valid = np.asarray(arr.is_valid(), dtype=bool) if arr.null_count else np.ones(n, bool)
+    if pa.types.is_fixed_size_list(arr.type):
+        size = arr.type.list_size
+        offsets = np.arange(n + 1, dtype=np.int64) * size
+        flat = arr.values.slice(arr.offset * size, n * size)
+        lengths = np.where(valid, size, 0)
+        if not valid.all():  # nulls of a fixed-size list still occupy their slots
+            keep = np.repeat(valid, size)
+            flat = flat.filter(pa.array(keep))
+            offsets = np.concatenate([[0], np.cumsum(lengths)])
+        return offsets, flat, valid
+    if pa.types.is_list(arr.type) or pa.types.is_large_list(arr.type):
+        offsets = np.asarray(arr.offsets, dtype=np.int64)
+        return offsets - offsets[0], arr.flatten(), valid
+    return None
 
 
-def _floats(arr: pa.Array) -> np.ndarray:
-    """Float values of an Arrow array, NaN where null."""
-    return np.asarray(arr.to_numpy(zero_copy_only=False), dtype=float)
+def _floats(arr: pa.Array) -> np.ndarray | None:
+    """Float64 values of a numeric Arrow array (NaN where null), None when not numeric."""
+    if pa.types.is_dictionary(arr.type):
+        arr = arr.dictionary_decode()
+    t = arr.type
+    if not (pa.types.is_floating(t) or pa.types.is_integer(t) or pa.types.is_decimal(t)
+            or pa.types.is_null(t)):
+        return None
+    if pa.types.is_null(t):
+        return np.full(len(arr), np.nan)
+    return np.asarray(arr.cast(pa.float64(), safe=False).to_numpy(zero_copy_only=False), dtype=float)
 
 
 def _vectors(arr: pa.Array, n: int):
-    """Rows of a list<double> array as an (n, 3) array (zero-padded) and their lengths (-1 where
-    the list is null)."""
-    offsets, flat, valid = _lists(arr)
-    lengths = np.diff(offsets)
+    """Rows of a list of numbers as an (n, 3) array (zero-padded) and their lengths (-1 where
+    the list is null, 4 for any longer list); None when ``arr`` is not a list of numbers."""
+    lists = _lists(arr)
+    if lists is None:
+        return None
+    offsets, flat, valid = lists
     values = _floats(flat)
+    if values is None:
+        return None
+    lengths = np.diff(offsets)
     out = np.zeros((n, 3))
     if n and valid.all() and (lengths == lengths[0]).all() and 1 <= lengths[0] <= 3:
         out[:, : lengths[0]] = values.reshape(n, lengths[0])  # the common, uniform case
@@ -84,92 +211,143 @@ def _vectors(arr: pa.Array, n: int):
         cols = np.arange(len(values)) - np.repeat(offsets[:-1], lengths)
         keep = np.repeat(good, lengths)
         out[rows[keep], cols[keep]] = values[keep]
-    return out, np.where(valid, lengths, -1)
+    return out, np.where(valid, np.minimum(lengths, 4), -1)
 
 
-def _contact_codes(model: pa.Array, mu_given: np.ndarray) -> np.ndarray:
-    """Model codes as :func:`qualgrasp.certify.grasp.grasp_from_dict` reads them: a missing model is
-    ``point`` when ``mu`` is given and ``frictionless`` otherwise; -1 for an unknown name."""
-    idx = pc.index_in(model, value_set=_NAMES)
-    codes = np.asarray(idx.to_numpy(zero_copy_only=False), dtype=float)
-    missing = np.asarray(model.is_null(), dtype=bool)
-    codes = np.where(np.isnan(codes), -1, codes).astype(np.int64)
-    return np.where(missing, np.where(mu_given, POINT, FRICTIONLESS), codes)
+def _strings(arr: pa.Array) -> pa.Array | None:
+    """A string array (dictionary-decoded, large strings cast), None when not strings."""
+    if pa.types.is_dictionary(arr.type):
+        arr = arr.dictionary_decode()
+    if pa.types.is_null(arr.type):
+        return pa.nulls(len(arr), pa.string())
+    if pa.types.is_string(arr.type):
+        return arr
+    if pa.types.is_large_string(arr.type) or getattr(pa.types, "is_string_view", lambda t: False)(arr.type):
+        return arr.cast(pa.string())
+    return None
+
+
+def _type_error(data, rows: np.ndarray, message: str) -> None:
+    """Record ``message`` for the ``rows`` of ``data`` without an error yet."""
+    for j in np.flatnonzero(rows):
+        if data.errors[j] is None:
+            data.errors[j] = message
+
+
+def _arrow_contacts(flat: pa.Array) -> ContactData:
+    """Contacts of a flattened ``contacts`` column (struct per contact) as :class:`ContactData`."""
+    k = len(flat)
+    data = ContactData.empty(k)
+    data.errors = np.full(k, None, dtype=object)
+    if not pa.types.is_struct(flat.type):
+        _type_error(data, np.ones(k, bool), f"expected an object with keys p, n, model, ..., got a "
+                                           f"{flat.type} value")
+        return data
+    fields = {f.name: flat.field(i) for i, f in enumerate(flat.type)}
+    row_null = np.asarray(flat.is_null(), dtype=bool) if flat.null_count else np.zeros(k, bool)
+    _type_error(data, row_null, "expected an object with keys p, n, model, ..., got null")
+    for key in ("p", "n"):
+        if key not in fields:
+            _type_error(data, ~row_null, f"{key}: missing (no '{key}' field in the contacts)")
+            continue
+        got = _vectors(fields[key], k)
+        if got is None:
+            _type_error(data, np.asarray(fields[key].is_valid(), bool),
+                        f"{key}: expected 2 (planar) or 3 (spatial) finite numbers, got a "
+                        f"{fields[key].type} value")
+            continue
+        vec, lengths = got
+        if key == "p":
+            data.p, data.plen = vec, lengths
+        else:
+            data.n, data.nlen = vec, lengths
+    bad_len = (data.plen == 4) | (data.nlen == 4) | (data.plen == 1) | (data.nlen == 1) | \
+        (data.plen == 0) | (data.nlen == 0)
+    for j in np.flatnonzero(bad_len):
+        key = "p" if data.plen[j] in (0, 1, 4) else "n"
+        if data.errors[j] is None:
+            data.errors[j] = (f"{key}: expected 2 (planar) or 3 (spatial) finite numbers, got "
+                              f"{show((fields[key][j]).as_py())}")
+    if "model" in fields:
+        names = _strings(fields["model"])
+        if names is None:
+            _type_error(data, np.asarray(fields["model"].is_valid(), bool),
+                        f"model: expected one of {', '.join(map(repr, registry.names()))}, got a "
+                        f"{fields['model'].type} value")
+        else:
+            idx = pc.index_in(names, value_set=pa.array(registry.names()))
+            codes = np.asarray(idx.to_numpy(zero_copy_only=False), dtype=float)
+            given = np.asarray(names.is_valid(), dtype=bool)
+            data.model = np.where(given, np.where(np.isnan(codes), UNKNOWN, codes), ABSENT).astype(np.int64)
+            data.names = names
+    for name in data.params:
+        if name not in fields:
+            continue
+        values = _floats(fields[name])
+        if values is None:
+            _type_error(data, np.asarray(fields[name].is_valid(), bool),
+                        f"{name}: expected a number, got a {fields[name].type} value")
+            continue
+        given = np.asarray(fields[name].is_valid(), dtype=bool)
+        data.params[name] = np.where(given, values, np.nan)
+        data.given[name] = given
+    return data
 
 
 def grasp_columns(table: pa.Table) -> GraspColumns:
-    """Columns of a grasp table, with the rows the columnar path may take marked ``ok``."""
+    """Checked columns of an Arrow grasp table (any of the layouts in the module docstring)."""
     table = table.combine_chunks()
     n = table.num_rows
-    ids = table.column("id").combine_chunks() if "id" in table.column_names else pa.nulls(n, pa.string())
-    contacts = table.column("contacts").combine_chunks()
-    offsets, flat, valid_row = _lists(contacts)
-    count = np.diff(offsets)
-    total = int(offsets[-1]) if n else 0
-    child = dict(zip([f.name for f in flat.type], flat.flatten()))
-    p, plen = _vectors(child["p"], total)
-    nn, nlen = _vectors(child["n"], total)
-    mu_raw = _floats(child["mu"])
-    tor_raw = _floats(child["torsion"])
-    mu_given = ~np.isnan(mu_raw)
-    codes = _contact_codes(child["model"], mu_given)
-
-    # per-contact validity, mirroring certify.grasp.Contact
-    good = (plen >= 2) & (plen <= 3) & (nlen == plen)
-    good &= np.isfinite(p).all(1) & np.isfinite(nn).all(1)
-    norm = np.sqrt((nn * nn).sum(1))
-    good &= norm >= 1e-9
-    good &= codes >= 0
-    mu = np.where(mu_given, mu_raw, 0.0)
-    good &= np.isfinite(mu) & (mu >= 0)
-    good &= ~((codes == FRICTIONLESS) & (mu != 0))
-    tor_given = ~np.isnan(tor_raw)
-    good &= ~((codes != SOFT) & tor_given)
-    good &= ~((codes == SOFT) & ((plen != 3) | ~tor_given | ~(tor_raw > 0) | ~np.isfinite(tor_raw)))
-    codes = np.where(mu == 0, FRICTIONLESS, codes)
-    torsion = np.where(codes == SOFT, np.nan_to_num(tor_raw), 0.0)
-    unit = np.abs(norm - 1.0) <= 1e-12  # unit normals are kept as given, others normalised
-    with np.errstate(invalid="ignore", divide="ignore"):
-        nstored = np.where(unit[:, None], nn, nn / norm[:, None])
-
-    row = np.repeat(np.arange(n), count)
-    ok = valid_row & (count >= 1)
-    ok[row[~good]] = False
-    dim = np.zeros(n, dtype=np.int64)
-    has = count > 0
-    dim[has] = plen[offsets[:-1][has]]
-    ok[row[plen != dim[row]]] = False
-
-    m = int(count.max()) if n else 0
-    P = np.zeros((n, m, 3))
-    N = np.zeros((n, m, 3))
-    MU = np.zeros((n, m))
-    TOR = np.zeros((n, m))
-    MODEL = np.full((n, m), -1, dtype=np.int64)
-    if n and (count == m).all():
-        P[:], N[:] = p.reshape(n, m, 3), nstored.reshape(n, m, 3)
-        MU[:], TOR[:], MODEL[:] = mu.reshape(n, m), torsion.reshape(n, m), codes.reshape(n, m)
+    names = table.column_names
+    data = GraspData(np.zeros(n, dtype=np.int64), np.zeros((n, 3)), np.full(n, -1), np.full(n, np.nan),
+                     np.zeros(n, dtype=bool), [None] * n, np.full(n, None, dtype=object), None)
+    ids = [None] * n
+    if "id" in names:
+        col = table.column("id").combine_chunks()
+        if pa.types.is_dictionary(col.type):
+            col = col.dictionary_decode()
+        if pa.types.is_integer(col.type) or _strings(col) is not None or pa.types.is_null(col.type):
+            ids = _strings(col) if _strings(col) is not None else col
+        else:
+            _type_error(data, np.asarray(col.is_valid(), bool),
+                        f"id: expected a string or an integer, got a {col.type} value")
+    contacts = None
+    if "contacts" not in names:
+        _type_error(data, np.ones(n, bool), "contacts: missing (no 'contacts' column)")
     else:
-        slot = np.arange(total) - np.repeat(offsets[:-1], count)
-        P[row, slot], N[row, slot] = p, nstored
-        MU[row, slot], TOR[row, slot], MODEL[row, slot] = mu, torsion, codes
-
-    if "center" in table.column_names:
-        center, clen = _vectors(table.column("center").combine_chunks(), n)
-    else:
-        center, clen = np.zeros((n, 3)), np.full(n, -1)
-    center_given = clen >= 0
-    ok &= ~center_given | ((clen == dim) & np.isfinite(center).all(1))
-    if not center_given.all():
-        # default centre: mean of the points, as Grasp computes it (sum in contact order / count)
-        centroid = P.sum(1) / np.maximum(count, 1)[:, None]
-        center = np.where(center_given[:, None], center, centroid)
-    length = _floats(table.column("length")) if "length" in table.column_names else np.full(n, np.nan)
-    length_given = ~np.isnan(length)
-    ok &= ~length_given | (np.isfinite(length) & (length > 0))
-    if not length_given.all():
-        # default length: the largest distance from the centre to a contact
-        reach = np.sqrt(((P - center[:, None, :]) ** 2).sum(2))
-        reach = np.where(MODEL >= 0, reach, 0.0).max(1) if m else np.zeros(n)
-        length = np.where(length_given, length, np.where(reach > 0, reach, 1.0))
-    return GraspColumns(ok, dim, count, P, N, MU, TOR, MODEL, center, length, ids)
+        col = table.column("contacts").combine_chunks()
+        lists = _lists(col)
+        if lists is None:
+            _type_error(data, np.ones(n, bool), f"contacts: expected a list of contacts, got a {col.type} column")
+        else:
+            offsets, flat, valid = lists
+            data.count = np.diff(offsets)
+            _type_error(data, ~valid, "contacts: missing (a grasp needs a 'contacts' list)")
+            for i in np.flatnonzero(data.count > MAX_CONTACTS):
+                data.errors[i] = data.errors[i] or (f"contacts: {data.count[i]} contacts, more than the "
+                                                    f"limit of {MAX_CONTACTS}")
+            contacts = _arrow_contacts(flat)
+    if contacts is None:
+        data.count[:] = 0
+        contacts = ContactData.empty(0)
+        contacts.errors = np.full(0, None, dtype=object)
+    if "center" in names:
+        got = _vectors(table.column("center").combine_chunks(), n)
+        if got is None:
+            col = table.column("center")
+            _type_error(data, np.asarray(col.is_valid(), bool),
+                        f"center: expected 2 (planar) or 3 (spatial) finite numbers, got a {col.type} value")
+        else:
+            data.center, data.clen = got
+            for i in np.flatnonzero(np.isin(data.clen, (0, 1, 4))):
+                data.errors[i] = data.errors[i] or "center: expected 2 (planar) or 3 (spatial) finite numbers"
+    if "length" in names:
+        col = table.column("length").combine_chunks()
+        values = _floats(col)
+        if values is None:
+            _type_error(data, np.asarray(col.is_valid(), bool), f"length: expected a number, got a {col.type} value")
+        else:
+            data.length_given = np.asarray(col.is_valid(), dtype=bool)
+            data.length = np.where(data.length_given, values, np.nan)
+    checked = check_grasps(data, contacts)
+    return _padded(checked, data.count, ids, None)

@@ -30,24 +30,14 @@ from pathlib import Path
 from typing import Any, Callable
 
 import pyarrow as pa
-import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
+from .chunk import Options, certify_chunk_results, status_counts
 from .errors import CertifyError, GraspFileError
-from .table import (RESULT_SCHEMA, RESULT_WRITE_OPTIONS, Chunk, chunk_values, count_grasps, is_parquet,
-                    iter_chunks, table_values)
+from .results import RESULT_SCHEMA, RESULT_WRITE_OPTIONS
+from .table import Chunk, count_grasps, is_parquet, iter_chunks, rows_to_table, table_to_rows
 
-__all__ = ["Options", "RunSummary", "run", "certify_chunk"]
-
-
-@dataclass(frozen=True)
-class Options:
-    """What is computed for every grasp (recorded in the manifest; part of a chunk's identity)."""
-
-    method: str = "fast"
-    quality: bool = True
-    eps_gap: float = 0.01
-    eps_budget: int = 200_000
+__all__ = ["RunSummary", "run", "certify_chunk"]
 
 
 @dataclass
@@ -75,24 +65,6 @@ class RunSummary:
         self.unverified += unverified
 
 
-def certify_chunk_results(chunk: Chunk, options: Options):
-    """Results of ``chunk``: an Arrow table for Parquet input (columnar path), a list of rows
-    for JSON Lines input (per-grasp path)."""
-    from .batch import certify_values
-
-    if not isinstance(chunk.rows, pa.Table):
-        return list(certify_values(chunk_values(chunk), chunk.lines, options))
-    from .fastpath import certify_table
-
-    table = chunk.rows
-
-    def slow(idx):
-        values = table_values(table.take(pa.array(idx)))
-        return list(certify_values(values, [chunk.lines[i] for i in idx], options))
-
-    return certify_table(table, chunk.lines, options, slow=slow)
-
-
 _IPC = pa.ipc.IpcWriteOptions(compression="lz4")
 
 
@@ -107,8 +79,6 @@ def _read_part(path: Path) -> pa.Table:
 
 
 def _write_part(results, path: Path) -> None:
-    from .table import rows_to_table, table_to_rows
-
     tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")  # writers never share a temporary
     if path.suffix == ".arrow":
         table = results if isinstance(results, pa.Table) else rows_to_table(results)
@@ -135,26 +105,16 @@ def _finish(results, part: Path) -> tuple[dict[str, int], int]:
     """Write a chunk's results to ``part`` atomically; its status counts and unverified count."""
     _write_part(results, part)
     if isinstance(results, pa.Table):
-        return _counts(results.column("status"), results.column("verified"))
-    return _counts([r["status"] for r in results], [r["verified"] for r in results])
+        return status_counts(results.column("status"), results.column("verified"))
+    return status_counts([r["status"] for r in results], [r["verified"] for r in results])
 
 
-def _counts(statuses, verified) -> tuple[dict[str, int], int]:
-    """Rows per status, and rows (not errors) whose certificates were not verified (Arrow
-    columns or lists)."""
-    status = pa.array(statuses, pa.string()) if isinstance(statuses, list) else statuses
-    ok = pa.array(verified, pa.bool_()) if isinstance(verified, list) else verified
-    counts = {d["values"]: d["counts"] for d in pc.value_counts(status).to_pylist()}
-    bad = pc.and_(pc.not_equal(status, "error"), pc.invert(pc.fill_null(ok, False)))
-    return counts, int(pc.sum(bad).as_py() or 0)
-
-
-def _part_counts(part: Path) -> tuple[dict[str, int], int]:
+def _partstatus_counts(part: Path) -> tuple[dict[str, int], int]:
     if part.suffix == ".arrow":
         t = _read_part(part)
-        return _counts(t.column("status"), t.column("verified"))
+        return status_counts(t.column("status"), t.column("verified"))
     rows = [json.loads(line) for line in part.read_text(encoding="utf-8").splitlines()]
-    return _counts([r["status"] for r in rows], [r["verified"] for r in rows])
+    return status_counts([r["status"] for r in rows], [r["verified"] for r in rows])
 
 
 def _manifest(grasps: Path, results: Path, chunk_size: int, options: Options) -> dict:
@@ -335,7 +295,7 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
             n_chunks += 1
             part = parts / _part_name(chunk.index, results)
             if part.exists():
-                summary.add(*_part_counts(part))
+                summary.add(*_partstatus_counts(part))
                 summary.resumed_chunks += 1
             elif pool is None:
                 _, counts, unverified = certify_chunk(chunk, options, str(part))

@@ -1,33 +1,51 @@
 """Columnar certification of a chunk of grasps: compiled kernels for whole groups at once.
 
-:func:`certify_table` takes a grasp table (:data:`qualgrasp.certify.table.GRASP_SCHEMA`) and returns the
-results table (:data:`qualgrasp.certify.table.RESULT_SCHEMA`), row for row equal to what
-:func:`qualgrasp.certify.report.certify_grasp` gives grasp by grasp. Valid planar grasps are grouped by
-contact pattern and each group goes through the compiled kernels of :mod:`qualgrasp.certify.kernels`:
-the LP (the same kernel the per-grasp path calls), the certificate, its rigorous re-check in
-floating point with error bounds, and the exact planar epsilon. Every row the columnar rules do
-not settle (invalid input, spatial grasps, numerically thin or near-degenerate problems, Farkas
-directions with tight contacts, certificates the float re-check cannot prove) goes through the
-per-grasp path, so the two agree by construction.
+:func:`certify_table` takes a grasp table (any layout :func:`qualgrasp.certify.columns.grasp_columns`
+reads) and returns the results table (:data:`qualgrasp.certify.results.RESULT_SCHEMA`), row for
+row equal to what :func:`qualgrasp.certify.certify_grasp` gives grasp by grasp. Valid grasps are
+grouped by contact pattern (dimension, contact count, each contact's model and variant):
+
+* planar groups go through :func:`qualgrasp.certify._kernels.planar.planar_batch`: the LP (the
+  same kernel the per-grasp path calls), the certificate, its rigorous re-check in floating point
+  with error bounds, and the exact planar epsilon;
+* spatial groups through the compiled dual barrier method over exact cones, with clear verdicts
+  proved columnar, and near-boundary rows decided by the per-grasp rules on the arrays already
+  built (the squeeze rule, then clarabel); form closure with six or more contacts by the fast
+  solver's own route.
+
+Every row these rules do not settle (invalid input, numerically thin or near-degenerate problems,
+certificates the float re-check cannot prove, spatial rows that need the epsilon) goes through
+the per-grasp path, so the two agree by construction.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from math import comb
 
 import numpy as np
 import pyarrow as pa
 
-from .certificates import Tolerances
-from .columns import FRICTIONLESS, POINT, SOFT, GraspColumns, grasp_columns
-from .kernels import planar_batch
-from .solvers.enumeration import _FEAS, bases
-from .table import CERTIFICATE, RESULT_SCHEMA
+from ._kernels.barrier import barrier_batch
+from ._kernels.linalg import projection_bound, world_values
+from ._kernels.planar import planar_batch
+from ._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
+from .certificates import Tolerances, verify
+from .closure import decide, farkas_from_arrays
+from .columns import GraspColumns, grasp_columns
+from .cones import LORENTZ, cone_code
+from .grasp import Contact, Grasp
+from .problem import Block, ClosureProblem, System, conic_columns, grasp_problem, grasp_system
+from .results import CERTIFICATE, RESULT_SCHEMA, result_table
+from .solvers import BARRIER_NEAR_ZERO, FastSolver, make_solver
+from .solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
+from .solvers.enumeration import FEAS, bases
+from .solvers.squeeze import squeeze_farkas
+from .table import rows_to_table
+from . import models as registry
+from .wrench import force_column_errors, force_columns, generator_columns, generator_layout
 
 __all__ = ["certify_table", "PlanarScreen", "planar_screen"]
-
-_MODEL_NAMES = {FRICTIONLESS: "frictionless", POINT: "point"}
 
 
 _STATUS = pa.array(["no_closure", "closure"])
@@ -83,28 +101,19 @@ def _certificates(code: np.ndarray, lam: np.ndarray, basis: np.ndarray, y: np.nd
     ], fields=list(CERTIFICATE))
 
 
-def _layout(models, frictionless: bool):
-    """Owner contact and edge sign of each generator (as :func:`generator_columns` orders them)."""
-    owner, sign = [], []
-    for i, model in enumerate(models):
-        if frictionless or model == "frictionless":
-            owner.append(i), sign.append(0)
-        else:
-            owner += [i, i]
-            sign += [1, -1]
-    return np.array(owner, dtype=np.int64), np.array(sign, dtype=np.float64)
-
-
-def _planar_kernel(P, N, mu, c, L, models, tol: Tolerances, quality: bool):
-    """:func:`qualgrasp.certify.kernels.planar_batch` on grasps sharing the contact models ``models``:
-    force and form closure (verdict codes, margins, weights, bases, directions) and epsilons."""
-    owner, sign = _layout(models, False)
-    owner_f, _ = _layout(models, True)
-    same = all(name == "frictionless" for name in models)
+def _planar_kernel(P, N, mu, width, c, L, models, variants, tol: Tolerances, quality: bool):
+    """:func:`qualgrasp.certify._kernels.planar.planar_batch` on grasps sharing the contact models
+    and variants: force and form closure (verdict codes, margins, weights, bases, directions)
+    and epsilons."""
+    owner, offset, friction = generator_layout(models, variants, 2)
+    owner_f, offset_f, friction_f = generator_layout(models, variants, 2, frictionless=True)
+    same = (np.array_equal(owner, owner_f) and np.array_equal(offset, offset_f)
+            and np.array_equal(friction, friction_f))  # frictionless contacts only: form is force
     return planar_batch(
         np.ascontiguousarray(P), np.ascontiguousarray(N), np.ascontiguousarray(mu),
-        np.ascontiguousarray(c), np.ascontiguousarray(L), owner, sign, bases(len(owner), 3), owner_f,
-        bases(len(models), 3), same, tol.margin, _FEAS, tol.residual, quality)
+        np.ascontiguousarray(width), np.ascontiguousarray(c), np.ascontiguousarray(L),
+        owner, offset, friction, bases(len(owner), 3), owner_f, offset_f, friction_f,
+        bases(len(owner_f), 3), same, tol.margin, FEAS, tol.residual, quality)
 
 
 @dataclass(frozen=True, eq=False)
@@ -138,7 +147,7 @@ def planar_screen(P, N, mu, center, length, *, quality: bool = True,
                   tol: Tolerances = Tolerances()) -> PlanarScreen:
     """Force closure and epsilon of many planar grasps sharing one contact pattern, columnar.
 
-    The same compiled kernels as :func:`certify_table` (:func:`qualgrasp.certify.kernels.planar_batch`:
+    The same compiled kernels as :func:`certify_table` (:func:`qualgrasp.certify._kernels.planar.planar_batch`:
     min-weight LP by basis enumeration, certificate re-checked in floating point, exact planar
     epsilon), called directly on arrays, without building grasp tables or certificates. Use it
     to screen large candidate sets (a grasp search); a grasp retained is then certified with
@@ -190,7 +199,8 @@ def planar_screen(P, N, mu, center, length, *, quality: bool = True,
         empty = np.zeros(0)
         return PlanarScreen(empty.astype(bool), empty.astype(bool), empty, empty, empty)
     models = tuple("point" if f else "frictionless" for f in pattern[0])
-    code, t, *_, eps = _planar_kernel(P, N, mu, center, length, models, tol, quality)
+    code, t, *_, eps = _planar_kernel(P, N, mu, np.zeros((B, m)), center, length, models, (0,) * m,
+                                      tol, quality)
     closure = code == 1
     return PlanarScreen(closure, code > 0, t, np.where(closure, eps[:, 0], 0.0),
                         np.where(closure, eps[:, 1], 0.0))
@@ -200,15 +210,20 @@ def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances
     """Certify the planar grasps ``rows`` (one contact pattern) with :func:`planar_batch`;
     return the settled rows and their result columns."""
     m = int(cols.count[rows[0]])
-    models = tuple(_MODEL_NAMES[int(c)] for c in cols.model[rows[0], :m])
     (code, t, lam, basis, y, code_f, t_f, lam_f, basis_f, y_f, eps) = _planar_kernel(
-        cols.P[rows, :m, :2], cols.N[rows, :m, :2], cols.mu[rows, :m], cols.center[rows, :2],
-        cols.length[rows], models, tol, options.quality)
+        cols.P[rows, :m, :2], cols.N[rows, :m, :2], cols.params["mu"][rows, :m],
+        cols.params["width"][rows, :m], cols.center[rows, :2], cols.length[rows],
+        cols.models_of(rows[0]), cols.variants_of(rows[0]), tol, options.quality)
     settled = (code > 0) & (code_f > 0)
     out = {"force": (code, t, lam, basis, y), "form": (code_f, t_f, lam_f, basis_f, y_f)}
     if options.quality:
         out["L1"], out["Linf"] = eps[:, 0], eps[:, 1]
     return settled, out
+
+
+def _ray_blocks(m: int):
+    """``(cone, first, width)`` block arrays of ``m`` rays (generator columns)."""
+    return (np.zeros(m, dtype=np.int64), np.arange(m), np.ones(m, dtype=np.int64))
 
 
 def _polyhedral_rows(P, N, c, L, W, E, options, tol: Tolerances):
@@ -217,18 +232,11 @@ def _polyhedral_rows(P, N, c, L, W, E, options, tol: Tolerances):
     it (same problem, same fast solver, same certificate), with the certificate then proved by
     the rigorous float kernels instead of rationals (the exact checker only where floats cannot
     decide). ``W`` and ``E`` are the frictionless generator columns and their error bounds
-    (:func:`_force_column_error`). Returns ``(code, t, lam, basis, y)`` and the tight blocks of
+    (:func:`qualgrasp.certify.wrench.force_column_errors`). Returns ``(code, t, lam, basis, y)`` and the tight blocks of
     code-4 rows."""
-    from .certificates import verify
-    from .closure import decide
-    from .grasp import Contact, Grasp
-    from .kernels import verify_farkas_general, verify_interior_general
-    from .problem import grasp_problem, grasp_system
-    from .solvers import make_solver
-
     B, m, d = P.shape
     zeros = np.zeros((B, m))
-    kind, first = np.zeros(m, dtype=np.int64), np.arange(m)
+    cone, first, width = _ray_blocks(m)
     code = np.zeros(B, dtype=np.int64)
     t, lam = np.zeros(B), np.zeros((B, m))
     basis, y = np.zeros((B, 2 * d), dtype=np.int64), np.zeros((B, 2 * d))
@@ -242,14 +250,15 @@ def _polyhedral_rows(P, N, c, L, W, E, options, tol: Tolerances):
         if v.status == "closure":
             t[i], lam[i], basis[i] = v.margin, cert.values, cert.basis
             if not options.quality and verify_interior_general(
-                    W[i], E[i], kind, first, N[i], zeros[i], zeros[i], lam[i], basis[i], tol.residual):
+                    W[i], E[i], cone, first, width, N[i], zeros[i], zeros[i], lam[i], basis[i],
+                    tol.residual):
                 code[i] = 1
         elif v.status == "no_closure":
             y[i] = cert.y
             mask = np.zeros(m, dtype=bool)
             mask[list(cert.tight)] = True
             proved = not cert.null_space and not mask.any() and verify_farkas_general(
-                W[i], E[i], kind, first, N[i], zeros[i], zeros[i], y[i], mask, 0.0)
+                W[i], E[i], cone, first, width, N[i], zeros[i], zeros[i], y[i], mask, 0.0)
             if proved or verify(grasp, cert, status="no_closure", frictionless=True):
                 code[i] = 3 if cert.null_space else 4 if mask.any() else 2
                 tight_rows[i] = np.flatnonzero(mask)
@@ -263,19 +272,12 @@ def _polyhedral(P, N, c, L, options, tol: Tolerances):
     method, are solved here by that method for the whole batch, and clear verdicts are proved
     columnar. Rows near the boundary, thin, or with certificates not proved this way are decided
     row by row. Returns ``(code, t, lam, basis, y)`` and the tight blocks of code-4 rows."""
-    from math import comb
-
-    from .kernels import barrier_batch, certify_rows, world_values
-    from .solvers import BARRIER_NEAR_ZERO, FastSolver
-    from .solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
-    from .wrench import generator_columns
-
     B, m, d = P.shape
     models = ("frictionless",) * m
     zeros = np.zeros((B, m))
-    W, _ = generator_columns(P, N, zeros, models, c, L, frictionless=True)
+    W, _ = generator_columns(P, N, zeros, models, c, L, frictionless=True, variants=(0,) * m)
     W = np.ascontiguousarray(W)  # (B, 6, m): one ray per contact, as barrier_arrays lays it out
-    E = _force_column_error(P, N, models, c, L, m)
+    E = force_column_errors(P, N, models, c, L)
     if comb(m, 2 * d) <= FastSolver.max_bases:
         return _polyhedral_rows(P, N, c, L, W, E, options, tol)
     status, t, y, xn, _ = barrier_batch(np.ascontiguousarray(np.swapaxes(W, 1, 2)),
@@ -289,9 +291,9 @@ def _polyhedral(P, N, c, L, options, tol: Tolerances):
     values = world_values(np.ascontiguousarray(np.broadcast_to(np.eye(m), (B, m, m))), xn)
     with np.errstate(invalid="ignore", divide="ignore"):
         yn = np.nan_to_num(y / np.sqrt(np.sum(y * y, axis=1, keepdims=True)))
-    code, basis = certify_rows(W, E, np.zeros(m, dtype=np.int64), np.arange(m), np.ascontiguousarray(N),
-                               zeros, zeros, values, yn, closure, farkas, np.abs(W).max(axis=(1, 2)),
-                               tol.residual)
+    cone, first, width = _ray_blocks(m)
+    code, basis = certify_rows(W, E, cone, first, width, np.ascontiguousarray(N), zeros, zeros,
+                               values, yn, closure, farkas, np.abs(W).max(axis=(1, 2)), tol.residual)
     out = [code, np.where(code == 1, t, 0.0), values, basis, yn]
     tight = {}
     rest = np.flatnonzero(code == 0)
@@ -304,35 +306,37 @@ def _polyhedral(P, N, c, L, options, tol: Tolerances):
     return tuple(out), tight
 
 
+def _block_arrays_of(models, N, mu, params):
+    """Per-row cone block arrays of the conic form of a group sharing ``models``: ``(cone,
+    first, width)`` shared, and the per-row normals, friction and moment lengths."""
+    cone = np.array([cone_code(registry.get(name).cone) for name in models], dtype=np.int64)
+    width = np.array([registry.get(name).columns(3) for name in models], dtype=np.int64)
+    first = np.concatenate([[0], np.cumsum(width)[:-1]]).astype(np.int64)
+    g = np.zeros(mu.shape)
+    for i, name in enumerate(models):
+        extra = registry.get(name).extra
+        if extra:
+            g[:, i] = params[extra[0]][:, i]
+    return cone, first, width, np.ascontiguousarray(N), np.ascontiguousarray(mu), g
+
+
 def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances):
     """Certify the spatial grasps ``rows`` (one contact pattern with friction): force closure
     by the compiled dual barrier method, form closure by the null-space direction (fewer than 6
     contacts) or the enumerated LP, every certificate re-checked in floating point with error
     bounds. Rows these rules do not settle (thin, near the boundary, tight contacts, unproved,
     or needing the spatial epsilon) are left to the per-grasp path."""
-    from .certificates import verify
-    from .closure import decide, farkas_from_arrays
-    from .grasp import Contact, Grasp
-    from .problem import Block, ClosureProblem, System, grasp_system
-    from .solvers.squeeze import squeeze_farkas
-    from .kernels import (barrier_batch, certify_rows, null_rows, verify_farkas_general,
-                          verify_interior_general, world_values)
-    from .problem import conic_columns
-    from .solvers import BARRIER_NEAR_ZERO, make_solver
-    from .solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
-    from .wrench import force_columns, generator_columns
-
     m = int(cols.count[rows[0]])
-    names = {FRICTIONLESS: "frictionless", POINT: "point", SOFT: "soft"}
-    models = tuple(names[int(c)] for c in cols.model[rows[0], :m])
+    models = cols.models_of(rows[0])
     P, N = cols.P[rows, :m, :], cols.N[rows, :m, :]
-    mu, tor, c, L = cols.mu[rows, :m], cols.torsion[rows, :m], cols.center[rows], cols.length[rows]
+    params = {name: values[rows, :m] for name, values in cols.params.items()}
+    mu, c, L = params["mu"], cols.center[rows], cols.length[rows]
     B = len(rows)
     if all(name == "frictionless" for name in models):  # force closure is form closure
         form, tight = _polyhedral(P, N, c, L, options, tol)
         return form[0] > 0, {"force": form, "form": form, "tight": tight, "form_tight": tight}
     # force closure: the barrier method on the solver columns
-    columns, rays, cones, to_values = conic_columns(P, N, mu, tor, models, c, L)
+    columns, rays, cones, to_values = conic_columns(P, N, params, models, c, L)
     blocks = [(r, 1, np.ones(B)) for r in rays] + list(cones)
     rmax = max(size - 1 for _, size, _ in cones)
     Pm = np.zeros((B, len(blocks), 6))
@@ -352,9 +356,8 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
     # the certificate system (world-frame force columns) and its error bounds
     C, owner = force_columns(P, N, models, c, L)
     C = np.ascontiguousarray(C)
-    E = _force_column_error(P, N, models, c, L, C.shape[2])
-    kind = np.array([{"frictionless": 0, "point": 1, "soft": 2}[name] for name in models])
-    first = np.array([np.flatnonzero(owner == i)[0] for i in range(m)])
+    E = force_column_errors(P, N, models, c, L)
+    cone, first, width, Nc, mu, g = _block_arrays_of(models, N, mu, params)
     sv = np.linalg.svd(C, compute_uv=False)
     thin = sv[:, -1] <= 1e-6 * sv[:, 0]
     near = (status == 2) | ((status == 0) & (np.abs(t) < BARRIER_NEAR_ZERO))
@@ -372,9 +375,8 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
     for b_ in range(m):
         sel = owner == b_
         farkas &= ~(np.abs(funct[:, sel]).max(axis=1) <= 1e-7 * scale)  # no tight contacts
-    code, basis = certify_rows(C, E, kind, first, np.ascontiguousarray(N), np.ascontiguousarray(mu),
-                               np.ascontiguousarray(tor), values, yn, closure_ok, farkas, scale,
-                               tol.residual)
+    code, basis = certify_rows(C, E, cone, first, width, Nc, mu, g, values, yn, closure_ok, farkas,
+                               scale, tol.residual)
     # near the boundary the per-grasp rule re-solves with clarabel (tight contacts); settle those
     # verdicts here too, with the float re-check
     tight_rows = {}
@@ -383,22 +385,20 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
     solver = make_solver("clarabel")
 
     def grasp_of(i):
-        return Grasp(tuple(Contact(P[i, j], N[i, j], models[j], mu[i, j],
-                                   tor[i, j] if models[j] == "soft" else None) for j in range(m)),
-                     center=c[i], length=L[i])
+        return cols.grasps([rows[i]])[0]
 
-    Nc, squeeze = np.ascontiguousarray(N), (kind == 1).sum() >= 2
+    squeeze = ((cone == LORENTZ) & (width == 3)).sum() >= 2
     for i in np.flatnonzero(near & ~thin):
         # the squeeze rule first, on the arrays (the certificate decide makes of its direction),
         # then the per-grasp decision on the columns already built
-        arrays = (kind, first, Nc[i], mu[i], tor[i])
+        arrays = (cone, first, width, Nc[i], mu[i], g[i])
         y_sq = squeeze_farkas(C[i], *arrays) if squeeze else None
         if y_sq is not None:
             status, cert = "no_closure", farkas_from_arrays(C[i], arrays, "forces", y_sq)
         else:
-            system = System(C[i], tuple(Block(("ray", "point", "soft")[kind[b]],
-                                              tuple(np.flatnonzero(owner == b)), tuple(N[i, b]),
-                                              float(mu[i, b]), float(tor[i, b]) if kind[b] == 2 else 0)
+            system = System(C[i], tuple(Block(registry.get(models[b]).cone,
+                                              tuple(int(j) for j in np.flatnonzero(owner == b)),
+                                              tuple(N[i, b]), float(mu[i, b]), float(g[i, b]), b)
                                         for b in range(m)), "forces")
             problem = ClosureProblem(columns[i], rays, tuple((st, sz, float(k[i])) for st, sz, k in cones),
                                      to_values[i], system)
@@ -406,7 +406,7 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
             status, cert = v.status, v.certificate
         if status == "closure" and not options.quality:
             values[i], basis[i], t[i] = cert.values, cert.basis, v.margin
-            if verify_interior_general(C[i], E[i], kind, first, N[i], mu[i], tor[i], values[i],
+            if verify_interior_general(C[i], E[i], cone, first, width, Nc[i], mu[i], g[i], values[i],
                                        basis[i], tol.residual):
                 code[i] = 1
         elif status == "no_closure" and not cert.null_space:
@@ -417,16 +417,16 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
             if mask.any():
                 shift = _tight_shift(C[i], E[i], owner, mask, models, P[i], yn[i])
             proved = shift <= 1e-6 * np.sqrt(np.sum(yn[i] ** 2)) and verify_farkas_general(
-                C[i], E[i], kind, first, N[i], mu[i], tor[i], yn[i], mask, shift)
+                C[i], E[i], cone, first, width, Nc[i], mu[i], g[i], yn[i], mask, shift)
             # tight blocks of lower rank than their columns (two fingers squeezing) have an
             # exact span that floats cannot certify: the exact checker decides those
             if proved or verify(grasp_of(i), cert, status="no_closure"):
                 code[i] = 4 if mask.any() else 2
                 tight_rows[int(i)] = np.flatnonzero(mask)
     # form closure: frictionless generators
-    Wf, _ = generator_columns(P, N, mu, models, c, L, frictionless=True)
+    Wf, _ = generator_columns(P, N, mu, models, c, L, frictionless=True, variants=(0,) * m)
     Wf = np.ascontiguousarray(Wf)
-    Ef = _force_column_error(P, N, ("frictionless",) * m, c, L, m)
+    Ef = force_column_errors(P, N, ("frictionless",) * m, c, L)
     code_f = np.zeros(B, dtype=np.int64)
     t_f = np.zeros(B)
     lam_f = np.zeros((B, m))
@@ -454,8 +454,6 @@ def _tight_shift(C, E, owner, mask, models, P, y) -> float:
     ``(a, b) -> (a + b, (r_1 x a + r_2 x b) / L)`` has kernel ``{(a, -a) : a || r_1 - r_2}``. So
     their span is that of any 5 of them proved independent, which floats can bound. Other tight
     sets go to the exact checker."""
-    from .kernels import projection_bound
-
     tight = np.flatnonzero(mask)
     cols = np.flatnonzero(mask[owner])
     if len(tight) == 2 and all(models[b] == "point" for b in tight) and \
@@ -469,30 +467,6 @@ def _tight_shift(C, E, owner, mask, models, P, y) -> float:
     if len(tight) == 1 and models[tight[0]] != "soft":
         return projection_bound(np.ascontiguousarray(C[:, cols]), np.ascontiguousarray(E[:, cols]), y)
     return np.inf
-
-
-def _force_column_error(P, N, models, center, length, k) -> np.ndarray:
-    """Bounds (B, 6, k) on the distance between float world-frame force columns and their exact
-    values on the same data: forces are exact (axes or stored normals); torques
-    ``(r x f) / L`` within ``gamma_8 (|r_a| |f_b| + |r_b| |f_a|) / L`` per component; a
-    torsion column ``n / L`` within ``2u |n| / L``."""
-    B = P.shape[0]
-    E = np.zeros((B, 6, k))
-    L = np.asarray(length)
-    g8 = 8 * 2.0**-53 / (1 - 8 * 2.0**-53)
-    j = 0
-    for i, model in enumerate(models):
-        r = np.abs(P[:, i, :] - center)
-        forces = [np.abs(N[:, i, :])] if model == "frictionless" else [np.broadcast_to(np.eye(3)[q], (B, 3)) for q in range(3)]
-        for f in forces:
-            E[:, 3, j] = g8 * (r[:, 1] * f[:, 2] + r[:, 2] * f[:, 1]) / L
-            E[:, 4, j] = g8 * (r[:, 2] * f[:, 0] + r[:, 0] * f[:, 2]) / L
-            E[:, 5, j] = g8 * (r[:, 0] * f[:, 1] + r[:, 1] * f[:, 0]) / L
-            j += 1
-        if model == "soft":
-            E[:, 3:, j] = 2 * 2.0**-53 * np.abs(N[:, i, :]) / L[:, None]
-            j += 1
-    return E
 
 
 def _group_table(cols: GraspColumns, rows: np.ndarray, lines: np.ndarray, out, options) -> pa.Table:
@@ -511,9 +485,8 @@ def _group_table(cols: GraspColumns, rows: np.ndarray, lines: np.ndarray, out, o
         values = out.get(norm) if options.quality else None
         arr = pa.array(values) if values is not None else pa.nulls(n, pa.float64())
         eps[f"eps_{key}_lo"] = eps[f"eps_{key}_hi"] = arr
-    ids = cols.ids if len(rows) == len(cols.ids) else cols.ids.take(pa.array(rows))
-    return pa.table({
-        "id": ids.cast(pa.string()),
+    return result_table({
+        "id": cols.id_column(rows),
         "line": pa.array(lines, type=pa.int64()),
         "dim": pa.array(np.full(n, dim, dtype=np.int8)),
         "status": _STATUS.take(pa.array(closure.astype(np.int8))),
@@ -525,37 +498,32 @@ def _group_table(cols: GraspColumns, rows: np.ndarray, lines: np.ndarray, out, o
         "certificate": cert,
         "verified": pa.array(np.ones(n, dtype=bool)),
         "error": pa.nulls(n, pa.string()),
-        "center": _list_array(np.ascontiguousarray(cols.center[rows, :dim]), None,
-                              RESULT_SCHEMA.field("center").type),
+        "center": _list_array(np.ascontiguousarray(cols.center[rows, :dim]), None, pa.list_(pa.float64())),
         "length": pa.array(cols.length[rows]),
         "n_contacts": pa.array(cols.count[rows].astype(np.int32)),
         **eps,
-    }, schema=RESULT_SCHEMA)
+    }, n)
 
 
-def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(),
-                  slow=None) -> pa.Table:
+def certify_table(table, lines, options, tol: Tolerances = Tolerances(), slow=None) -> pa.Table:
     """Results table of a grasp table (rows in input order).
 
+    ``table`` is an Arrow grasp table or its checked columns (:class:`GraspColumns`).
     ``slow(row_indices) -> list of results rows`` certifies rows grasp by grasp (the per-grasp
-    path of :func:`qualgrasp.certify.batch.certify_values`); it receives every row that the columnar rules
-    do not settle.
+    path, :func:`qualgrasp.certify.chunk.certify_rows`); it receives every row that the columnar
+    rules do not settle, invalid rows included.
     """
-    cols = grasp_columns(table)
+    cols = table if isinstance(table, GraspColumns) else grasp_columns(table)
     lines = (np.arange(lines.start, lines.stop, lines.step) if isinstance(lines, range)
              else np.asarray(lines, dtype=np.int64))
     n = len(lines)
     done = np.zeros(n, dtype=bool)
     pieces, order = [], []
-    planar = cols.ok & (cols.dim == 2) & ((cols.model <= POINT)).all(axis=1) & (cols.count >= 1)
-    spatial = cols.ok & (cols.dim == 3) & (cols.count >= 1)
-    if options.method == "fast" and (planar | spatial).any():
-        m = cols.model.shape[1]
-        key = cols.dim * 3 ** (m + 2) + cols.count * 3 ** m + \
-            (np.where(cols.model < 0, 0, cols.model) * 3 ** np.arange(m)).sum(1)
-        for k in np.unique(key[planar | spatial]):
-            rows = np.flatnonzero((planar | spatial) & (key == k))
-            group = _planar_group if planar[rows[0]] else _spatial_group
+    if options.method == "fast" and cols.ok.any():
+        label = cols.pattern()
+        for k in np.unique(label[cols.ok]):
+            rows = np.flatnonzero(label == k)
+            group = _planar_group if cols.dim[rows[0]] == 2 else _spatial_group
             settled, out = group(cols, rows, options, tol)
             if settled.all():
                 sub = dict(out)
@@ -572,8 +540,6 @@ def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(
                 done[rows[settled]] = True
     rest = np.flatnonzero(~done)
     if len(rest):
-        from .table import rows_to_table
-
         pieces.append(rows_to_table(slow(rest)))
         order.append(rest)
     if not pieces:

@@ -7,122 +7,147 @@ Conventions
 * ``n`` is the **inward** normal: it points into the object. Normals of any non-zero finite length
   are accepted and normalised to unit length on construction (a normal is a direction; image
   gradients rarely come out unit length); a normal already unit to within ``1e-12`` is kept as
-  given, so that exact data (``n = -p`` on the unit circle) stays exact. A normal shorter than
-  ``1e-9`` is rejected as zero.
-* Contact models: ``frictionless`` (force ``l n``, ``l >= 0``); ``point`` with Coulomb friction
-  coefficient ``mu`` (``norm(f_t) <= mu f_n``); ``soft`` (spatial only) which adds a torsional
-  moment ``m`` about ``n`` with ``norm((f_t, m / torsion)) <= mu f_n``, ``torsion`` being a length.
-  A ``point`` or ``soft`` contact with ``mu == 0`` can only push along ``n`` and is stored as
-  ``frictionless``.
+  given, so that exact data (``n = -p`` on the unit circle) stays exact.
+* Contact models are registered objects (:mod:`qualgrasp.certify.models`): ``frictionless``
+  (force ``l n``, ``l >= 0``); ``point`` with Coulomb friction coefficient ``mu``
+  (``norm(f_t) <= mu f_n``); ``soft`` (spatial) which adds a torsional moment ``m`` about ``n``
+  with ``norm((f_t, m / torsion)) <= mu f_n``, ``torsion`` a length; ``pad`` (planar), a flat pad
+  of width ``width`` with friction ``mu``. A contact whose parameters make it a simpler model is
+  stored as that model (``mu == 0``: frictionless; a pad of width 0: point).
 * ``center`` (reference point of torques) defaults to the centroid of the contact points and
   ``length`` (characteristic length dividing torques) to the largest distance from ``center`` to a
   contact, or 1 when that distance is zero. Closure verdicts and the min-weight margin do not depend
   on either; quality measures such as epsilon do. The values used are always reported.
+
+Every rule and message is :mod:`qualgrasp.certify.validation`'s, for contacts built here, grasps
+read from JSON and columns read from Parquet alike.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field, replace
-from typing import Any, Mapping, Sequence
+from typing import Any, Mapping
 
 import numpy as np
 
+from . import models as registry
 from .errors import GraspError
+from .validation import (Checked, CheckedGrasps, GraspData, check_contacts, contact_data, grasp_data,
+                         check_grasps, grasp_rules, number, numbers, param_names)
 
-__all__ = ["MODELS", "Contact", "Grasp", "grasp_from_dict", "grasp_to_dict"]
-
-MODELS = ("frictionless", "point", "soft")
-_MIN_NORMAL = 1e-9
-
-
-def _vector(value: Any, what: str) -> tuple[float, ...]:
-    try:
-        vec = tuple(float(v) for v in value)
-    except (TypeError, ValueError):
-        raise GraspError(f"{what} must be a list of 2 or 3 numbers, got {value!r}") from None
-    if len(vec) not in (2, 3):
-        raise GraspError(f"{what} must have 2 (planar) or 3 (spatial) coordinates, got {len(vec)}")
-    if not all(math.isfinite(v) for v in vec):
-        raise GraspError(f"{what} has a NaN or infinite coordinate: {list(vec)}")
-    return vec
+__all__ = ["Contact", "Grasp", "grasp_from_dict", "grasp_to_dict", "grasps_from_checked"]
 
 
-def _scalar(value: Any, what: str) -> float:
-    if isinstance(value, bool):
-        raise GraspError(f"{what} must be a number, got {value!r}")
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise GraspError(f"{what} must be a number, got {value!r}") from None
-    if not math.isfinite(x):
-        raise GraspError(f"{what} must be finite, got {value!r}")
-    return x
-
-
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Contact:
     """A contact between a finger and the object.
 
     Parameters
     ----------
     p : sequence of float
-        Contact point, 2 or 3 coordinates.
+        Contact point, 2 or 3 coordinates (the user's length unit).
     n : sequence of float
         Inward normal (into the object); normalised to unit length.
-    model : {'frictionless', 'point', 'soft'}
-        Contact model.
-    mu : float
-        Coulomb friction coefficient (``point`` and ``soft``), ``>= 0``.
+    model : str
+        A registered contact model (:mod:`qualgrasp.certify.models`): ``'frictionless'``
+        (default), ``'point'``, ``'soft'`` or ``'pad'``.
+    mu : float, optional
+        Coulomb friction coefficient (``point``, ``soft``, ``pad``), ``>= 0``.
     torsion : float, optional
         Torsional length of a ``soft`` contact, ``> 0``, in the unit of ``p``.
+    **params : float
+        Other model parameters, e.g. ``width`` of a ``pad`` (``>= 0``, unit of ``p``).
+
+    Attributes
+    ----------
+    p, n : tuple of float
+        The point and the stored unit normal.
+    model : str
+        The effective model (after reductions such as ``mu == 0`` meaning frictionless).
+    params : tuple of (str, float)
+        The model's parameters, in its declared order.
+
+    Raises
+    ------
+    GraspError
+        A value breaks a rule of :mod:`qualgrasp.certify.validation` (the message names it).
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import Contact
+    >>> Contact((0, 1), (0, -2), "point", 0.5)
+    Contact(p=(0.0, 1.0), n=(0.0, -1.0), model='point', params=(('mu', 0.5),))
+    >>> Contact((0, 1), (0, -1), "pad", mu=0.5, width=0.0).model  # a pad of width 0 is a point
+    'point'
     """
 
     p: tuple[float, ...]
     n: tuple[float, ...]
-    model: str = "frictionless"
-    mu: float = 0.0
-    torsion: float | None = None
+    model: str
+    params: tuple[tuple[str, float], ...]
 
-    def __post_init__(self) -> None:
-        p = _vector(self.p, "contact point p")
-        n = _vector(self.n, "normal n")
-        if len(p) != len(n):
-            raise GraspError(f"contact point p has {len(p)} coordinates but normal n has {len(n)}")
-        norm = math.sqrt(sum(v * v for v in n))
-        if norm < _MIN_NORMAL:
-            raise GraspError(f"normal n is zero (length {norm:.3g}); give the inward surface normal")
-        if self.model not in MODELS:
-            raise GraspError(f"unknown contact model {self.model!r}; use one of {', '.join(MODELS)}")
-        mu = _scalar(self.mu, "friction coefficient mu")
-        if mu < 0:
-            raise GraspError(f"friction coefficient mu must be >= 0, got {mu}")
-        model, torsion = self.model, self.torsion
-        if model == "frictionless" and mu != 0:
-            raise GraspError("a frictionless contact takes no mu; use model 'point' for friction")
-        if model == "soft":
-            if len(p) != 3:
-                raise GraspError("soft contacts are spatial only; a planar contact has no torsion")
-            if torsion is None:
-                raise GraspError("a soft contact needs its torsional length 'torsion' (> 0)")
-            torsion = _scalar(torsion, "torsional length torsion")
-            if torsion <= 0:
-                raise GraspError(f"torsional length must be > 0, got {torsion}")
-        elif torsion is not None:
-            raise GraspError(f"'torsion' applies to soft contacts only, not to {model!r}")
-        if mu == 0:
-            model, torsion = "frictionless", None
-        object.__setattr__(self, "p", p)
-        if abs(norm - 1.0) > 1e-12:  # re-normalising a unit normal would only add rounding
-            n = tuple(v / norm for v in n)
-        object.__setattr__(self, "n", n)
-        object.__setattr__(self, "model", model)
-        object.__setattr__(self, "mu", mu)
-        object.__setattr__(self, "torsion", torsion)
+    def __init__(self, p, n, model: str | None = "frictionless", mu: float | None = None,
+                 torsion: float | None = None, **params: float) -> None:
+        unknown = sorted(set(params) - set(param_names()))
+        if unknown:
+            raise GraspError(f"unknown contact parameter(s) {unknown}; the models take "
+                             f"{', '.join(param_names())}")
+        value = {"p": p, "n": n, "model": model, "mu": mu, "torsion": torsion, **params}
+        checked = check_contacts(contact_data([value]))
+        if checked.error[0] is not None:
+            raise GraspError(str(checked.error[0]))
+        _set_contact(self, checked, 0)
 
     @property
     def dim(self) -> int:
+        """Number of coordinates: 2 (planar) or 3 (spatial)."""
         return len(self.p)
+
+    def param(self, name: str, default: Any = None) -> Any:
+        """The value of parameter ``name``, or ``default`` when the model does not take it."""
+        return dict(self.params).get(name, default)
+
+    @property
+    def mu(self) -> float:
+        """Friction coefficient (0 for a frictionless contact)."""
+        return float(self.param("mu", 0.0))
+
+    @property
+    def torsion(self) -> float | None:
+        """Torsional length of a soft contact, else None."""
+        return self.param("torsion")
+
+    @property
+    def contact_model(self) -> registry.ContactModel:
+        """The registered model object."""
+        return registry.get(self.model)
+
+
+def _set_contact(contact: Contact, checked: Checked, j: int) -> None:
+    dim = int(checked.dim[j])
+    model = registry.get(int(checked.model[j]))
+    object.__setattr__(contact, "p", tuple(float(v) for v in checked.p[j, :dim]))
+    object.__setattr__(contact, "n", tuple(float(v) for v in checked.n[j, :dim]))
+    object.__setattr__(contact, "model", model.name)
+    object.__setattr__(contact, "params",
+                       tuple((name, float(checked.params[name][j])) for name in model.param_names))
+
+
+def _checked_of(contacts) -> Checked:
+    """The :class:`Checked` arrays of valid contacts (no rule is re-applied)."""
+    k = len(contacts)
+    p, n = np.zeros((k, 3)), np.zeros((k, 3))
+    dim = np.array([c.dim for c in contacts], dtype=np.int64)
+    for j, c in enumerate(contacts):
+        p[j, : c.dim], n[j, : c.dim] = c.p, c.n
+    params = {name: np.array([float(c.param(name, 0.0)) for c in contacts]) for name in param_names()}
+    model = np.array([registry.get(c.model).code for c in contacts], dtype=np.int64)
+    variant = np.zeros(k, dtype=np.int64)
+    for m in registry.models():
+        rows = model == m.code
+        if rows.any():
+            variant[rows] = m.variant({name: params[name][rows] for name in m.param_names})
+    return Checked(np.full(k, None, dtype=object), p, n, dim, model, params, variant)
 
 
 @dataclass(frozen=True)
@@ -138,10 +163,22 @@ class Grasp:
     length : float, optional
         Characteristic length dividing torques, ``> 0``. Default: largest distance from ``center``
         to a contact point (1 if that is zero).
-    id : str, optional
+    id : str or int, optional
         The grasp's identifier in a grasp set.
     meta : mapping, optional
         Extra fields carried through unchanged (for example region ids).
+
+    Raises
+    ------
+    GraspError
+        No contact, mixed dimensions, a bad ``center`` or ``length``.
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import Contact, Grasp
+    >>> g = Grasp((Contact((0, 0), (1, 0)), Contact((4, 0), (-1, 0)), Contact((2, 3), (0, -1))))
+    >>> g.center, round(g.length, 4)
+    ((2.0, 1.0), 2.2361)
     """
 
     contacts: tuple[Contact, ...]
@@ -152,31 +189,28 @@ class Grasp:
 
     def __post_init__(self) -> None:
         contacts = tuple(self.contacts)
-        if not contacts:
-            raise GraspError("a grasp needs at least one contact")
         if not all(isinstance(c, Contact) for c in contacts):
             raise GraspError("contacts must be Contact objects")
-        dims = {c.dim for c in contacts}
-        if len(dims) > 1:
-            raise GraspError(f"contacts mix dimensions {sorted(dims)}; a grasp is planar or spatial")
-        dim = dims.pop()
-        points = np.array([c.p for c in contacts])
-        if self.center is None:
-            center = tuple(float(v) for v in points.mean(axis=0))
-        else:
-            center = _vector(self.center, "center")
-            if len(center) != dim:
-                raise GraspError(f"center has {len(center)} coordinates, the contacts have {dim}")
-        if self.length is None:
-            reach = float(np.max(np.linalg.norm(points - np.array(center), axis=1)))
-            length = reach if reach > 0 else 1.0
-        else:
-            length = _scalar(self.length, "length")
-            if length <= 0:
-                raise GraspError(f"length must be > 0, got {length}")
+        data = GraspData(np.array([len(contacts)]), np.zeros((1, 3)), np.full(1, -1), np.full(1, np.nan),
+                         np.zeros(1, dtype=bool), [None], [None], [{}])
+        if self.center is not None:
+            vec = numbers(self.center)
+            if vec is None or not 2 <= len(vec) <= 3:
+                raise GraspError(f"center: expected 2 (planar) or 3 (spatial) finite numbers, got {self.center!r}")
+            data.center[0, : len(vec)], data.clen[0] = vec, len(vec)
+            data.raw[(0, "center")] = list(vec)
+        if self.length is not None:
+            x = number(self.length)
+            if x is None:
+                raise GraspError(f"length: expected a number, got {self.length!r}")
+            data.length[0], data.length_given[0] = x, True
+        checked = grasp_rules(data, _checked_of(contacts))
+        if checked.error[0] is not None:
+            raise GraspError(str(checked.error[0]))
+        dim = int(checked.dim[0])
         object.__setattr__(self, "contacts", contacts)
-        object.__setattr__(self, "center", center)
-        object.__setattr__(self, "length", length)
+        object.__setattr__(self, "center", tuple(float(v) for v in checked.center[0, :dim]))
+        object.__setattr__(self, "length", float(checked.length[0]))
 
     @property
     def dim(self) -> int:
@@ -204,26 +238,38 @@ class Grasp:
         return all(c.model == "frictionless" for c in self.contacts)
 
     def as_frictionless(self) -> "Grasp":
-        """The same grasp with every contact treated as frictionless (for form closure)."""
-        contacts = tuple(Contact(c.p, c.n) for c in self.contacts)
-        return replace(self, contacts=contacts)
+        """The same grasp with friction ignored at every contact (for form closure): each
+        contact becomes its model's frictionless counterpart (a pad stays a pad with ``mu = 0``)."""
+        contacts = []
+        for c in self.contacts:
+            model, overrides, _ = c.contact_model.frictionless()
+            params = {k: v for k, v in c.params if k in registry.get(model).param_names}
+            params.update(overrides)
+            contacts.append(Contact(c.p, c.n, model, **params))
+        return replace(self, contacts=tuple(contacts))
 
 
-def _contact_from_dict(d: Any, i: int) -> Contact:
-    if not isinstance(d, Mapping):
-        raise GraspError(f"contact {i} must be an object with keys p, n, model, mu, torsion")
-    unknown = set(d) - {"p", "n", "model", "mu", "torsion"}
-    if unknown:
-        raise GraspError(f"contact {i} has unknown key(s) {sorted(unknown)}")
-    for key in ("p", "n"):
-        if key not in d:
-            raise GraspError(f"contact {i} has no {key!r}")
-    mu = d.get("mu")
-    model = d.get("model", "frictionless" if mu is None else "point")
-    try:
-        return Contact(d["p"], d["n"], model, 0.0 if mu is None else mu, d.get("torsion"))
-    except GraspError as err:
-        raise GraspError(f"contact {i}: {err}") from None
+def grasps_from_checked(checked: CheckedGrasps, rows, ids=None, meta=None) -> list[Grasp]:
+    """:class:`Grasp` objects of the valid ``rows`` of checked grasp arrays (no rule is applied
+    again: the arrays come from :func:`qualgrasp.certify.validation.check_grasps`)."""
+    out = []
+    c = checked.contacts
+    for i in rows:
+        contacts = []
+        for j in range(checked.offsets[i], checked.offsets[i + 1]):
+            contact = object.__new__(Contact)
+            _set_contact(contact, c, j)
+            contacts.append(contact)
+        dim = int(checked.dim[i])
+        grasp = object.__new__(Grasp)
+        for name, value in (("contacts", tuple(contacts)),
+                            ("center", tuple(float(v) for v in checked.center[i, :dim])),
+                            ("length", float(checked.length[i])),
+                            ("id", None if ids is None else ids[i]),
+                            ("meta", {} if meta is None else meta[i])):
+            object.__setattr__(grasp, name, value)
+        out.append(grasp)
+    return out
 
 
 def grasp_from_dict(d: Any) -> Grasp:
@@ -231,34 +277,45 @@ def grasp_from_dict(d: Any) -> Grasp:
 
     ``{"id": "g1", "contacts": [{"p": [x, y], "n": [nx, ny], "model": "point", "mu": 0.5}],
     "center": [cx, cy], "length": 1.0}``; ``center``, ``length`` and ``id`` are optional, 3
-    coordinates for spatial grasps, ``torsion`` for soft contacts. A contact without ``model`` is
-    ``point`` when it has ``mu`` and ``frictionless`` otherwise. Other top-level keys are kept in
-    ``meta``.
+    coordinates for spatial grasps, the model's parameters (``mu``, ``torsion``, ``width``) as
+    keys of a contact. A contact without ``model`` is ``point`` when it has ``mu`` and
+    ``frictionless`` otherwise. Other keys of a contact are ignored; other top-level keys are kept
+    in ``meta``.
+
+    Raises
+    ------
+    GraspError
+        The value breaks a rule (the message names the field, e.g. ``contacts[1].mu``).
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import grasp_from_dict
+    >>> g = grasp_from_dict({"id": "g1", "contacts": [
+    ...     {"p": [1, 0], "n": [-1, 0], "model": "pad", "mu": 0.5, "width": 0.2},
+    ...     {"p": [-1, 0], "n": [1, 0], "model": "pad", "mu": 0.5, "width": 0.2}]})
+    >>> [c.model for c in g.contacts], g.length
+    (['pad', 'pad'], 1.0)
     """
-    if not isinstance(d, Mapping):
-        raise GraspError("a grasp must be a JSON object with a 'contacts' list")
-    contacts = d.get("contacts")
-    if not isinstance(contacts, Sequence) or isinstance(contacts, (str, bytes)):
-        raise GraspError("a grasp needs a 'contacts' list")
-    meta = {k: v for k, v in d.items() if k not in ("id", "contacts", "center", "length")}
-    return Grasp(
-        tuple(_contact_from_dict(c, i) for i, c in enumerate(contacts)),
-        center=d.get("center"),
-        length=d.get("length"),
-        id=d.get("id"),
-        meta=meta,
-    )
+    data, contacts = grasp_data([d])
+    checked = check_grasps(data, contacts)
+    if checked.error[0] is not None:
+        raise GraspError(str(checked.error[0]))
+    return grasps_from_checked(checked, [0], data.ids, data.meta)[0]
 
 
 def grasp_to_dict(grasp: Grasp) -> dict[str, Any]:
-    """The grasp-set schema of ``grasp`` (inverse of :func:`grasp_from_dict`)."""
+    """The grasp-set schema of ``grasp`` (inverse of :func:`grasp_from_dict`).
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import Contact, Grasp, grasp_to_dict
+    >>> grasp_to_dict(Grasp((Contact((0, 0), (1, 0)),), id="g"))["contacts"]
+    [{'p': [0.0, 0.0], 'n': [1.0, 0.0], 'model': 'frictionless'}]
+    """
     contacts = []
     for c in grasp.contacts:
         item: dict[str, Any] = {"p": list(c.p), "n": list(c.n), "model": c.model}
-        if c.model != "frictionless":
-            item["mu"] = c.mu
-        if c.torsion is not None:
-            item["torsion"] = c.torsion
+        item.update(c.params)
         contacts.append(item)
     out: dict[str, Any] = {}
     if grasp.id is not None:

@@ -14,26 +14,11 @@ from typing import Any, Iterable, Iterator
 
 import pyarrow.parquet as pq
 
-from .errors import CertifyError, GraspFileError
-from .grasp import Grasp, grasp_from_dict, grasp_to_dict
-from .table import (RESULT_WRITE_OPTIONS, chunk_values, grasps_table, is_parquet, iter_chunks,
-                    rows_to_table, table_to_rows)
+from .grasp import Grasp, grasp_to_dict
+from .results import RESULT_WRITE_OPTIONS
+from .table import grasps_table, is_parquet, iter_chunks, rows_to_table, table_to_rows
 
-__all__ = ["read_grasps", "write_grasps", "read_results", "write_rows"]
-
-
-def read_grasps(path: str | Path, chunk_size: int = 4096) -> Iterator[tuple[int, Any, Grasp | CertifyError]]:
-    """Yield ``(line number, id or None, Grasp or the error that line raised)``."""
-    for chunk in iter_chunks(path, chunk_size):
-        for number, value in zip(chunk.lines, chunk_values(chunk)):
-            gid = value.get("id") if isinstance(value, dict) else None
-            if isinstance(value, CertifyError):
-                yield number, gid, type(value)(f"line {number}: {value}")
-                continue
-            try:
-                yield number, gid, grasp_from_dict(value)
-            except CertifyError as err:
-                yield number, gid, type(err)(f"line {number}: {err}")
+__all__ = ["write_grasps", "read_results", "write_rows"]
 
 
 def write_grasps(path: str | Path, grasps: Iterable[Grasp]) -> int:

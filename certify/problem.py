@@ -25,8 +25,10 @@ from typing import Any, NamedTuple, Sequence
 import numpy as np
 
 from .grasp import Grasp
+from . import models as registry
+from .cones import cone_code
 from .wrench import (contact_frame, force_columns, generator_columns, grasp_arrays, tangent,
-                     to_exact, wrench)
+                     to_exact, variants_of, wrench)
 
 __all__ = ["Block", "block_arrays", "System", "ClosureProblem", "grasp_problem", "span_problem", "grasp_system",
            "span_system", "is_polyhedral"]
@@ -34,24 +36,28 @@ __all__ = ["Block", "block_arrays", "System", "ClosureProblem", "grasp_problem",
 
 @dataclass(frozen=True)
 class Block:
-    """One contact cone over certificate columns ``cols``: ``ray``, ``point`` or ``soft``."""
+    """One cone block over certificate columns ``cols``: its shape ``cone`` (``'ray'`` or
+    ``'lorentz'``, :mod:`qualgrasp.certify.cones`), the stored normal ``n``, friction ``mu`` and
+    moment length ``g`` of a Lorentz block (0 for none), and the ``contact`` it belongs to."""
 
-    kind: str
+    cone: str
     cols: tuple[int, ...]
     n: tuple = ()
     mu: Any = 0
-    torsion: Any = 0
+    g: Any = 0
+    contact: int = -1
 
 
 def block_arrays(blocks: Sequence[Block], dim: int):
-    """``(kind, first column, n, mu, torsion)`` arrays of cone blocks (kind 0 ray, 1 point,
-    2 soft), the form the compiled kernels take; rays get zero normals."""
-    kind = np.array([("ray", "point", "soft").index(b.kind) for b in blocks], dtype=np.int64)
+    """``(cone, first, width, n, mu, g)`` arrays of cone blocks, the form the compiled kernels
+    take (:mod:`qualgrasp.certify._kernels.cones`); rays get zero normals."""
+    cone = np.array([cone_code(b.cone) for b in blocks], dtype=np.int64)
     first = np.array([b.cols[0] for b in blocks], dtype=np.int64)
+    width = np.array([len(b.cols) for b in blocks], dtype=np.int64)
     n = np.array([[float(v) for v in b.n] if b.n else [0.0] * dim for b in blocks]).reshape(len(blocks), dim)
     mu = np.array([float(b.mu) for b in blocks])
-    torsion = np.array([float(b.torsion) for b in blocks])
-    return kind, first, n, mu, torsion
+    g = np.array([float(b.g) for b in blocks])
+    return cone, first, width, n, mu, g
 
 
 class System(NamedTuple):
@@ -118,8 +124,8 @@ def span_problem(vectors) -> ClosureProblem:
 
 
 def is_polyhedral(grasp: Grasp, frictionless: bool = False, socp: bool = False) -> bool:
-    """True when the programme uses generator rays: frictionless grasps, and planar grasps
-    unless ``socp`` asks for their friction cones as 2-D second-order cones."""
+    """True when the programme uses generator rays: frictionless grasps (and form closure), and
+    planar grasps unless ``socp`` asks for their friction cones as 2-D second-order cones."""
     return frictionless or grasp.frictionless or (grasp.dim == 2 and not socp)
 
 
@@ -136,29 +142,32 @@ def grasp_problem(grasp: Grasp, *, frictionless: bool = False, socp: bool = Fals
     """The closure programme of ``grasp`` (form closure when ``frictionless=True``).
 
     Frictionless grasps and planar grasps are polyhedral (rays = generator wrenches; a planar
-    friction cone is exactly its two edges). Spatial frictional contacts are exact second-order
-    cones in the contact frame ``(n, t1, t2)``; a soft contact's fourth variable is
-    ``m / torsion``, so its cone is ``norm((f_t, m / torsion)) <= mu f_n``. ``socp=True`` writes
-    planar friction cones as 2-D second-order cones ``abs(f_t) <= mu f_n`` instead of edges: the same
-    verdict by another route (the margin's scale differs), used to cross-check the LP.
+    friction cone is exactly its two edges, a pad's cone the edges at its two ends). Spatial
+    frictional contacts are exact second-order cones in the contact frame ``(n, t1, t2)``; a
+    soft contact's fourth variable is ``m / torsion``, so its cone is
+    ``norm((f_t, m / torsion)) <= mu f_n``. ``socp=True`` writes planar friction cones as 2-D
+    second-order cones ``abs(f_t) <= mu f_n`` instead of edges: the same verdict by another route
+    (the margin's scale differs), used to cross-check the LP (not for pads, which have no
+    conic form).
     """
     system = grasp_system(grasp, frictionless=frictionless, socp=socp)
     if system.layout == "generators":
         k = system.columns.shape[1]
         return ClosureProblem(system.columns, tuple(range(k)), (), np.eye(k), system)
-    P, N, mu, torsion, c, L = grasp_arrays(grasp)
+    P, N, mu, params, c, L = grasp_arrays(grasp)
     models = tuple(contact.model for contact in grasp.contacts)
-    columns, rays, cones, to_values = conic_columns(P, N, mu, torsion, models, c, L)
+    columns, rays, cones, to_values = conic_columns(P, N, params, models, c, L)
     return ClosureProblem(columns, rays, cones, to_values, system)
 
 
-def conic_columns(P, N, mu, torsion, models, center, length):
+def conic_columns(P, N, params, models, center, length):
     """Solver columns of a closure programme with cones, for one grasp or a batch.
 
     Parameters
     ----------
     P, N : array, shape (..., m, dim)
-    mu, torsion : array, shape (..., m)
+    params : mapping of str to array, shape (..., m)
+        Model parameters (``mu``, moment lengths such as ``torsion``).
     models : sequence of str, length m (shared by the batch)
     center : array, shape (..., dim)
     length : array, shape (...)
@@ -166,9 +175,9 @@ def conic_columns(P, N, mu, torsion, models, center, length):
     Returns
     -------
     columns : array, shape (..., d, nvar)
-        Wrench of each variable: frictionless contacts one ray (``n``); frictional contacts the
-        normal and tangential forces of the contact frame ``(n, t1, t2)`` (``(n, t)`` in the
-        plane) and, for a soft contact, the scaled torsional moment ``m / torsion``.
+        Wrench of each variable: a ray contact one column (``n``); a Lorentz contact the normal
+        and tangential forces of the contact frame ``(n, t1, t2)`` (``(n, t)`` in the plane) and,
+        per moment of the model (a soft finger's torsion), the scaled moment ``m / g``.
     to_values : array, shape (..., ncert, nvar)
         Map from the variables to the certificate's world-frame values (forces, moments).
     rays, cones : tuple
@@ -181,24 +190,29 @@ def conic_columns(P, N, mu, torsion, models, center, length):
     dim = P.shape[-1]
     batch = P.shape[:-2]
     cols, rays, cones, blocks = [], [], [], []
-    for i, model in enumerate(models):
+    for i, name in enumerate(models):
+        model = registry.get(name)
         start = len(cols)
-        if model == "frictionless":
+        if model.cone == "ray":
             cols.append(wrenches[..., i, 0, :])
             rays.append(start)
             blocks.append(N[..., i, :, None])
             continue
+        if model.cone != "lorentz":
+            raise ValueError(f"{name} contacts have no conic form (they are polyhedral: use the generators)")
         cols.extend(wrenches[..., i, j, :] for j in range(dim))
         frame = np.swapaxes(frames[..., i, :, :], -1, -2)
-        if model == "soft":
-            g = torsion[..., i]
+        if model.extra:
+            size = dim + len(model.extra)
+            frame_x = np.zeros(batch + (size, size))
+            frame_x[..., :dim, :dim] = frame
             L_ = np.asarray(length)[..., None]
-            cols.append(np.concatenate([np.zeros(batch + (3,)), g[..., None] * N[..., i, :] / L_], axis=-1))
-            frame4 = np.zeros(batch + (4, 4))
-            frame4[..., :3, :3] = frame
-            frame4[..., 3, 3] = g
-            frame = frame4
-        cones.append((start, len(cols) - start, mu[..., i]))
+            for q, extra in enumerate(model.extra):
+                g = params[extra][..., i]
+                cols.append(np.concatenate([np.zeros(batch + (dim,)), g[..., None] * N[..., i, :] / L_], axis=-1))
+                frame_x[..., dim + q, dim + q] = g
+            frame = frame_x
+        cones.append((start, len(cols) - start, params["mu"][..., i]))
         blocks.append(frame)
     columns = np.stack(cols, axis=-1)
     to_values = _block_diag(blocks, batch)
@@ -220,21 +234,28 @@ def _block_diag(blocks: list[np.ndarray], batch: tuple = ()) -> np.ndarray:
 
 def grasp_system(grasp: Grasp, *, frictionless: bool = False, socp: bool = False,
                  exact: bool = False):
-    """The certificate :class:`System` of ``grasp`` (exact: Fraction entries)."""
-    P, N, mu, _, c, L = grasp_arrays(grasp, exact)
+    """The certificate :class:`System` of ``grasp`` (exact: Fraction entries).
+
+    Polyhedral programmes (:func:`is_polyhedral`) are written over the generator wrenches, one
+    ray block per generator; the others over world-frame force (and moment) columns
+    (:func:`qualgrasp.certify.wrench.force_columns`), one block per contact with the model's cone.
+    """
+    P, N, mu, params, c, L = grasp_arrays(grasp, exact)
     models = tuple(contact.model for contact in grasp.contacts)
     if is_polyhedral(grasp, frictionless, socp):
-        C, _ = generator_columns(P, N, mu, models, c, L, frictionless=frictionless)
-        return System(C, tuple(Block("ray", (j,)) for j in range(C.shape[1])), "generators")
+        C, owner = generator_columns(P, N, mu, models, c, L, frictionless=frictionless,
+                                     width=params["width"], variants=variants_of(grasp))
+        return System(C, tuple(Block("ray", (j,), contact=int(owner[j])) for j in range(C.shape[1])),
+                      "generators")
     C, owner = force_columns(P, N, models, c, L)
     conv = to_exact if exact else np.asarray
     num = Fraction if exact else float
     blocks = []
-    for i, c in enumerate(grasp.contacts):
+    for i, contact in enumerate(grasp.contacts):
+        model = contact.contact_model
         cols = tuple(int(j) for j in np.flatnonzero(owner == i))
-        kind = "ray" if c.model == "frictionless" else c.model
-        blocks.append(Block(kind, cols, tuple(conv(np.array(c.n))), num(c.mu),
-                            num(c.torsion) if c.torsion else 0))
+        g = num(contact.param(model.extra[0])) if model.extra else 0
+        blocks.append(Block(model.cone, cols, tuple(conv(np.array(contact.n))), num(contact.mu), g, i))
     return System(C, tuple(blocks), "forces")
 
 

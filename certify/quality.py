@@ -15,16 +15,20 @@ Torque scaling is explicit: wrenches are ``(f, (p - center) x f / length)``, so 
 ``center`` and ``length`` together leaves epsilon unchanged; dividing ``length`` by ``s`` multiplies
 the torque coordinates by ``s``. The min-weight margin of :mod:`qualgrasp.certify.closure` depends on neither.
 
-Planar grasps: the cones are polyhedral, so epsilon is exact: the minimum of ``h`` over a finite
-set of directions that contains every facet normal of the GWS (normals of triples of generator
-points for L1; cross products of pairs of edges of the per-contact polytopes for L-infinity, since
-every facet of a Minkowski sum in 3-D is a facet of a summand or spanned by two summands' edges).
+Planar grasps: every contact model is polyhedral in the plane, so epsilon is exact: the minimum
+of ``h`` over a finite set of directions that contains every facet normal of the GWS (normals of
+triples of generator points for L1; cross products of pairs of edges of the per-contact polytopes
+``conv(0, generators of the contact)`` for L-infinity, since every facet of a Minkowski sum in 3-D
+is a facet of a summand or spanned by two summands' edges).
 
-Spatial grasps with exact cones: rigorous bounds ``lo <= epsilon <= hi``. ``conv(S)`` of support
-points ``S`` of the exact GWS is inscribed in it, so its epsilon (from qhull) is a lower bound;
-``h(u)`` at any unit ``u`` is an upper bound. Each round adds the exact support points in the
-directions of the inscribed polytope's closest facets (they push those facets out where it
-matters) and evaluates ``h`` there, until ``hi - lo <= rel_gap * hi`` or the budget is spent.
+Spatial grasps with exact cones: rigorous bounds ``lo <= epsilon <= hi`` by branch and bound over
+the sphere of wrench directions. ``h(u)`` at any unit ``u`` is an upper bound; the best one is
+refined by local minimisation (a tangent-plane SOCP). The sphere is covered by cells (the faces of
+the cube ``[-1, 1]^d`` cut into boxes, projected radially); each cell gets a lower bound of ``h``
+over it from global linear minorants of the contacts' pieces (and, for L1, the exact minimum over
+the flat cell, an SOCP solved by clarabel whose dual is turned into a minorant valid whatever the
+solver's accuracy). Cells whose bound reaches ``(1 - rel_gap) hi`` are retired, the others split,
+until ``hi - lo <= rel_gap * hi`` or the budget of cells is spent.
 
 Epsilon is 0 for grasps not in closure (and for degenerate ones): the closure verdict is decided
 first, so flat hulls and rank-deficient sets never reach qhull.
@@ -39,11 +43,10 @@ from scipy.spatial import ConvexHull, QhullError
 
 from .closure import Verdict, force_closure
 from .grasp import Grasp
+from ._kernels.epsilon import planar_epsilon as kernel_planar_epsilon
 from .problem import System, grasp_system
-from .wrench import generator_columns, grasp_arrays
 
-__all__ = ["NORMS", "Epsilon", "support", "support_points", "epsilon", "epsilon_of_points",
-           "epsilon_linearised"]
+__all__ = ["NORMS", "Epsilon", "epsilon", "planar_epsilon", "epsilon_of_points", "epsilon_linearised"]
 
 NORMS = ("L1", "Linf")
 
@@ -89,87 +92,13 @@ def _check_norm(norm: str) -> None:
         raise ValueError(f"unknown norm {norm!r}; use 'L1' or 'Linf'")
 
 
-def _block_functional(system: System, U: np.ndarray):
-    """Per block: ``(a_n, norm(a_t))``-based support values and the normal/tangential parts.
-
-    Returns a list, one entry per block, of ``(value, an, at, n_hat)`` arrays over directions.
-    """
-    C = system.columns
-    A = U @ C  # (n_dirs, k): functional of each column
-    out = []
-    for b in system.blocks:
-        a = A[:, list(b.cols)]
-        if b.kind == "ray":
-            out.append((a[:, 0], None, None, None))
-            continue
-        n = np.asarray(b.n, dtype=float)
-        n_hat = n / np.linalg.norm(n)
-        dim = len(n)
-        an = a[:, :dim] @ n_hat
-        at = a[:, :dim] - an[:, None] * n_hat
-        if b.kind == "soft":
-            at = np.concatenate([at, float(b.torsion) * a[:, dim:]], axis=1)
-        value = an + float(b.mu) * np.linalg.norm(at, axis=1)
-        out.append((value, an, at, n_hat))
-    return out
-
-
-def support(system: System, U, norm: str = "L1") -> np.ndarray:
-    """Exact support function ``h(u)`` of the GWS at the rows of ``U`` (unit directions).
-
-    ``system`` is the certificate system with one block per contact
-    (:func:`qualgrasp.certify.problem.grasp_system` with ``socp=True`` for planar friction).
-    """
-    _check_norm(norm)
-    U = np.atleast_2d(np.asarray(U, dtype=float))
-    values = np.stack([np.maximum(v, 0.0) for v, *_ in _block_functional(system, U)])
-    return values.max(axis=0) if norm == "L1" else values.sum(axis=0)
-
-
-def support_points(system: System, U, norm: str = "L1") -> np.ndarray:
-    """Points of the exact GWS attaining ``h(u)`` for each row ``u`` of ``U``, shape (n, d)."""
-    _check_norm(norm)
-    U = np.atleast_2d(np.asarray(U, dtype=float))
-    C = system.columns
-    d = C.shape[0]
-    per_block = []
-    for b, (value, an, at, n_hat) in zip(system.blocks, _block_functional(system, U)):
-        cols = C[:, list(b.cols)]
-        if b.kind == "ray":
-            w = np.repeat(cols.T, len(U), axis=0)
-        else:
-            dim = len(n_hat)
-            norm_t = np.linalg.norm(at, axis=1, keepdims=True)
-            unit_t = np.divide(at, norm_t, out=np.zeros_like(at), where=norm_t > 0)
-            f = n_hat + float(b.mu) * unit_t[:, :dim]  # unit normal force at the cone's rim
-            if b.kind == "soft":
-                moment = float(b.mu) * float(b.torsion) * unit_t[:, dim:]
-                f = np.concatenate([f, moment], axis=1)
-            w = f @ cols.T
-        per_block.append(np.where((value > 0)[:, None], w, 0.0))
-    W = np.stack(per_block)  # (blocks, n, d)
-    if norm == "Linf":
-        return W.sum(axis=0)
-    values = np.stack([v for v, *_ in _block_functional(system, U)])
-    best = np.argmax(values, axis=0)
-    return W[best, np.arange(len(U))].reshape(-1, d)
-
-
-def _unit(V: np.ndarray) -> np.ndarray:
-    norms = np.linalg.norm(V, axis=1)
-    keep = norms > 1e-12 * max(1.0, norms.max(initial=0.0))
-    V = V[keep] / norms[keep, None]
-    return np.concatenate([V, -V])
-
-
 def planar_epsilon(grasp: Grasp, norm: str) -> tuple[float, np.ndarray]:
-    """Exact planar epsilon and its direction (compiled kernel, also used for whole batches)."""
-    from .kernels import planar_epsilon as kernel
-
-    P, N, mu, _, c, L = grasp_arrays(grasp)
-    models = tuple(contact.model for contact in grasp.contacts)
-    W, owner = generator_columns(P, N, mu, models, c, L)
-    eps, arg = kernel(np.ascontiguousarray(W[None]), owner, len(models), norm == "Linf")
+    """Exact planar epsilon and its direction (the compiled kernel that also serves whole
+    batches), over the grasp's generator wrenches (:func:`qualgrasp.certify.problem.grasp_system`)."""
+    system = grasp_system(grasp)
+    owner = np.array([b.contact for b in system.blocks], dtype=np.int64)
+    eps, arg = kernel_planar_epsilon(np.ascontiguousarray(system.columns[None]), owner,
+                                     len(grasp.contacts), norm == "Linf")
     return float(eps[0]), arg[0]
 
 
@@ -226,17 +155,18 @@ class _Pieces:
         self.kappa = np.zeros(len(system.blocks))
         for i, b in enumerate(system.blocks):
             cols = C[:, list(b.cols)].T  # functional rows: a = cols @ v
-            if b.kind == "ray":
+            if b.cone == "ray":
                 self.p[i] = cols[0]
                 rows.append(np.zeros((0, d)))
                 continue
             n = np.asarray(b.n, dtype=float)
-            n_hat = n / np.linalg.norm(n)
+            rn = np.linalg.norm(n)
+            n_hat = n / rn
             dim = len(n)
             self.p[i] = n_hat @ cols[:dim]
             T = cols[:dim] - np.outer(n_hat, self.p[i])
-            if b.kind == "soft":
-                T = np.vstack([T, float(b.torsion) * cols[dim:]])
+            if len(b.cols) > dim:  # moment columns, weighted as in qualgrasp.certify.cones.polar
+                T = np.vstack([T, float(b.g) / rn * cols[dim:]])
             rows.append(T)
             self.kappa[i] = float(b.mu)
         r = max(1, max(len(t) for t in rows))
@@ -256,15 +186,6 @@ class _Pieces:
     def h(self, V: np.ndarray, norm: str) -> np.ndarray:
         c = np.maximum(self.at(V)[0], 0.0)
         return c.max(axis=1) if norm == "L1" else c.sum(axis=1)
-
-    def own_minorant(self, V: np.ndarray, norm: str) -> np.ndarray:
-        """A linear minorant of ``h`` exact at each direction of ``V`` (rows)."""
-        c, g = self.at(V)
-        if norm == "L1":
-            best = np.argmax(c, axis=1)
-            out = g[np.arange(len(V)), best]
-            return np.where((c.max(axis=1) > 0)[:, None], out, 0.0)
-        return np.einsum("nb,nbd->nd", (c > 0).astype(float), g)
 
     def cell_bound(self, V: np.ndarray, centre: np.ndarray, norm: str, rounds: int = 24) -> np.ndarray:
         """Lower bound of ``h`` over each flat cell ``conv(V[i])`` (V: (n, m, d)).
@@ -571,10 +492,10 @@ def epsilon_linearised(grasp: Grasp, norm: str = "L1", edges: int = 8) -> float:
     per_contact = []
     for b in system.blocks:
         cols = system.columns[:, list(b.cols)]
-        if b.kind == "ray":
+        if b.cone == "ray":
             per_contact.append(cols.T)
             continue
-        if b.kind == "soft":
+        if len(b.cols) > len(b.n):
             raise ValueError("epsilon_linearised handles point and frictionless contacts only")
         n = np.asarray(b.n, dtype=float) / np.linalg.norm(b.n)
         if len(n) == 2:

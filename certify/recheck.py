@@ -1,8 +1,9 @@
 """Columnar re-check of a results table against its grasps: the independent checker at scale.
 
-:func:`recheck_table` re-checks every row of a results table (:data:`qualgrasp.certify.table.RESULT_SCHEMA`)
-against the grasp table it came from. The common certificates are proved in bulk with the
-rigorous floating-point kernels of :mod:`qualgrasp.certify.kernels` (error bounds instead of rationals):
+:func:`recheck_table` re-checks every row of a results table
+(:data:`qualgrasp.certify.results.RESULT_SCHEMA`) against the checked grasp columns it came from.
+The common certificates are proved in bulk with the rigorous floating-point kernels of
+:mod:`qualgrasp.certify._kernels.recheck` (error bounds instead of rationals):
 planar generator certificates (interior, strict Farkas, null space) and spatial ones (interior
 forces, strict Farkas, null-space form certificates). Each row's claims are checked as
 :func:`qualgrasp.certify.report.verify_row` checks them (status against certificate kind, closure flags,
@@ -15,13 +16,16 @@ from __future__ import annotations
 import numpy as np
 import pyarrow as pa
 
-from .certificates import Tolerances
-from .columns import FRICTIONLESS, POINT, SOFT, GraspColumns, grasp_columns
-from .kernels import (_planar_generators, null_rows, verify_farkas_general,
-                      verify_interior_general)
-from .wrench import force_columns, generator_columns
+from . import models as registry
+from ._kernels.planar import planar_generators
+from ._kernels.recheck import null_rows, verify_farkas_general, verify_interior_general
+from .certificates import Tolerances, margin_of
+from .columns import GraspColumns
+from .cones import CONES, cone_code
+from .problem import Block
+from .wrench import force_column_errors, force_columns, generator_columns, generator_layout
 
-__all__ = ["recheck_table"]
+__all__ = ["recheck_table", "generator_errors"]
 
 _FLAGS = {"closure": True, "no_closure": False}
 
@@ -66,12 +70,11 @@ def _group_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, tol: Tole
     """Rows (indices into ``rows``) whose force and form certificates are proved in bulk."""
     m = int(cols.count[rows[0]])
     dim = int(cols.dim[rows[0]])
-    names = {FRICTIONLESS: "frictionless", POINT: "point", SOFT: "soft"}
-    models = tuple(names[int(c)] for c in cols.model[rows[0], :m])
+    models, variants = cols.models_of(rows[0]), cols.variants_of(rows[0])
     P = np.ascontiguousarray(cols.P[rows, :m, :dim])
     N = np.ascontiguousarray(cols.N[rows, :m, :dim])
-    mu = np.ascontiguousarray(cols.mu[rows, :m])
-    tor = np.ascontiguousarray(cols.torsion[rows, :m])
+    params = {name: np.ascontiguousarray(values[rows, :m]) for name, values in cols.params.items()}
+    mu = params["mu"]
     c, L = np.ascontiguousarray(cols.center[rows, :dim]), np.ascontiguousarray(cols.length[rows])
     cert = res.column("certificate").combine_chunks()
     status = np.asarray(res.column("status").to_numpy(zero_copy_only=False), dtype=object)[rows]
@@ -86,27 +89,27 @@ def _group_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, tol: Tole
                                    ("form", True, form_status, form_margin, [form_flag[r] for r in rows])):
         struct = cert.field(key)
         if polyhedral or fl:
-            C, owner = generator_columns(P, N, mu, models, c, L, frictionless=fl)
-            C = np.ascontiguousarray(C)
+            C, E = generator_errors(P, N, params, models, variants, c, L, frictionless=fl)
             k = C.shape[2]
-            E = _generator_error(P, N, mu, models, c, L, fl, C.shape)
-            kind_b = np.zeros(k, dtype=np.int64)
-            first = np.arange(k)
+            cone, first, width = np.zeros(k, dtype=np.int64), np.arange(k), np.ones(k, dtype=np.int64)
             nb = np.zeros((len(rows), k, dim))
             mub = np.zeros((len(rows), k))
-            torb = np.zeros((len(rows), k))
+            gb = np.zeros((len(rows), k))
             layout = "generators"
             blocks = k
         else:
             C, owner = force_columns(P, N, models, c, L)
             C = np.ascontiguousarray(C)
             k = C.shape[2]
-            from .fastpath import _force_column_error
-
-            E = _force_column_error(P, N, models, c, L, k)
-            kind_b = np.array([("frictionless", "point", "soft").index(name) for name in models])
-            first = np.array([np.flatnonzero(owner == i)[0] for i in range(m)])
-            nb, mub, torb = N, mu, tor
+            E = force_column_errors(P, N, models, c, L)
+            cone = np.array([cone_code(registry.get(name).cone) for name in models], dtype=np.int64)
+            width = np.array([registry.get(name).columns(dim) for name in models], dtype=np.int64)
+            first = np.concatenate([[0], np.cumsum(width)[:-1]]).astype(np.int64)
+            gb = np.zeros((len(rows), m))
+            for i, name in enumerate(models):
+                if registry.get(name).extra:
+                    gb[:, i] = params[registry.get(name).extra[0]][:, i]
+            nb, mub = N, mu
             layout = "forces"
             blocks = m
         d = C.shape[1]
@@ -116,14 +119,14 @@ def _group_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, tol: Tole
         farkas = ok & (kind == "farkas") & yok & (tight_len == 0) & ~null
         nulls = ok & (kind == "farkas") & yok & null & (tight_len == blocks) & (k < d)
         good = np.zeros(len(rows), dtype=bool)
-        none = np.zeros(len(kind_b), dtype=bool)
+        none = np.zeros(len(cone), dtype=bool)
         for i in np.flatnonzero(interior):
-            if verify_interior_general(C[i], E[i], kind_b, first, nb[i], mub[i], torb[i], values[i],
+            if verify_interior_general(C[i], E[i], cone, first, width, nb[i], mub[i], gb[i], values[i],
                                        basis[i], tol.residual) and \
-                    mg[i] <= _certified_margin(C[i], kind_b, first, nb[i], mub[i], torb[i], values[i]):
+                    mg[i] <= _certified_margin(cone, first, width, nb[i], mub[i], gb[i], values[i]):
                 good[i] = True
         for i in np.flatnonzero(farkas):
-            good[i] = verify_farkas_general(C[i], E[i], kind_b, first, nb[i], mub[i], torb[i], y[i],
+            good[i] = verify_farkas_general(C[i], E[i], cone, first, width, nb[i], mub[i], gb[i], y[i],
                                             none, 0.0)
         if nulls.any():
             good[nulls] = null_rows(C[nulls], np.ascontiguousarray(E[nulls]),
@@ -132,59 +135,50 @@ def _group_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, tol: Tole
     return proved
 
 
-def _certified_margin(C, kind, first, n, mu, torsion, x) -> float:
+def _certified_margin(cone, first, width, n, mu, g, x) -> float:
     """Margin the values certify (slack over total normal force), with slack for rounding; the
     claimed margin may not exceed it (the exact checker's rule, with its tolerance)."""
-    from .certificates import margin_of
-    from .problem import Block
-
-    dim = n.shape[1]
-    blocks = []
-    for b in range(len(kind)):
-        width = 1 if kind[b] == 0 else (dim if kind[b] == 1 else dim + 1)
-        blocks.append(Block(("ray", "point", "soft")[kind[b]], tuple(range(first[b], first[b] + width)),
-                            tuple(n[b]), mu[b], torsion[b]))
+    blocks = [Block(CONES[cone[b]], tuple(range(first[b], first[b] + width[b])), tuple(n[b]), mu[b], g[b], b)
+              for b in range(len(cone))]
     t = margin_of(blocks, x)
     return t + 1e-9 + 1e-6 * abs(t)
 
 
-def _generator_error(P, N, mu, models, c, L, frictionless, shape) -> np.ndarray:
-    """Error bounds of planar or spatial generator columns (see :func:`_planar_generators` and
-    :func:`qualgrasp.certify.fastpath._force_column_error`)."""
-    B, d, k = shape
-    if d == 3:
-        from .fastpath import _layout
-
-        owner, sgn = _layout(models, frictionless)
-        W = np.empty((3, k))
+def generator_errors(P, N, params, models, variants, c, L, *, frictionless: bool = False):
+    """Generator columns (B, d, k) of a group of grasps and bounds on their distance to the
+    exact values on the same data: the planar kernel's
+    (:func:`qualgrasp.certify._kernels.planar.planar_generators`) or, in space, those of
+    frictionless force columns (:func:`qualgrasp.certify.wrench.force_column_errors`)."""
+    B, m, dim = P.shape
+    if dim == 2:
+        owner, offset, friction = generator_layout(models, variants, 2, frictionless=frictionless)
+        k = len(owner)
+        W = np.empty((B, 3, k))
         E = np.empty((B, 3, k))
         for i in range(B):
-            _planar_generators(P[i], N[i], mu[i], c[i], L[i], owner, sgn, W, E[i])
-        return E
-    from .fastpath import _force_column_error
+            planar_generators(P[i], N[i], params["mu"][i], params["width"][i], c[i], L[i], owner,
+                              offset, friction, W[i], E[i])
+        return W, E
+    W, _ = generator_columns(P, N, params["mu"], models, c, L, frictionless=True, variants=(0,) * m)
+    return np.ascontiguousarray(W), force_column_errors(P, N, ("frictionless",) * m, c, L)
 
-    return _force_column_error(P, N, ("frictionless",) * k, c, L, k)
 
+def recheck_table(cols: GraspColumns, results: pa.Table, lines, slow, tol: Tolerances = Tolerances()):
+    """Re-check ``results`` against the checked grasp columns ``cols`` (same rows, same order).
 
-def recheck_table(grasps: pa.Table, results: pa.Table, lines, slow, tol: Tolerances = Tolerances()):
-    """Re-check ``results`` against ``grasps`` (same rows in the same order).
-
-    ``slow(index) -> Check`` re-checks one row exactly; it receives every row not proved in
+    ``slow(index) -> bool`` re-checks one row exactly; it receives every row not proved in
     bulk. Returns the boolean array of rows that passed.
     """
     n = results.num_rows
-    cols = grasp_columns(grasps)
     status = np.asarray(results.column("status").to_numpy(zero_copy_only=False), dtype=object)
     passed = np.zeros(n, dtype=bool)
     line = results.column("line").to_numpy(zero_copy_only=False)
-    ids_ok = np.array([a == b or str(a) == str(b) for a, b in
-                       zip(results.column("id").to_pylist(), cols.ids.to_pylist())], dtype=bool)
+    ids = results.column("id").to_pylist()
+    ids_ok = np.array([a == cols.id_of(i) or str(a) == str(cols.id_of(i)) for i, a in enumerate(ids)], dtype=bool)
     fine = cols.ok & (status != "error") & ids_ok & (np.asarray(line) == np.asarray(lines))
-    m = cols.model.shape[1]
-    key = cols.dim * 3 ** (m + 2) + cols.count * 3 ** m + \
-        (np.where(cols.model < 0, 0, cols.model) * 3 ** np.arange(m)).sum(1)
-    for k in np.unique(key[fine]):
-        rows = np.flatnonzero(fine & (key == k))
+    label = cols.pattern()
+    for k in np.unique(label[fine]):
+        rows = np.flatnonzero(fine & (label == k))
         passed[rows] = _group_proofs(cols, rows, results, tol)
     for i in np.flatnonzero(~passed):
         passed[i] = bool(slow(int(i)))

@@ -1,13 +1,10 @@
 """Certify one grasp end to end: force and form closure, certificates, independent re-check.
 
 :func:`certify_grasp` returns a :class:`Report`; :meth:`Report.row` is the results-file row
-(one JSON object per input grasp) with the keys ``id``, ``line``, ``dim``, ``status``,
-``form_closure``, ``force_closure``, ``margin``, ``form_status``, ``form_margin``,
-``certificate`` (``{"force": ..., "form": ...}``), ``verified``, ``error``, ``center``, ``length``,
-``n_contacts``, and the Ferrari-Canny epsilon bounds ``eps_l1_lo``, ``eps_l1_hi``,
-``eps_linf_lo``, ``eps_linf_hi`` (equal in the plane; 0 when not in force closure; null when
-quality was not asked for), computed with the row's ``center`` and ``length``. ``status`` refers
-to force closure under the declared contact models.
+(:data:`qualgrasp.certify.results.COLUMNS`): the force and form closure verdicts, margins and
+certificates, whether both certificates re-checked, the ``center`` and ``length`` used, and the
+Ferrari-Canny epsilon bounds (equal in the plane; 0 when not in force closure; null when quality
+was not asked for). ``status`` refers to force closure under the declared contact models.
 """
 
 from __future__ import annotations
@@ -20,8 +17,9 @@ from .errors import CertificateError
 from .closure import Verdict, form_closure, force_closure
 from .grasp import Grasp
 from .quality import Epsilon, epsilon
+from .results import result_row
 
-__all__ = ["Report", "certify_grasp", "error_row", "verify_row"]
+__all__ = ["Report", "certify_grasp", "verify_row"]
 
 
 @dataclass(frozen=True)
@@ -45,31 +43,21 @@ class Report:
         return float(self.epsilons["L1"].hi) if self.certified and self.epsilons else 0.0
 
     def row(self, line: int | None = None) -> dict[str, Any]:
+        """The results-file row of this grasp (:data:`qualgrasp.certify.results.COLUMNS`)."""
         g = self.grasp
         eps = {}
         for norm, key in (("L1", "l1"), ("Linf", "linf")):
             e = self.epsilons.get(norm) if self.epsilons else None
             eps[f"eps_{key}_lo"] = None if e is None else e.lo
             eps[f"eps_{key}_hi"] = None if e is None else e.hi
-        return {
-            "id": g.id,
-            "line": line,
-            "dim": g.dim,
-            "status": self.force.status,
-            "form_closure": self.form.closure,
-            "force_closure": self.force.closure,
-            "margin": self.force.margin,
-            "form_status": self.form.status,
-            "form_margin": self.form.margin,
-            "certificate": {"force": self.force.certificate.to_json(),
-                            "form": self.form.certificate.to_json()},
-            "verified": self.verified,
-            "error": None,
-            "center": list(g.center),
-            "length": g.length,
-            "n_contacts": len(g.contacts),
-            **eps,
-        }
+        return result_row(
+            id=g.id, line=line, dim=g.dim, status=self.force.status,
+            form_closure=self.form.closure, force_closure=self.force.closure,
+            margin=self.force.margin, form_status=self.form.status, form_margin=self.form.margin,
+            certificate={"force": self.force.certificate.to_json(),
+                         "form": self.form.certificate.to_json()},
+            verified=self.verified, error=None, center=list(g.center), length=g.length,
+            n_contacts=len(g.contacts), **eps)
 
 
 def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
@@ -89,17 +77,6 @@ def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
         eps = {norm: epsilon(grasp, norm, rel_gap=eps_gap, budget=eps_budget, verdict=force)
                for norm in ("L1", "Linf")}
     return Report(grasp, force, form, ok, eps)
-
-
-def error_row(message: str, *, id: Any = None, line: int | None = None) -> dict[str, Any]:
-    """Results row for an input that could not be certified."""
-    return {
-        "id": id, "line": line, "dim": None, "status": "error", "form_closure": None,
-        "force_closure": None, "margin": None, "form_status": "error", "form_margin": None,
-        "certificate": None, "verified": False, "error": message, "center": None,
-        "length": None, "n_contacts": None, "eps_l1_lo": None, "eps_l1_hi": None,
-        "eps_linf_lo": None, "eps_linf_hi": None,
-    }
 
 
 def verify_row(grasp: Grasp, row: dict[str, Any], tol: Tolerances = Tolerances()) -> Check:

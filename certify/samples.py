@@ -124,9 +124,10 @@ def random_grasp_table(seed: int, count: int, *, dim: int = 2, n_contacts: int =
     else:
         mus = pa.array(rng.uniform(*mu, size=total))
     tors = pa.array(rng.uniform(*torsion, size=total)) if model == "soft" else pa.nulls(total, pa.float64())
+    fields = {"p": lists(p), "n": lists(n), "model": pa.array(np.full(total, model, dtype=object)),
+              "mu": mus, "torsion": tors}
     contacts = pa.StructArray.from_arrays(
-        [lists(p), lists(n), pa.array(np.full(total, model, dtype=object)), mus, tors],
-        fields=list(CONTACT))
+        [fields.get(f.name, pa.nulls(total, f.type)) for f in CONTACT], fields=list(CONTACT))
     per_row = pa.ListArray.from_arrays(pa.array(np.arange(0, total + 1, m, dtype=np.int32)), contacts)
     ids = pa.array([f"r{i}" for i in range(start, start + count)])
     return pa.table({"id": ids, "contacts": per_row, "center": pa.nulls(count, pa.list_(pa.float64())),

@@ -30,7 +30,7 @@ import numpy as np
 from .errors import GraspError
 from .grasp import Contact, Grasp
 from .quality import epsilon, epsilon_of_points
-from .wrench import generator_columns, grasp_arrays
+from .problem import grasp_system
 
 __all__ = ["Efficiency", "polygon_frame", "boundary_contacts", "boundary_epsilon",
            "steinitz_bound", "efficiency"]
@@ -96,8 +96,7 @@ def boundary_epsilon(vertices, *, spacing: float | None = None, model: str = "po
     if spacing is None:
         spacing = float(np.sum(np.linalg.norm(np.roll(V, -1, axis=0) - V, axis=1))) / 200
     g = Grasp(tuple(boundary_contacts(V, spacing, model=model, mu=mu)), center=center, length=length)
-    P, N, m, _, c, L = grasp_arrays(g)
-    W, _ = generator_columns(P, N, m, tuple(ct.model for ct in g.contacts), c, L)
+    W = grasp_system(g).columns
     return epsilon_of_points(np.vstack([np.zeros(3), W.T])), center, length, W.shape[1]
 
 

@@ -3,10 +3,11 @@
 Parquet files hold the same schema as the JSON Lines files of :mod:`qualgrasp.certify.io`:
 
 * grasps: ``id`` (string), ``contacts`` (list of struct ``p``, ``n`` (lists of float64),
-  ``model`` (string), ``mu``, ``torsion`` (float64, nullable)), ``center`` (list of float64,
-  nullable), ``length`` (float64, nullable);
-* results: the columns of :meth:`qualgrasp.certify.report.Report.row`, with ``certificate`` a struct
-  ``{force, form}`` of certificate structs.
+  ``model`` (string), and one float64 field per model parameter: ``mu``, ``torsion``,
+  ``width``, nullable), ``center`` (list of float64, nullable), ``length`` (float64, nullable).
+  Other layouts are read too (:mod:`qualgrasp.certify.columns`);
+* results: the columns of :data:`qualgrasp.certify.results.COLUMNS`, with ``certificate`` a
+  struct ``{force, form}`` of certificate structs.
 
 The format of a file is chosen by its extension: ``.parquet`` / ``.pq`` for Parquet, anything
 else (``.jsonl``, ``.json``, ``.ndjson``) for JSON Lines. Both are read in chunks of a fixed number
@@ -25,39 +26,19 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from .errors import GraspFileError
+from .results import RESULT_SCHEMA
+from .validation import param_names
 
-__all__ = ["CONTACT", "GRASP_SCHEMA", "CERTIFICATE", "RESULT_SCHEMA", "RESULT_WRITE_OPTIONS", "is_parquet",
-           "Chunk", "iter_chunks", "count_grasps", "grasps_table", "rows_to_table", "table_to_rows"]
+__all__ = ["CONTACT", "GRASP_SCHEMA", "is_parquet", "Chunk", "iter_chunks", "count_grasps",
+           "grasps_table", "rows_to_table", "table_to_rows", "chunk_values"]
 
-CONTACT = pa.struct([
-    ("p", pa.list_(pa.float64())), ("n", pa.list_(pa.float64())), ("model", pa.string()),
-    ("mu", pa.float64()), ("torsion", pa.float64()),
-])
+CONTACT = pa.struct([("p", pa.list_(pa.float64())), ("n", pa.list_(pa.float64())), ("model", pa.string())]
+                    + [(name, pa.float64()) for name in param_names()])
+"""A contact as an Arrow struct: ``p``, ``n``, ``model`` and every registered model parameter."""
 GRASP_SCHEMA = pa.schema([
     ("id", pa.string()), ("contacts", pa.list_(CONTACT)), ("center", pa.list_(pa.float64())),
     ("length", pa.float64()),
 ])
-CERTIFICATE = pa.struct([
-    ("kind", pa.string()), ("layout", pa.string()), ("values", pa.list_(pa.float64())),
-    ("basis", pa.list_(pa.int32())), ("y", pa.list_(pa.float64())), ("tight", pa.list_(pa.int32())),
-    ("null_space", pa.bool_()), ("reason", pa.string()),
-])
-RESULT_SCHEMA = pa.schema([
-    ("id", pa.string()), ("line", pa.int64()), ("dim", pa.int8()), ("status", pa.string()),
-    ("form_closure", pa.bool_()), ("force_closure", pa.bool_()), ("margin", pa.float64()),
-    ("form_status", pa.string()), ("form_margin", pa.float64()),
-    ("certificate", pa.struct([("force", CERTIFICATE), ("form", CERTIFICATE)])),
-    ("verified", pa.bool_()), ("error", pa.string()), ("center", pa.list_(pa.float64())),
-    ("length", pa.float64()), ("n_contacts", pa.int32()),
-    ("eps_l1_lo", pa.float64()), ("eps_l1_hi", pa.float64()),
-    ("eps_linf_lo", pa.float64()), ("eps_linf_hi", pa.float64()),
-])
-
-# Dictionary-encode only the columns of names: dictionary pages of float columns cost more
-# than half the time of writing results, and make the file larger.
-RESULT_WRITE_OPTIONS = {"use_dictionary": [
-    "status", "form_status", "certificate.force.kind", "certificate.force.layout",
-    "certificate.form.kind", "certificate.form.layout"]}
 
 
 def is_parquet(path: str | Path) -> bool:
@@ -185,9 +166,9 @@ def count_grasps(path: str | Path) -> int | None:
 def grasps_table(dicts: list[dict]) -> pa.Table:
     """Arrow table (grasp schema) of grasp dictionaries in the JSON schema; ids become strings."""
     rows = []
+    keys = ("p", "n", "model") + param_names()
     for d in dicts:
-        contacts = [{"p": c["p"], "n": c["n"], "model": c.get("model"), "mu": c.get("mu"),
-                     "torsion": c.get("torsion")} for c in d["contacts"]]
+        contacts = [{k: c.get(k) for k in keys} for c in d["contacts"]]
         gid = d.get("id")
         rows.append({"id": None if gid is None else str(gid), "contacts": contacts,
                      "center": d.get("center"), "length": d.get("length")})

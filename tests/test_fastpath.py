@@ -7,8 +7,8 @@ import pyarrow as pa
 import pytest
 
 from qualgrasp.certify import Contact, Grasp
-from qualgrasp.certify.batch import certify_values, verify_file
-from qualgrasp.certify.engine import Options
+from qualgrasp.certify.batch import verify_file
+from qualgrasp.certify.chunk import Options, certify_values
 from qualgrasp.certify.table import table_values
 from qualgrasp.certify.fastpath import certify_table
 from qualgrasp.certify.grasp import grasp_to_dict

@@ -1,12 +1,12 @@
 """Spatial closure programmes through their dual, by the compiled barrier method of
-:func:`qualgrasp.certify.kernels.socp_dual_barrier`: a few dozen Newton steps in the ``d = 6`` wrench
+:func:`qualgrasp.certify._kernels.barrier.socp_dual_barrier`: a few dozen Newton steps in the ``d = 6`` wrench
 coordinates, tens of microseconds per grasp, no solver library call."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..kernels import socp_dual_barrier
+from .._kernels.barrier import socp_dual_barrier
 from ..problem import ClosureProblem
 from . import Solution
 

@@ -23,13 +23,14 @@ from itertools import combinations
 
 import numpy as np
 
-from ..kernels import lp_enumerate, lp_planar
+from .._kernels.lp import lp_enumerate, lp_planar
 from ..problem import ClosureProblem
 from . import Solution
 
-__all__ = ["enumerate_lp", "solve_enumeration", "EnumerationSolver"]
+__all__ = ["FEAS", "bases", "enumerate_lp", "solve_enumeration", "EnumerationSolver"]
 
-_FEAS = 1e-12  # feasibility slack on basic solutions, relative to their scale
+#: Feasibility slack on basic solutions, relative to their scale.
+FEAS = 1e-12
 
 
 def bases(k: int, d: int) -> np.ndarray:
@@ -38,7 +39,7 @@ def bases(k: int, d: int) -> np.ndarray:
 
 
 def enumerate_lp(W: np.ndarray):
-    """Solve a batch of min-weight LPs exactly (compiled kernels of :mod:`qualgrasp.certify.kernels`).
+    """Solve a batch of min-weight LPs exactly (compiled kernels of :mod:`qualgrasp.certify._kernels.lp`).
 
     Parameters
     ----------
@@ -58,7 +59,7 @@ def enumerate_lp(W: np.ndarray):
     W = np.ascontiguousarray(W, dtype=float)
     _, d, k = W.shape
     kernel = lp_planar if d == 3 else lp_enumerate
-    t, lam, y, has_y = kernel(W, bases(k, d), _FEAS)
+    t, lam, y, has_y = kernel(W, bases(k, d), FEAS)
     y[~has_y] = np.nan
     return t, lam, y
 

@@ -19,7 +19,8 @@ from itertools import combinations
 
 import numpy as np
 
-from ..kernels import farkas_direction, squeeze_direction
+from .._kernels.cones import farkas_direction, squeeze_direction
+from ..cones import LORENTZ
 from ..problem import ClosureProblem, block_arrays
 from . import Solution
 
@@ -40,19 +41,19 @@ def squeeze_solution(problem: ClosureProblem) -> Solution | None:
     return None if y is None else Solution("optimal", 0.0, None, y)
 
 
-def squeeze_farkas(C, kind, first, n, mu, torsion) -> np.ndarray | None:
+def squeeze_farkas(C, cone, first, width, n, mu, g) -> np.ndarray | None:
     """The rule on a spatial certificate system given as block arrays
     (:func:`qualgrasp.certify.problem.block_arrays`): the squeeze direction ``y`` (or ``-y``) of the first
-    pair of point blocks for which :func:`qualgrasp.certify.closure.farkas_certificate` gives a certificate
+    pair of point blocks (Lorentz cones without moment columns) for which :func:`qualgrasp.certify.closure.farkas_certificate` gives a certificate
     with exactly that pair tight, else None."""
-    points = np.flatnonzero(kind == 1)
+    points = np.flatnonzero((cone == LORENTZ) & (width == 3))
     for a, b in combinations(points, 2):
         cols = np.concatenate([first[a] + np.arange(3), first[b] + np.arange(3)])
         ok, y = squeeze_direction(C, cols)
         if not ok:
             continue
         for signed in (y, -y):
-            good, _, tight = farkas_direction(C, kind, first, n, mu, torsion, signed, 1e-7)
+            good, _, tight = farkas_direction(C, cone, first, width, n, mu, g, signed, 1e-7)
             if good and tight[a] and tight[b] and tight.sum() == 2:
                 return signed
     return None

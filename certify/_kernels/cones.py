@@ -1,0 +1,148 @@
+"""Cone tests in floating point, compiled (numba): the formulas of :mod:`qualgrasp.certify.cones`.
+
+Cone blocks are given as arrays ``(cone, first, width, n, mu, g)``
+(:func:`qualgrasp.certify.problem.block_arrays`): the cone shape code (:data:`~qualgrasp.certify.cones.RAY`
+or :data:`~qualgrasp.certify.cones.LORENTZ`), the block's first certificate column and its
+number of columns, its stored normal (zeros for rays), friction coefficient and moment length
+(a Lorentz block's columns beyond the dimension of ``n`` are moment columns weighted by ``g``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ..cones import RAY
+
+__all__ = ["functional", "polar_value", "polar_values", "farkas_direction", "squeeze_direction"]
+
+
+@njit(cache=True)
+def functional(C, first, width, y, a):
+    """``a[c] = y . C[:, first + c]`` for the ``width`` columns of one block."""
+    for c in range(width):
+        acc = 0.0
+        for i in range(C.shape[0]):
+            acc += C[i, first + c] * y[i]
+        a[c] = acc
+
+
+@njit(cache=True)
+def polar_value(a, cone, width, n, mu, g):
+    """Polar value ``a_n + mu norm((a_t, a_m g / |n|))`` of the functional ``a`` (values on the
+    block's ``width`` columns) on one block, ``a[0]`` for a ray: the largest ``y . w`` over the
+    block's unit-normal-force wrenches."""
+    if cone == RAY:
+        return a[0]
+    dim = n.shape[0]
+    nn = 0.0
+    for i in range(dim):
+        nn += n[i] * n[i]
+    rn = np.sqrt(nn)
+    an = 0.0
+    for i in range(dim):
+        an += a[i] * n[i] / rn
+    t2 = 0.0
+    for i in range(dim):
+        ti = a[i] - an * n[i] / rn
+        t2 += ti * ti
+    for c in range(dim, width):  # moment columns (a soft finger's torsion)
+        t2 += (a[c] * g / rn) ** 2
+    return an + mu * np.sqrt(t2)
+
+
+@njit(cache=True)
+def polar_values(C, cone, first, width, n, mu, g, y):
+    """:func:`polar_value` of every block for the functional ``a = C_b' y`` (the same formula
+    for every route: see :mod:`qualgrasp.certify.cones`)."""
+    out = np.empty(cone.shape[0])
+    a = np.empty(C.shape[1])
+    for b in range(cone.shape[0]):
+        functional(C, first[b], width[b], y, a)
+        out[b] = polar_value(a, cone[b], width[b], n[b], mu[b], g[b])
+    return out
+
+
+@njit(cache=True)
+def farkas_direction(C, cone, first, width, n, mu, g, y, rel):
+    """The rule of :func:`qualgrasp.certify.closure.farkas_certificate`, compiled: ``(ok, y,
+    tight)``.
+
+    ``y`` is normalised; if every block's polar value is below ``-1e-9 scale`` (``scale`` the
+    largest ``abs(C)``) it is a strict certificate. Otherwise blocks whose functional
+    ``C_b' y`` is at most ``rel scale`` in absolute value are tight, ``y`` is projected off the
+    span of their columns (QR, columns with ``abs(R_ii) > 1e-12 scale``) and normalised again
+    (refused if the projection leaves less than half of it), and every other block must be
+    strictly separated."""
+    d = C.shape[0]
+    nb = cone.shape[0]
+    tight = np.zeros(nb, dtype=np.bool_)
+    out = np.zeros(d)
+    ss = 0.0
+    for i in range(d):
+        ss += y[i] * y[i]
+    norm = np.sqrt(ss)
+    if not (np.isfinite(norm) and norm > 0.0):
+        return False, out, tight
+    for i in range(d):
+        out[i] = y[i] / norm
+    scale = 0.0
+    for i in range(d):
+        for j in range(C.shape[1]):
+            scale = max(scale, abs(C[i, j]))
+    pv = polar_values(C, cone, first, width, n, mu, g, out)
+    if pv.max() < -1e-9 * scale:
+        return True, out, tight
+    ntc = 0
+    a = np.empty(C.shape[1])
+    for b in range(nb):
+        functional(C, first[b], width[b], out, a)
+        big = 0.0
+        for c in range(width[b]):
+            big = max(big, abs(a[c]))
+        if big <= rel * scale:
+            tight[b] = True
+            ntc += width[b]
+    if ntc > 0:
+        T = np.empty((d, ntc))
+        c0 = 0
+        for b in range(nb):
+            if tight[b]:
+                for c in range(width[b]):
+                    T[:, c0] = C[:, first[b] + c]
+                    c0 += 1
+        Q, R = np.linalg.qr(T)
+        proj = out.copy()
+        for c in range(min(d, ntc)):
+            if abs(R[c, c]) > 1e-12 * scale:
+                dot = 0.0
+                for i in range(d):
+                    dot += Q[i, c] * out[i]
+                for i in range(d):
+                    proj[i] -= Q[i, c] * dot
+        ss = 0.0
+        for i in range(d):
+            ss += proj[i] * proj[i]
+        norm = np.sqrt(ss)
+        if norm < 0.5:
+            return False, out, tight
+        for i in range(d):
+            out[i] = proj[i] / norm
+        pv = polar_values(C, cone, first, width, n, mu, g, out)
+    for b in range(nb):
+        if not tight[b] and not pv[b] < -1e-9 * scale:
+            return False, out, tight
+    return True, out, tight
+
+
+@njit(cache=True)
+def squeeze_direction(C, cols):
+    """The direction orthogonal to the columns ``cols`` of ``C`` (6, k) of two point contacts,
+    and whether they span exactly 5 dimensions (smallest singular value at most ``1e-12``,
+    next one above ``1e-6``, of the largest): see :mod:`qualgrasp.certify.solvers.squeeze`."""
+    T = np.empty((C.shape[0], cols.shape[0]))
+    for c in range(cols.shape[0]):
+        T[:, c] = C[:, cols[c]]
+    U, sv, _ = np.linalg.svd(T)
+    ok = sv[-1] <= 1e-12 * sv[0] and sv[-2] > 1e-6 * sv[0]
+    return ok, U[:, -1].copy()

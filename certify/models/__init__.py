@@ -1,0 +1,21 @@
+"""Contact models as objects, registered by name (see :mod:`qualgrasp.certify.models.base`).
+
+Built in, in code order: ``frictionless``, ``point``, ``soft``, ``pad``. A new model is one
+module declaring a :class:`ContactModel` subclass and registering an instance, plus its import
+here.
+
+Examples
+--------
+>>> from qualgrasp.certify import models
+>>> models.names()
+('frictionless', 'point', 'soft', 'pad')
+>>> models.get("pad").generators(2, variant=1)[0]
+Generator(offset=0.5, friction=1.0)
+"""
+
+from .base import (MAX_LENGTH, MAX_MU, MIN_LENGTH, ContactModel, Generator, Param, get, models,
+                   names, register)
+from . import frictionless, point, soft, pad  # noqa: E402,F401  (registration, in code order)
+
+__all__ = ["ContactModel", "Param", "Generator", "register", "get", "names", "models",
+           "MAX_MU", "MAX_LENGTH", "MIN_LENGTH"]
