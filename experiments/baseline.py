@@ -51,7 +51,8 @@ from qualgrasp.certify.fastpath import planar_screen
 from qualgrasp.qualitative.candidates import object_frame
 from qualgrasp.qualitative.errors import QualitativeError
 from qualgrasp.qualitative.outline import Outline, outline_contour, resample
-from qualgrasp.qualitative.synthesis import MU
+from qualgrasp.qualitative.procedures import Procedure
+from qualgrasp.qualitative.synthesis import MU, choose
 from qualgrasp.qualitative.vision import ImageSource, extract_contour
 
 __all__ = ["MU", "Budget", "Boundary", "BaselineResult", "boundary", "boundary_of", "search",
@@ -323,7 +324,7 @@ def _grasp(points, normals, rows, mu: float, center, length: float, gid: str) ->
                  meta={"procedure": "Baseline", "fingers": len(contacts)})
 
 
-def baseline(image: ImageSource | Boundary, fingers: int, mu: float | None = MU,
+def baseline(image: ImageSource | Boundary, procedure: int | str | Procedure, mu: float | None = MU,
              budget: Budget = Budget(), *, name: str = "image", threshold: float | None = None,
              largest: bool = True) -> BaselineResult:
     """The baseline's best grasps on the object of an image (module notes).
@@ -332,10 +333,12 @@ def baseline(image: ImageSource | Boundary, fingers: int, mu: float | None = MU,
     ----------
     image : image file, array, or Boundary
         The image (its boundary is extracted by :func:`boundary`), or a boundary already extracted.
-    fingers : {2, 3, 4}
-        2 and 3: point contacts with friction ``mu``; 4: frictionless (``mu`` ignored).
+    procedure : Procedure, str or int
+        The synthesis procedure whose fingers and contact model the baseline uses (a registered
+        one, :mod:`qualgrasp.qualitative.procedures`, by object, name, or finger count: 2 and 3
+        point contacts with friction, 4 frictionless).
     mu : float
-        Friction coefficient of 2 and 3 fingers.
+        Friction coefficient of procedures with friction (ignored for frictionless ones).
     budget : Budget
         Search size.
     name : str
@@ -348,8 +351,11 @@ def baseline(image: ImageSource | Boundary, fingers: int, mu: float | None = MU,
     BaselineResult
     """
     start = time.perf_counter()
+    proc = procedure if isinstance(procedure, Procedure) else choose(
+        procedure if isinstance(procedure, int) else None, procedure if isinstance(procedure, str) else None)
+    fingers = proc.fingers
     bound = image if isinstance(image, Boundary) else boundary(image, threshold=threshold, largest=largest)
-    friction = 0.0 if fingers == 4 else float(mu)
+    friction = float(mu) if proc.friction else 0.0
     n = len(bound.points)
     pick = np.round(np.arange(budget.samples) * n / budget.samples).astype(int) % n
     points, normals = bound.points[pick], bound.normals[pick]
@@ -358,7 +364,7 @@ def baseline(image: ImageSource | Boundary, fingers: int, mu: float | None = MU,
                           f"{name}-base{fingers}-{k:04d}") for k, rows in enumerate(idx))
     reports = tuple(certify_grasp(g) for g in grasps)
     epsilons = tuple(r.eps_l1 for r in reports)
-    return BaselineResult(fingers, None if fingers == 4 else float(mu), grasps, reports, epsilons,
+    return BaselineResult(fingers, float(mu) if proc.friction else None, grasps, reports, epsilons,
                           tuple(float(e) for e in eps), evaluated, time.perf_counter() - start, bound)
 
 

@@ -27,16 +27,16 @@ from qualgrasp.certify.samples import textbook_grasps
 from qualgrasp.qualitative.objects import render
 from qualgrasp.qualitative.synthesis import MU, synthesize
 
+from ..qualitative import procedures
+from .figures import STEMS, make_figures
 from .study import BUILTINS, StudyResult, compare, workload
 
 __all__ = ["DemoResult", "SynthesisRow", "run_demo", "demo_steps"]
 
-FINGERS = (4, 2, 3)
-
-
 @dataclass(frozen=True)
 class SynthesisRow:
-    """One object and procedure of the demo: outline string, grasps found and certified."""
+    """One object and procedure of the demo: outline string, grasps found and certified
+    (``procedure`` is the procedure's title, ``method`` its registry name)."""
 
     name: str
     string: str
@@ -73,23 +73,21 @@ class DemoResult:
 
 def demo_steps(objects: int = len(BUILTINS)) -> int:
     """Number of progress messages :func:`run_demo` sends (for a progress bar's total)."""
-    from .figures import STEMS
-
-    return len(STEMS) + objects * len(FINGERS) + 2 + workload(objects, "quick")
+    return len(STEMS) + objects * len(procedures.procedures()) + 2 + workload(objects, "quick")
 
 
 def _synthesise(progress: Callable[[str], None]) -> tuple[list, list[SynthesisRow]]:
     grasps, rows = [], []
     for name in BUILTINS:
         image = render(name)
-        for fingers in FINGERS:
-            s = synthesize(image, fingers, mu=None if fingers == 4 else MU, name=name)
+        for proc in procedures.procedures():
+            s = synthesize(image, procedure=proc.name, mu=MU if proc.friction else None, name=name)
             summary = s.summary()
             grasps += s.grasps
-            rows.append(SynthesisRow(name, s.outline.string, s.procedure, fingers, len(s.grasps),
+            rows.append(SynthesisRow(name, s.outline.string, proc.title, proc.fingers, len(s.grasps),
                                      summary["certified"], summary["median_margin"],
                                      summary["median_eps_l1"], s.seconds))
-            progress(f"{s.procedure} {fingers} on {name}: {len(s.grasps)} grasps")
+            progress(f"{proc.title} {proc.fingers} on {name}: {len(s.grasps)} grasps")
     return grasps, rows
 
 
@@ -108,8 +106,6 @@ def run_demo(out: str | Path = "qualgrasp-demo", *,
     -------
     DemoResult
     """
-    from .figures import make_figures
-
     start = time.perf_counter()
     tick = progress or (lambda message: None)
     out = Path(out)

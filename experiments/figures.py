@@ -82,7 +82,7 @@ def best_grasp(synth: Synthesis) -> int:
         The synthesis found no grasp, or was not certified.
     """
     if not synth.found or not synth.reports:
-        raise ValueError(f"{synth.name}: {synth.procedure} found no certified grasp to draw")
+        raise ValueError(f"{synth.name}: {synth.procedure.title} found no certified grasp to draw")
     return max(range(len(synth.found)), key=lambda k: (synth.reports[k].force.margin, _own_margin(synth, k)))
 
 

@@ -4,9 +4,10 @@
 
 Routes
 ------
-* qualitative: :func:`qualgrasp.qualitative.synthesis.synthesize`, FormGrasp with 4 frictionless fingers and
-  ForceGrasp with 2 and 3 point contacts at ``mu`` (0.5);
-* baseline: :func:`qualgrasp.experiments.baseline.baseline` for the same finger counts and contact models,
+* qualitative: :func:`qualgrasp.qualitative.synthesis.synthesize` with every registered procedure
+  (:mod:`qualgrasp.qualitative.procedures`: FormGrasp with 4 frictionless fingers, ForceGrasp
+  with 2 and 3 point contacts at ``mu``, 0.5);
+* baseline: :func:`qualgrasp.experiments.baseline.baseline` for each procedure's fingers and contact model,
   the grasps of largest certified L1 epsilon on a densely sampled boundary (its docstring states
   the search and its budget).
 
@@ -80,144 +81,22 @@ from qualgrasp.qualitative.objects import NAMES, render
 from qualgrasp.qualitative.synthesis import synthesize
 from qualgrasp.qualitative.vision import read_image, segment
 
-from .baseline import MU, Boundary, Budget, baseline, boundary, screen_grasps
+from .baseline import Boundary, Budget, baseline, boundary, screen_grasps
+from .design import (BUILTINS, DETERMINISTIC, FULL, GRASP_COLUMNS, KINDS, OBJECT_COLUMNS,
+                     OVERALL_COLUMNS, QUICK, ROBUSTNESS_COLUMNS, ROUTES, SETTINGS, UNITS, Route,
+                     RouteSummary, Settings, StudyResult, Subject, routes)
 from .silhouettes import Silhouette
+from .study_plots import plot_all
+from .study_tables import overall_rows, robustness_rows, summarise, write_tables
 
 __all__ = ["BUILTINS", "KINDS", "UNITS", "ROUTES", "QUICK", "FULL", "SETTINGS", "OBJECT_COLUMNS",
            "OVERALL_COLUMNS", "ROBUSTNESS_COLUMNS", "GRASP_COLUMNS", "Settings", "Subject",
            "RouteSummary", "StudyResult", "subjects", "perturb", "execute", "evaluate_object",
            "robustness_trial", "warm_up", "workload", "compare"]
 
-KINDS = ("rotation", "translation", "noise", "blur", "threshold")
-UNITS = {"none": "", "rotation": "deg", "translation": "px", "noise": "grey sd", "blur": "px sd",
-         "threshold": "grey levels"}
-BUILTINS = ("polygon", "nut", "disc", "figure3")
-ROUTES = (("ForceGrasp", 2), ("ForceGrasp", 3), ("FormGrasp", 4),
-          ("Baseline", 2), ("Baseline", 3), ("Baseline", 4))
-
-OBJECT_COLUMNS = ("object", "route", "method", "fingers", "mu", "grasps", "certified",
-                  "certified_fraction", "eps_median", "eps_best", "ratio_best", "ratio_median",
-                  "seconds", "candidates", "error")
-"""Per object and route: grasps returned, certified, certified fraction, median and best certified
-L1 epsilon (uncertified grasps count 0), the qualitative best and median over the baseline's best
-with the same fingers (empty for the baseline), seconds (image to certified grasps), candidates
-screened (baseline), error message (route failed on the image)."""
-
-OVERALL_COLUMNS = ("route", "method", "fingers", "objects", "objects_with_grasps", "grasps",
-                   "certified_fraction", "eps_median", "eps_best", "ratio_best", "ratio_median",
-                   "seconds_median", "seconds_total", "robustness", "robustness_paired")
-"""Per route over all objects: objects, objects where the route found a certified grasp, grasps,
-certified fraction (pooled), medians over objects of the per-object median and best epsilon and
-of the ratios (objects where both routes found grasps), median and total seconds, robustness
-pooled over every perturbation (not ``none``), and the same over the trials where both methods
-planned a certified grasp with the route's finger count (``paired``: the qualitative route finds
-no grasp on some objects, where the baseline's grasps may be the most fragile)."""
-
-ROBUSTNESS_COLUMNS = ("route", "method", "fingers", "kind", "size", "unit", "trials", "planned",
-                      "held", "fraction", "misses", "collisions", "eps_planned", "eps_executed")
-"""Per route, perturbation kind and size: trials (object x trial), planned grasps that certified on
-the perturbed image, how many hold on the true object, their fraction, fingers that missed or
-collided, median epsilon of the planned and of the executed grasps (0 for those that fail)."""
-
-GRASP_COLUMNS = ("object", "route", "method", "fingers", "certified", "eps")
-
-_DETERMINISTIC = ("blur", "threshold")
 _ON = 1e-3  # a point this close to a contour (pixels) is on it
+
 _VERTEX = 1e-9  # rounding allowed at the ends of an edge (fraction of the edge)
-
-_FULL_SIZES = (("rotation", (1.0, 2.0, 4.0, 8.0)), ("translation", (1.0, 2.0, 4.0, 8.0)),
-               ("noise", (10.0, 20.0, 40.0, 60.0)), ("blur", (1.0, 2.0, 4.0, 8.0)),
-               ("threshold", (-60.0, -30.0, 30.0, 60.0)))
-_QUICK_SIZES = (("rotation", (2.0, 8.0)), ("translation", (2.0, 8.0)), ("noise", (20.0, 60.0)),
-                ("blur", (2.0, 8.0)), ("threshold", (-60.0, 60.0)))
-
-
-@dataclass(frozen=True)
-class Settings:
-    """How much work the study does.
-
-    Attributes
-    ----------
-    budget : Budget
-        Baseline search budget (nominal images and every perturbed image).
-    sizes : tuple of (str, tuple of float)
-        Perturbation sizes per kind (units in :data:`UNITS`).
-    trials : int
-        Random trials per object, kind and size.
-    mu : float
-        Friction coefficient of the 2- and 3-finger routes.
-    standoff : float
-        Finger start distance before the planned contact, fraction of the object's diameter.
-    workers : int
-        Processes (1: run in this process).
-    seed : int
-        Seed of the perturbations.
-    """
-
-    budget: Budget = Budget()
-    sizes: tuple[tuple[str, tuple[float, ...]], ...] = _FULL_SIZES
-    trials: int = 2
-    mu: float = MU
-    standoff: float = 0.1
-    workers: int = 2
-    seed: int = 0
-
-
-QUICK = Settings(budget=Budget(samples=128, extend=32, random=4000, starts=8, rounds=2),
-                 sizes=_QUICK_SIZES, trials=1)
-FULL = Settings()
-SETTINGS = {"quick": QUICK, "full": FULL}
-
-
-@dataclass(frozen=True, eq=False)
-class Subject:
-    """An object of the study: a name and its unperturbed grey image (uint8)."""
-
-    name: str
-    image: np.ndarray
-
-
-@dataclass(frozen=True)
-class RouteSummary:
-    """Headline numbers of one route (see :data:`OVERALL_COLUMNS`); None where undefined."""
-
-    route: str
-    fingers: int
-    grasps: int
-    certified_fraction: float | None
-    eps_median: float | None
-    eps_best: float | None
-    ratio_best: float | None
-    ratio_median: float | None
-    seconds_median: float | None
-    robustness: float | None
-    robustness_paired: float | None
-
-
-@dataclass(frozen=True)
-class StudyResult:
-    """What :func:`compare` found and wrote.
-
-    Attributes
-    ----------
-    objects : tuple of str
-        Object names.
-    routes : tuple of RouteSummary
-        One per route of :data:`ROUTES`.
-    robustness : mapping of (route, kind) to float
-        Robustness pooled over sizes and objects, per route and perturbation kind.
-    seconds : float
-        Wall time of the study, seconds.
-    files : tuple of pathlib.Path
-        Tables and plots written.
-    """
-
-    objects: tuple[str, ...]
-    routes: tuple[RouteSummary, ...]
-    robustness: Mapping[tuple[str, str], float | None]
-    seconds: float
-    files: tuple[Path, ...] = field(default=())
-
 
 # --------------------------------------------------------------------------------------------------
 # Subjects and perturbations
@@ -396,30 +275,33 @@ def execute(grasp: Grasp, truth: Boundary, standoff: float = 0.1,
 # One object, one perturbation
 
 
-def _route(method: str, fingers: int) -> str:
-    return f"{method} {fingers}"
-
-
-def _plan(image: np.ndarray, method: str, fingers: int, settings: Settings, name: str,
-          threshold: float | None, final: bool):
+def _plan(image: np.ndarray, route: Route, settings: Settings, name: str, threshold: float | None,
+          final: bool):
     """Plan with one route: ``(grasps, certified, eps, seconds, candidates, contour)``.
 
     ``final``: the nominal evaluation (qualitative grasps certified one by one with reports, as
     ``synthesize`` does); otherwise certified columnar (:func:`screen_grasps`)."""
-    mu = None if fingers == 4 else settings.mu
+    proc = route.procedure
+    mu = settings.mu if proc.friction else None
     start = time.perf_counter()
-    if method == "Baseline":
-        found = baseline(image, fingers, settings.mu, settings.budget, name=name, threshold=threshold)
+    if route.method == "baseline":
+        found = baseline(image, proc, mu, settings.budget, name=name, threshold=threshold)
         return (found.grasps, np.array(found.certified, dtype=bool), np.array(found.epsilons),
                 found.seconds, found.candidates, found.boundary.points)
-    s = synthesize(image, fingers, mu, name=name, certify=final, quality=final, threshold=threshold,
-                   largest=True)
+    s = synthesize(image, procedure=proc.name, mu=mu, name=name, certify=final, quality=final,
+                   threshold=threshold, largest=True)
     if final:
         ok = np.array(s.certified, dtype=bool)
         eps = np.array([r.eps_l1 for r in s.reports])
     else:
         ok, eps = screen_grasps(s.grasps)
     return s.grasps, ok, eps, time.perf_counter() - start, None, s.outline.contour
+
+
+def _route_fields(route: Route, settings: Settings) -> dict:
+    """The columns every row of ``route`` starts with."""
+    return {"route": route.name, "method": route.method, "procedure": route.procedure.name,
+            "fingers": route.fingers}
 
 
 def _stats(eps: np.ndarray) -> tuple[float | None, float | None]:
@@ -430,13 +312,12 @@ def evaluate_object(subject: Subject, settings: Settings = QUICK) -> tuple[list[
     """Both routes on one unperturbed image: per-route rows (:data:`OBJECT_COLUMNS`, ratios still
     empty) and per-grasp rows (:data:`GRASP_COLUMNS`)."""
     rows, grasp_rows = [], []
-    for method, fingers in ROUTES:
+    for route in routes():
         row = dict.fromkeys(OBJECT_COLUMNS)
-        row.update(object=subject.name, route=_route(method, fingers), fingers=fingers,
-                   method="baseline" if method == "Baseline" else "qualitative",
-                   mu=None if fingers == 4 else settings.mu)
+        row.update(object=subject.name, **_route_fields(route, settings),
+                   mu=settings.mu if route.procedure.friction else None)
         try:
-            grasps, ok, eps, seconds, candidates, _ = _plan(subject.image, method, fingers, settings,
+            grasps, ok, eps, seconds, candidates, _ = _plan(subject.image, route, settings,
                                                             subject.name, None, True)
         except QualitativeError as err:
             row.update(grasps=0, certified=0, error=f"{type(err).__name__}: {err}")
@@ -447,17 +328,16 @@ def evaluate_object(subject: Subject, settings: Settings = QUICK) -> tuple[list[
                    certified_fraction=float(ok.mean()) if len(ok) else None, seconds=seconds,
                    candidates=candidates)
         rows.append(row)
-        grasp_rows += [{"object": subject.name, "route": row["route"], "method": row["method"],
-                        "fingers": fingers, "certified": bool(c), "eps": float(e)}
-                       for c, e in zip(ok, eps)]
+        grasp_rows += [{"object": subject.name, **_route_fields(route, settings), "certified": bool(c),
+                        "eps": float(e)} for c, e in zip(ok, eps)]
     return _with_ratios(rows), grasp_rows
 
 
 def _with_ratios(rows: list[dict]) -> list[dict]:
     """Fill ``ratio_best``/``ratio_median`` of qualitative rows from the baseline's best."""
-    best = {r["fingers"]: r["eps_best"] for r in rows if r["method"] == "baseline"}
+    best = {r["procedure"]: r["eps_best"] for r in rows if r["method"] == "baseline"}
     for r in rows:
-        ref = best.get(r["fingers"])
+        ref = best.get(r["procedure"])
         if r["method"] == "qualitative" and ref and r["eps_best"] is not None:
             r["ratio_best"] = r["eps_best"] / ref
             r["ratio_median"] = r["eps_median"] / ref
@@ -473,7 +353,7 @@ def robustness_trial(subject: Subject, truth: Boundary, level: float, kind: str,
                      trial: int, settings: Settings = QUICK) -> list[dict]:
     """Plan with every route on one perturbed image and execute on the true object.
 
-    Returns one row per route: ``object, route, method, fingers, kind, size, trial, planned``
+    Returns one row per route: ``object, route, method, procedure, fingers, kind, size, trial, planned``
     (grasps that certified on the perturbed image), ``held``, ``misses``, ``collisions``,
     ``eps_planned`` and ``eps_executed`` (lists, per planned grasp) and ``error``.
     """
@@ -481,14 +361,12 @@ def robustness_trial(subject: Subject, truth: Boundary, level: float, kind: str,
     signed = -size if kind == "rotation" and trial % 2 else size
     image, threshold = perturb(subject.image, kind, signed, rng, truth.center, level)
     rows = []
-    for method, fingers in ROUTES:
-        row = {"object": subject.name, "route": _route(method, fingers), "fingers": fingers,
-               "method": "baseline" if method == "Baseline" else "qualitative", "kind": kind,
+    for route in routes():
+        row = {"object": subject.name, **_route_fields(route, settings), "kind": kind,
                "size": size, "trial": trial, "planned": 0, "held": 0, "misses": 0, "collisions": 0,
                "eps_planned": [], "eps_executed": [], "error": None}
         try:
-            grasps, ok, eps, _, _, seen = _plan(image, method, fingers, settings, subject.name,
-                                                threshold, False)
+            grasps, ok, eps, _, _, seen = _plan(image, route, settings, subject.name, threshold, False)
         except QualitativeError as err:
             row["error"] = f"{type(err).__name__}: {err}"
             rows.append(row)
@@ -521,7 +399,7 @@ def _tasks(items: list[Subject], truths: dict, settings: Settings) -> list[tuple
         truth, level = truths[s.name]
         tasks.append((s, truth, level, "none", 0.0, 0, settings))
         for kind, sizes in settings.sizes:
-            trials = 1 if kind in _DETERMINISTIC else settings.trials
+            trials = 1 if kind in DETERMINISTIC else settings.trials
             for size in sizes:
                 tasks += [(s, truth, level, kind, float(size), trial, settings)
                           for trial in range(trials)]
@@ -533,8 +411,8 @@ def warm_up() -> None:
     kernels, imports) do not count in the first object's time. Run in each worker process."""
     image = render("polygon", size=160)
     small = Settings(budget=Budget(samples=24, extend=4, random=50, starts=2, rounds=1))
-    for method, fingers in ROUTES:
-        grasps = _plan(image, method, fingers, small, "warm-up", None, True)[0]
+    for route in routes():
+        grasps = _plan(image, route, small, "warm-up", None, True)[0]
         screen_grasps(grasps)
 
 
@@ -542,7 +420,7 @@ def workload(objects: int, settings: str | Settings = "quick") -> int:
     """Number of progress messages :func:`compare` sends for ``objects`` objects: one per object,
     then one per robustness trial."""
     settings = SETTINGS[settings] if isinstance(settings, str) else settings
-    per = 1 + sum(len(sizes) * (1 if kind in _DETERMINISTIC else settings.trials)
+    per = 1 + sum(len(sizes) * (1 if kind in DETERMINISTIC else settings.trials)
                   for kind, sizes in settings.sizes)
     return objects * (1 + per)
 
@@ -586,8 +464,6 @@ def compare(images: Iterable[Any], out: str | Path, *, settings: str | Settings 
     -------
     StudyResult
     """
-    from .study_tables import overall_rows, robustness_rows, summarise, write_tables
-
     start = time.perf_counter()
     settings = SETTINGS[settings] if isinstance(settings, str) else settings
     items = subjects(images)
@@ -611,8 +487,6 @@ def compare(images: Iterable[Any], out: str | Path, *, settings: str | Settings 
     overall = overall_rows(object_rows, grasp_rows, trial_rows)
     files = write_tables(out, object_rows, overall, robust, trial_rows, grasp_rows)
     if plots:
-        from .study_plots import plot_all
-
         files += plot_all(out, object_rows, grasp_rows, robust)
     routes, by_kind = summarise(overall, trial_rows)
     return StudyResult(tuple(names), routes, by_kind, time.perf_counter() - start, tuple(files))

@@ -1,6 +1,6 @@
 """Tables of the comparison study (:mod:`qualgrasp.experiments.study`): aggregation, CSV and Markdown.
 
-Column meanings are documented with the column tuples in :mod:`qualgrasp.experiments.study`. Empty cells
+Column meanings are documented with the column tuples in :mod:`qualgrasp.experiments.design`. Empty cells
 (CSV) and ``-`` (Markdown) mark values that are undefined (no grasp, no baseline grasp, no trial).
 """
 
@@ -12,13 +12,13 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .study import (GRASP_COLUMNS, KINDS, OBJECT_COLUMNS, OVERALL_COLUMNS, ROBUSTNESS_COLUMNS,
-                    ROUTES, UNITS, RouteSummary, Settings)
+from .design import (GRASP_COLUMNS, KINDS, OBJECT_COLUMNS, OVERALL_COLUMNS, ROBUSTNESS_COLUMNS,
+                     UNITS, RouteSummary, Settings, routes)
 
 __all__ = ["robustness_rows", "overall_rows", "summarise", "write_csv", "write_markdown",
            "write_tables"]
 
-_TRIAL_COLUMNS = ("object", "route", "method", "fingers", "kind", "size", "trial", "planned",
+_TRIAL_COLUMNS = ("object", "route", "method", "procedure", "fingers", "kind", "size", "trial", "planned",
                   "held", "misses", "collisions", "eps_planned", "eps_executed", "error")
 
 
@@ -27,23 +27,19 @@ def _median(values: Sequence[float]) -> float | None:
     return float(np.median(values)) if values else None
 
 
-def _routes():
-    for method, fingers in ROUTES:
-        yield f"{method} {fingers}", "baseline" if method == "Baseline" else "qualitative", fingers
-
-
 def robustness_rows(trial_rows: list[dict], settings: Settings) -> list[dict]:
     """Aggregate trials per route, kind and size (:data:`ROBUSTNESS_COLUMNS`), ``none`` first."""
     sizes = [("none", 0.0)] + [(k, float(s)) for k, values in settings.sizes for s in values]
     out = []
-    for route, method, fingers in _routes():
+    for route in routes():
         for kind, size in sizes:
-            rows = [r for r in trial_rows if r["route"] == route and r["kind"] == kind and r["size"] == size]
+            rows = [r for r in trial_rows if r["route"] == route.name and r["kind"] == kind and r["size"] == size]
             if not rows:
                 continue
             planned, held = sum(r["planned"] for r in rows), sum(r["held"] for r in rows)
             out.append({
-                "route": route, "method": method, "fingers": fingers, "kind": kind, "size": size,
+                "route": route.name, "method": route.method, "procedure": route.procedure.name,
+                "fingers": route.fingers, "kind": kind, "size": size,
                 "unit": UNITS[kind], "trials": len(rows), "planned": planned, "held": held,
                 "fraction": held / planned if planned else None,
                 "misses": sum(r["misses"] for r in rows), "collisions": sum(r["collisions"] for r in rows),
@@ -55,10 +51,10 @@ def robustness_rows(trial_rows: list[dict], settings: Settings) -> list[dict]:
 
 def _pooled(trial_rows: list[dict], route: str, kinds: Sequence[str], paired: bool = False) -> float | None:
     """Held over planned for ``route`` and ``kinds``; ``paired``: only the trials where both
-    methods planned a certified grasp with the route's finger count."""
+    methods planned a certified grasp for the route's procedure."""
     rows = [r for r in trial_rows if r["route"] == route and r["kind"] in kinds]
     if paired:
-        key = lambda r: (r["object"], r["kind"], r["size"], r["trial"], r["fingers"])  # noqa: E731
+        key = lambda r: (r["object"], r["kind"], r["size"], r["trial"], r["procedure"])  # noqa: E731
         methods: dict[tuple, set] = {}
         for r in trial_rows:
             if r["planned"]:
@@ -71,12 +67,14 @@ def _pooled(trial_rows: list[dict], route: str, kinds: Sequence[str], paired: bo
 def overall_rows(object_rows: list[dict], grasp_rows: list[dict], trial_rows: list[dict]) -> list[dict]:
     """One row per route over all objects (:data:`OVERALL_COLUMNS`)."""
     out = []
-    for route, method, fingers in _routes():
+    for r_ in routes():
+        route = r_.name
         rows = [r for r in object_rows if r["route"] == route]
         grasps = [g for g in grasp_rows if g["route"] == route]
         seconds = [r["seconds"] for r in rows if r["seconds"] is not None]
         out.append({
-            "route": route, "method": method, "fingers": fingers, "objects": len(rows),
+            "route": route, "method": r_.method, "procedure": r_.procedure.name, "fingers": r_.fingers,
+            "objects": len(rows),
             "objects_with_grasps": sum(1 for r in rows if r["certified"]),
             "grasps": len(grasps),
             "certified_fraction": sum(g["certified"] for g in grasps) / len(grasps) if grasps else None,

@@ -6,6 +6,8 @@ from pathlib import Path
 
 import typer
 
+from . import procedures
+
 __all__ = ["register"]
 
 
@@ -112,8 +114,8 @@ def regions_command(
 
 def synthesize_command(
     image: Path = typer.Argument(..., help="Image file (PNG, JPEG, anything OpenCV reads)."),
-    fingers: int = typer.Option(..., "--fingers", help="4: FormGrasp (frictionless form closure); "
-                                "2 or 3: ForceGrasp (force closure with friction)."),
+    fingers: int | None = typer.Option(None, "--fingers", help="4: FormGrasp (frictionless form closure); "
+                                       "2 or 3: ForceGrasp (force closure with friction)."),
     output: Path = typer.Option(..., "-o", "--output", help="Grasp set to write: .jsonl (or .parquet, "
                                 "which keeps only certify's fields)."),
     mu: float | None = typer.Option(None, "--mu", help="Friction coefficient of ForceGrasp (default 0.5)."),
@@ -126,6 +128,10 @@ def synthesize_command(
     largest: bool = typer.Option(False, "--largest", help="With several objects, use the largest whole one."),
     threshold: float | None = typer.Option(None, "--threshold", help="Grey level separating object and "
                                            "background, in the image's units (default: Otsu's)."),
+    procedure: str | None = typer.Option(None, "--procedure", help="A synthesis procedure by name: "
+                                         + ", ".join(f"{p.name} ({p.fingers} fingers, {p.model})"
+                                                     for p in procedures.procedures())
+                                         + "; instead of --fingers."),
 ) -> None:
     """Synthesise grasps of the object in an image and write them in certify's grasp format.
 
@@ -137,7 +143,7 @@ def synthesize_command(
     """
     import math
 
-    from qualgrasp.certify.io import write_grasps
+    from ..certify.io import write_grasps
 
     from .errors import QualitativeError
     from .synthesis import synthesize
@@ -146,9 +152,12 @@ def synthesize_command(
     if mu is not None and theta_min is not None:
         typer.echo("error: give --mu or --theta-min, not both", err=True)
         raise typer.Exit(2)
+    if fingers is None and procedure is None:
+        typer.echo(f"error: give --fingers or --procedure ({', '.join(procedures.names())})", err=True)
+        raise typer.Exit(2)
     try:
         result = synthesize(image, fingers, mu, None if theta_min is None else math.radians(theta_min),
-                            alpha, threshold=threshold, largest=largest)
+                            alpha, procedure=procedure, threshold=threshold, largest=largest)
     except QualitativeError as err:
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(2)
@@ -159,7 +168,8 @@ def synthesize_command(
         synthesis_figure(result, read_image(image)).savefig(plot, dpi=110)
     friction = "frictionless" if result.mu is None else f"mu {result.mu:.4g}"
     if not result.grasps:
-        typer.echo(f"no grasp found: {result.procedure} ({fingers} fingers, {friction}) on {len(result.regions)} "
+        typer.echo(f"no grasp found: {result.procedure.title} ({result.fingers} fingers, {friction}) on "
+                   f"{len(result.regions)} "
                    f"feasible region(s) of {result.outline.string}; wrote an empty grasp set to {output}")
         return
     for grasp, report, ok in zip(result.grasps, result.reports, result.certified):
@@ -167,7 +177,8 @@ def synthesize_command(
         typer.echo(f"{grasp.id}\tregions {grasp.meta['regions']}\t{report.force.status}\t"
                    f"margin {report.force.margin:.4f}\teps {eps:.4f}\t{'verified' if ok else 'NOT CERTIFIED'}")
     s = result.summary()
-    typer.echo(f"{s['grasps']} grasp(s) by {result.procedure} ({fingers} fingers, {friction}) -> {output}; "
+    typer.echo(f"{s['grasps']} grasp(s) by {result.procedure.title} ({result.fingers} fingers, {friction}) "
+               f"-> {output}; "
                f"{100 * s['certified_fraction']:.0f} % certified; synthesis {s['seconds']:.2f} s, "
                f"certification {s['certify_seconds']:.2f} s")
     if s["certified"] < s["grasps"]:

@@ -241,14 +241,14 @@ def _ranked(synth: Synthesis) -> list[int]:
     if synth.reports:
         key = [r.force.margin for r in synth.reports]
     else:
-        key = [-g.depth if isinstance(g, FormGrasp) else g.margin for g in synth.found]
+        key = [synth.procedure.score(g) for g in synth.found]
     return sorted(range(len(synth.found)), key=lambda i: -key[i])
 
 
 def _legend(fig: Figure, synth: Synthesis) -> None:
     handles = [Line2D([], [], ls="none", marker="o", mfc="white", mec="black", label="contact"),
                Line2D([], [], color="black", label="inward normal")]
-    if synth.procedure == "FormGrasp":
+    if not synth.procedure.friction:
         handles += [Patch(label="Z+ (clockwise)", **ZPLUS), Patch(label="Z- (counter-clockwise)", **ZMINUS),
                     Patch(color=TCOLOR, alpha=0.45, label="free translations T"),
                     Line2D([], [], ls="--", color="0.25", label="line of action")]
@@ -284,7 +284,7 @@ def synthesis_figure(synth: Synthesis, image: np.ndarray | None = None, count: i
         Bound to an Agg canvas; save it with ``fig.savefig(path)``.
     """
     order = _ranked(synth)
-    title = (f"{synth.name}: {synth.procedure}, {synth.fingers} fingers"
+    title = (f"{synth.name}: {synth.procedure.title}, {synth.fingers} fingers"
              + (f", mu = {synth.mu:.3g}" if synth.mu is not None else ", frictionless")
              + f": {len(synth.grasps)} grasp(s)")
     if synth.certified_fraction is not None:
@@ -300,7 +300,7 @@ def synthesis_figure(synth: Synthesis, image: np.ndarray | None = None, count: i
         ax.set_title(f"no grasp found ({len(P)} candidate contacts, dots)", fontsize=10)
         fig.suptitle(title)
         return fig
-    if synth.procedure == "FormGrasp":
+    if isinstance(synth.found[order[0]], FormGrasp):  # zones of freedom, contact by contact
         best, rest = order[0], order[1:count + 1]
         steps = zone_steps(synth.found[best], synth.center, synth.length)
         cols = max(len(steps), len(rest), 1)

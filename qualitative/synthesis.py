@@ -1,18 +1,21 @@
-"""Grasp synthesis from an image: outline, feasible regions, FormGrasp or ForceGrasp, certification.
+"""Grasp synthesis from an image: outline, feasible regions, a synthesis procedure, certification.
 
-:func:`synthesize` is the public function behind ``qualgrasp synthesize``:
+:func:`synthesize` is the public function behind ``qualgrasp synthesize``. The procedure is a
+registered object (:mod:`qualgrasp.qualitative.procedures`), chosen by name or by finger count:
 
-* ``fingers=4``: FormGrasp (:mod:`qualgrasp.qualitative.formgrasp`), frictionless contacts;
-* ``fingers=2`` or ``3``: ForceGrasp (:mod:`qualgrasp.qualitative.forcegrasp`), ``point`` contacts with
-  Coulomb friction ``mu`` (from ``mu``, or ``mu = tan(theta_min)``).
+* ``formgrasp`` (4 fingers): FormGrasp (:mod:`qualgrasp.qualitative.formgrasp`), frictionless
+  contacts;
+* ``forcegrasp2`` and ``forcegrasp3`` (2 and 3 fingers): ForceGrasp
+  (:mod:`qualgrasp.qualitative.forcegrasp`), ``point`` contacts with Coulomb friction ``mu``
+  (from ``mu``, or ``mu = tan(theta_min)``).
 
 Every grasp found is converted to a :class:`qualgrasp.certify.Grasp` -- contacts in pixels of the input image
 (x = column, y = row) with inward unit normals, ``center`` = the object's area centroid and
 ``length`` = its radius (largest distance from the centroid to the contour), so that epsilons are
-comparable across procedures -- with the id ``<name>-form-0007``, ``<name>-force2-0003`` or
-``<name>-force3-0001`` and the extra fields ``procedure``, ``fingers``, ``regions`` (indices into
-the feasible regions list) and the procedure's own margin (``zone_depth`` for FormGrasp,
-``cone_margin`` in radians for ForceGrasp). Each is then certified by :func:`qualgrasp.certify.certify_grasp`;
+comparable across procedures -- with the id ``<name>-<tag>-0007`` (the procedure's tag: ``form``,
+``force2``, ``force3``) and the extra fields ``procedure`` (``FormGrasp`` or ``ForceGrasp``),
+``fingers``, ``regions`` (indices into the feasible regions list) and the procedure's own fields
+(``zone_depth`` for FormGrasp, ``cone_margin`` in radians for ForceGrasp). Each is then certified by :func:`qualgrasp.certify.certify_grasp`;
 a synthesised grasp that does not certify is a bug of the synthesis, and is reported, not dropped.
 """
 
@@ -22,25 +25,25 @@ import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Union
+from typing import Any
 
 import numpy as np
 
-from qualgrasp.certify import Contact, Grasp, Report, certify_grasp
-
+from ..certify import Contact, Grasp, Report, certify_grasp
+from . import procedures as registry
 from .candidates import INSET, PER_REGION, STEP, Candidates, candidates, object_frame
 from .errors import SynthesisError
-from .forcegrasp import MARGIN, ForceGrasp, friction, pair_grasps, triplet_grasps
-from .formgrasp import ERROR, FormGrasp, form_grasps
+from .forcegrasp import MARGIN, friction
+from .formgrasp import ERROR
 from .outline import Outline, outline_image
+from .procedures import Procedure, SearchInput
 from .regions import ALPHA, FINGER_WIDTH, MARGIN as REGION_MARGIN, Region, feasible_regions
 from .vision import ImageSource
 
-__all__ = ["MU", "PROCEDURES", "Synthesis", "synthesize", "to_grasp"]
+__all__ = ["MU", "Synthesis", "synthesize", "to_grasp", "choose"]
 
 MU = 0.5
-PROCEDURES = {2: "ForceGrasp", 3: "ForceGrasp", 4: "FormGrasp"}
-_TAG = {2: "force2", 3: "force3", 4: "form"}
+"""Default friction coefficient of procedures with friction."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -52,11 +55,12 @@ class Synthesis:
     name : str
         Image name used in grasp ids (the file's stem, or the name given).
     fingers : int
-        2 or 3 (ForceGrasp) or 4 (FormGrasp).
-    procedure : str
-        ``FormGrasp`` or ``ForceGrasp``.
+        Number of contacts of the procedure's grasps.
+    procedure : Procedure
+        The registered procedure (:mod:`qualgrasp.qualitative.procedures`).
     mu, theta_min : float or None
-        Friction coefficient and cone half-angle (radians) of ForceGrasp; None for FormGrasp.
+        Friction coefficient and cone half-angle (radians) of procedures with friction; None for
+        frictionless ones.
     outline : Outline
         The object's qualitative outline.
     regions : tuple of Region
@@ -67,8 +71,9 @@ class Synthesis:
         Object's area centroid (x, y), pixels.
     length : float
         Object's radius about ``center``, pixels.
-    found : tuple of FormGrasp or ForceGrasp
-        The qualitative results, parallel to ``grasps``.
+    found : tuple
+        The procedure's results (:class:`~qualgrasp.qualitative.formgrasp.FormGrasp` or
+        :class:`~qualgrasp.qualitative.forcegrasp.ForceGrasp`), parallel to ``grasps``.
     grasps : tuple of certify.Grasp
         The grasps in certify's format.
     reports : tuple of certify.Report
@@ -81,7 +86,7 @@ class Synthesis:
 
     name: str
     fingers: int
-    procedure: str
+    procedure: Procedure
     mu: float | None
     theta_min: float | None
     outline: Outline
@@ -89,7 +94,7 @@ class Synthesis:
     candidates: Candidates
     center: np.ndarray
     length: float
-    found: tuple[Union[FormGrasp, ForceGrasp], ...]
+    found: tuple[Any, ...]
     grasps: tuple[Grasp, ...]
     reports: tuple[Report, ...]
     seconds: float
@@ -113,7 +118,7 @@ class Synthesis:
         eps = [r.epsilons["L1"].hi for r in ok if r.epsilons]
         return {
             "name": self.name,
-            "procedure": self.procedure,
+            "procedure": self.procedure.name,
             "fingers": self.fingers,
             "mu": self.mu,
             "grasps": len(self.grasps),
@@ -126,20 +131,44 @@ class Synthesis:
         }
 
 
-def to_grasp(found: Union[FormGrasp, ForceGrasp], gid: str, center: np.ndarray, length: float,
-             mu: float | None) -> Grasp:
-    """A synthesised grasp in certify's format (see the module notes for the fields)."""
-    if isinstance(found, FormGrasp):
-        contacts = tuple(Contact(tuple(p), tuple(n)) for p, n in zip(found.points, found.normals))
-        meta = {"procedure": "FormGrasp", "fingers": len(contacts), "regions": list(found.regions),
-                "zone_depth": found.depth}
-    else:
-        contacts = tuple(Contact(tuple(p), tuple(n), "point", mu) for p, n in zip(found.points, found.normals))
-        meta = {"procedure": "ForceGrasp", "fingers": len(contacts), "regions": list(found.regions),
-                "cone_margin": found.margin}
-        if found.point is not None:
-            meta["meeting_point"] = [float(v) for v in found.point]
+def to_grasp(found: Any, gid: str, center: np.ndarray, length: float, mu: float | None,
+             procedure: Procedure) -> Grasp:
+    """A grasp ``procedure`` found, in certify's format (see the module notes for the fields)."""
+    model = procedure.model
+    contacts = tuple(Contact(tuple(p), tuple(n), model, mu if procedure.friction else None)
+                     for p, n in zip(found.points, found.normals))
+    meta = {"procedure": procedure.title, "fingers": len(contacts), "regions": list(found.regions),
+            **procedure.meta(found)}
     return Grasp(contacts, center=tuple(float(v) for v in center), length=float(length), id=gid, meta=meta)
+
+
+def choose(fingers: int | None = None, procedure: str | None = None) -> Procedure:
+    """The procedure named ``procedure``, else the first registered with ``fingers`` contacts
+    (default 2).
+
+    Raises
+    ------
+    SynthesisError
+        Unknown name, no procedure with that many fingers, or a name and a finger count that
+        disagree.
+    """
+    if procedure is not None:
+        try:
+            proc = registry.get(procedure)
+        except KeyError:
+            raise SynthesisError(f"unknown procedure {procedure!r}; use one of "
+                                 f"{', '.join(registry.names())}") from None
+        if fingers is not None and fingers != proc.fingers:
+            raise SynthesisError(f"procedure {procedure!r} places {proc.fingers} fingers, not {fingers}")
+        return proc
+    fingers = 2 if fingers is None else fingers
+    try:
+        return registry.for_fingers(fingers)
+    except KeyError:
+        counts = sorted({p.fingers for p in registry.procedures()})
+        raise SynthesisError(f"fingers must be one of {', '.join(map(str, counts))} ("
+                             + "; ".join(f"{p.fingers}: {p.name}" for p in registry.procedures())
+                             + f"), got {fingers}") from None
 
 
 def _name(image: ImageSource, name: str | None) -> str:
@@ -150,8 +179,9 @@ def _name(image: ImageSource, name: str | None) -> str:
     return "image"
 
 
-def synthesize(image: ImageSource, fingers: int = 2, mu: float | None = None, theta_min: float | None = None,
-               alpha: float = ALPHA, *, name: str | None = None, certify: bool = True, quality: bool = True,
+def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None = None,
+               theta_min: float | None = None, alpha: float = ALPHA, *, procedure: str | None = None,
+               name: str | None = None, certify: bool = True, quality: bool = True,
                threshold: float | None = None, largest: bool = False, finger_width: float = FINGER_WIDTH,
                region_margin: float = REGION_MARGIN, step: float = STEP, inset: float = INSET,
                per_region: int = PER_REGION, error: float = ERROR, margin: float = MARGIN) -> Synthesis:
@@ -161,15 +191,20 @@ def synthesize(image: ImageSource, fingers: int = 2, mu: float | None = None, th
     ----------
     image : str, pathlib.Path or numpy.ndarray
         Image file or array (see :func:`qualgrasp.qualitative.vision.read_image`).
-    fingers : {2, 3, 4}
-        2 or 3: ForceGrasp with friction; 4: FormGrasp, frictionless.
+    fingers : int, optional
+        Finger count: the first registered procedure with that many fingers (2: ForceGrasp,
+        3: ForceGrasp, 4: FormGrasp); default 2 when ``procedure`` is not given either.
     mu : float, optional
-        Friction coefficient of ForceGrasp (default 0.5 when ``theta_min`` is not given either).
+        Friction coefficient of procedures with friction (default 0.5 when ``theta_min`` is not
+        given either).
     theta_min : float, optional
         Friction cone half-angle, **radians** (``mu = tan(theta_min)``); instead of ``mu``.
     alpha : float
         Curvature threshold of feasible regions, fraction of the object's size
         (:func:`qualgrasp.qualitative.regions.feasible_regions`).
+    procedure : str, optional
+        A registered procedure by name (:mod:`qualgrasp.qualitative.procedures`):
+        ``forcegrasp2``, ``forcegrasp3``, ``formgrasp``.
     name : str, optional
         Name used in grasp ids (default: the file's stem, or ``image`` for an array).
     certify : bool
@@ -194,18 +229,27 @@ def synthesize(image: ImageSource, fingers: int = 2, mu: float | None = None, th
     Raises
     ------
     SynthesisError
-        Bad parameters (finger count, friction given for FormGrasp, both ``mu`` and ``theta_min``).
+        Bad parameters (unknown procedure or finger count, friction given to a frictionless
+        procedure, both ``mu`` and ``theta_min``).
     ImageError, SegmentationError, ContourError
         Unusable image (see :func:`qualgrasp.qualitative.outline.outline_image`).
+
+    Examples
+    --------
+    >>> from qualgrasp.qualitative.objects import render
+    >>> from qualgrasp.qualitative.synthesis import synthesize
+    >>> s = synthesize(render("polygon"), procedure="formgrasp", quality=False)
+    >>> s.procedure.title, s.fingers, len(s.grasps) > 0, all(s.certified)
+    ('FormGrasp', 4, True, True)
     """
-    if fingers not in PROCEDURES:
-        raise SynthesisError(f"fingers must be 2 or 3 (ForceGrasp) or 4 (FormGrasp), got {fingers}")
-    if fingers == 4:
+    proc = choose(fingers, procedure)
+    if not proc.friction:
         if mu is not None or theta_min is not None:
-            raise SynthesisError("FormGrasp (4 fingers) uses frictionless contacts: give no mu or theta_min")
-    elif mu is None and theta_min is None:
-        mu = MU
-    if fingers != 4:
+            raise SynthesisError(f"{proc.title} ({proc.fingers} fingers) uses frictionless contacts: "
+                                 "give no mu or theta_min")
+    else:
+        if mu is None and theta_min is None:
+            mu = MU
         mu, theta_min = friction(mu, theta_min)
     if not (math.isfinite(alpha) and alpha >= 0):
         raise SynthesisError(f"alpha must be finite and >= 0, got {alpha}")
@@ -214,17 +258,13 @@ def synthesize(image: ImageSource, fingers: int = 2, mu: float | None = None, th
     regions = tuple(feasible_regions(outline, alpha, finger_width, region_margin))
     cands = candidates(outline, regions, step, inset, per_region)
     center, length = object_frame(outline.contour)
-    if fingers == 4:
-        found = form_grasps(cands, outline.contour, center, length, outline.size, error=error)
-    elif fingers == 2:
-        found = pair_grasps(cands, theta_min, outline.size, margin=margin)
-    else:
-        found = triplet_grasps(cands, outline.contour, theta_min, outline.size, margin=margin)
+    found = proc.search(SearchInput(cands, outline.contour, center, length, outline.size, theta_min,
+                                    error, margin))
     stem = _name(image, name)
-    grasps = tuple(to_grasp(g, f"{stem}-{_TAG[fingers]}-{k:04d}", center, length, mu)
+    grasps = tuple(to_grasp(g, f"{stem}-{proc.tag}-{k:04d}", center, length, mu, proc)
                    for k, g in enumerate(found))
     seconds = time.perf_counter() - start
     start = time.perf_counter()
     reports = tuple(certify_grasp(g, quality=quality) for g in grasps) if certify else ()
-    return Synthesis(stem, fingers, PROCEDURES[fingers], mu, theta_min, outline, regions, cands,
+    return Synthesis(stem, proc.fingers, proc, mu, theta_min, outline, regions, cands,
                      center, length, tuple(found), grasps, reports, seconds, time.perf_counter() - start)

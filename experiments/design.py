@@ -1,0 +1,189 @@
+"""The comparison study's design: its routes (generated from the procedure registry), the
+perturbations, the settings and the columns of its tables.
+
+:mod:`qualgrasp.experiments.study` runs the study, :mod:`qualgrasp.experiments.study_tables` and
+:mod:`qualgrasp.experiments.study_plots` report it; all three share these definitions.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Mapping
+
+import numpy as np
+
+from ..qualitative import procedures
+from ..qualitative.procedures import Procedure
+from .baseline import MU, Budget
+
+__all__ = ["Route", "routes", "route_of", "KINDS", "UNITS", "BUILTINS", "ROUTES", "QUICK", "FULL",
+           "SETTINGS", "OBJECT_COLUMNS", "OVERALL_COLUMNS", "ROBUSTNESS_COLUMNS", "GRASP_COLUMNS",
+           "DETERMINISTIC", "Settings", "Subject", "RouteSummary", "StudyResult"]
+
+
+@dataclass(frozen=True, eq=False)
+class Route:
+    """A route of the study: a registered synthesis procedure (``method`` ``qualitative``) or
+    the quantitative baseline with the same fingers and contact model (``baseline``).
+
+    ``name`` is ``'<Title> <fingers>'`` (``'ForceGrasp 2'``) or ``'Baseline <fingers>'``."""
+
+    method: str
+    procedure: Procedure
+
+    @property
+    def name(self) -> str:
+        title = self.procedure.title if self.method == "qualitative" else "Baseline"
+        return f"{title} {self.procedure.fingers}"
+
+    @property
+    def fingers(self) -> int:
+        return self.procedure.fingers
+
+
+def routes() -> tuple[Route, ...]:
+    """Every route: one qualitative route per registered procedure, then their baselines."""
+    procs = procedures.procedures()
+    return tuple(Route("qualitative", p) for p in procs) + tuple(Route("baseline", p) for p in procs)
+
+
+def route_of(name: str) -> Route:
+    """The route named ``name`` (KeyError if there is none)."""
+    for r in routes():
+        if r.name == name:
+            return r
+    raise KeyError(name)
+
+
+KINDS = ("rotation", "translation", "noise", "blur", "threshold")
+UNITS = {"none": "", "rotation": "deg", "translation": "px", "noise": "grey sd", "blur": "px sd",
+         "threshold": "grey levels"}
+BUILTINS = ("polygon", "nut", "disc", "figure3")
+"""The built-in objects the demo and ``--builtins`` use."""
+ROUTES = tuple((r.name.rsplit(" ", 1)[0], r.fingers) for r in routes())
+"""``(method title, fingers)`` of every route, as in the tables' ``route`` column."""
+
+OBJECT_COLUMNS = ("object", "route", "method", "procedure", "fingers", "mu", "grasps", "certified",
+                  "certified_fraction", "eps_median", "eps_best", "ratio_best", "ratio_median",
+                  "seconds", "candidates", "error")
+"""Per object and route: grasps returned, certified, certified fraction, median and best certified
+L1 epsilon (uncertified grasps count 0), the qualitative best and median over the baseline's best
+with the same fingers (empty for the baseline), seconds (image to certified grasps), candidates
+screened (baseline), error message (route failed on the image)."""
+
+OVERALL_COLUMNS = ("route", "method", "procedure", "fingers", "objects", "objects_with_grasps", "grasps",
+                   "certified_fraction", "eps_median", "eps_best", "ratio_best", "ratio_median",
+                   "seconds_median", "seconds_total", "robustness", "robustness_paired")
+"""Per route over all objects: objects, objects where the route found a certified grasp, grasps,
+certified fraction (pooled), medians over objects of the per-object median and best epsilon and
+of the ratios (objects where both routes found grasps), median and total seconds, robustness
+pooled over every perturbation (not ``none``), and the same over the trials where both methods
+planned a certified grasp with the route's finger count (``paired``: the qualitative route finds
+no grasp on some objects, where the baseline's grasps may be the most fragile)."""
+
+ROBUSTNESS_COLUMNS = ("route", "method", "procedure", "fingers", "kind", "size", "unit", "trials", "planned",
+                      "held", "fraction", "misses", "collisions", "eps_planned", "eps_executed")
+"""Per route, perturbation kind and size: trials (object x trial), planned grasps that certified on
+the perturbed image, how many hold on the true object, their fraction, fingers that missed or
+collided, median epsilon of the planned and of the executed grasps (0 for those that fail)."""
+
+GRASP_COLUMNS = ("object", "route", "method", "procedure", "fingers", "certified", "eps")
+
+DETERMINISTIC = ("blur", "threshold")
+"""Perturbations that get one trial whatever the settings."""
+
+_FULL_SIZES = (("rotation", (1.0, 2.0, 4.0, 8.0)), ("translation", (1.0, 2.0, 4.0, 8.0)),
+               ("noise", (10.0, 20.0, 40.0, 60.0)), ("blur", (1.0, 2.0, 4.0, 8.0)),
+               ("threshold", (-60.0, -30.0, 30.0, 60.0)))
+_QUICK_SIZES = (("rotation", (2.0, 8.0)), ("translation", (2.0, 8.0)), ("noise", (20.0, 60.0)),
+                ("blur", (2.0, 8.0)), ("threshold", (-60.0, 60.0)))
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How much work the study does.
+
+    Attributes
+    ----------
+    budget : Budget
+        Baseline search budget (nominal images and every perturbed image).
+    sizes : tuple of (str, tuple of float)
+        Perturbation sizes per kind (units in :data:`UNITS`).
+    trials : int
+        Random trials per object, kind and size.
+    mu : float
+        Friction coefficient of the 2- and 3-finger routes.
+    standoff : float
+        Finger start distance before the planned contact, fraction of the object's diameter.
+    workers : int
+        Processes (1: run in this process).
+    seed : int
+        Seed of the perturbations.
+    """
+
+    budget: Budget = Budget()
+    sizes: tuple[tuple[str, tuple[float, ...]], ...] = _FULL_SIZES
+    trials: int = 2
+    mu: float = MU
+    standoff: float = 0.1
+    workers: int = 2
+    seed: int = 0
+
+
+QUICK = Settings(budget=Budget(samples=128, extend=32, random=4000, starts=8, rounds=2),
+                 sizes=_QUICK_SIZES, trials=1)
+FULL = Settings()
+SETTINGS = {"quick": QUICK, "full": FULL}
+
+
+@dataclass(frozen=True, eq=False)
+class Subject:
+    """An object of the study: a name and its unperturbed grey image (uint8)."""
+
+    name: str
+    image: np.ndarray
+
+
+@dataclass(frozen=True)
+class RouteSummary:
+    """Headline numbers of one route (see :data:`OVERALL_COLUMNS`); None where undefined."""
+
+    route: str
+    fingers: int
+    grasps: int
+    certified_fraction: float | None
+    eps_median: float | None
+    eps_best: float | None
+    ratio_best: float | None
+    ratio_median: float | None
+    seconds_median: float | None
+    robustness: float | None
+    robustness_paired: float | None
+
+
+@dataclass(frozen=True)
+class StudyResult:
+    """What :func:`compare` found and wrote.
+
+    Attributes
+    ----------
+    objects : tuple of str
+        Object names.
+    routes : tuple of RouteSummary
+        One per route of :data:`ROUTES`.
+    robustness : mapping of (route, kind) to float
+        Robustness pooled over sizes and objects, per route and perturbation kind.
+    seconds : float
+        Wall time of the study, seconds.
+    files : tuple of pathlib.Path
+        Tables and plots written.
+    """
+
+    objects: tuple[str, ...]
+    routes: tuple[RouteSummary, ...]
+    robustness: Mapping[tuple[str, str], float | None]
+    seconds: float
+    files: tuple[Path, ...] = field(default=())
+
+

@@ -1,0 +1,28 @@
+"""``forcegrasp2``: ForceGrasp with two fingers (paper 5.1.3-5.1.4, Nguyen's condition), point
+contacts with friction; see :func:`qualgrasp.qualitative.forcegrasp.pair_grasps`."""
+
+from __future__ import annotations
+
+from ..forcegrasp import ForceGrasp, pair_grasps
+from .base import Procedure, SearchInput, register
+
+__all__ = ["FORCEGRASP2", "force_meta"]
+
+
+def force_meta(found: ForceGrasp) -> dict:
+    """Fields recorded on a ForceGrasp grasp: its angular margin (radians) and, with three
+    fingers, the point where the forces meet."""
+    meta = {"cone_margin": found.margin}
+    if found.point is not None:
+        meta["meeting_point"] = [float(v) for v in found.point]
+    return meta
+
+
+def _search(s: SearchInput) -> list[ForceGrasp]:
+    return pair_grasps(s.candidates, s.theta_min, s.size, margin=s.margin)
+
+
+FORCEGRASP2 = register(Procedure(
+    name="forcegrasp2", title="ForceGrasp", fingers=2, model="point", tag="force2", colour="tab:blue",
+    search=_search, score=lambda g: g.margin, meta=force_meta,
+    description="two fingers with friction: the grasp line inside both friction cones (Nguyen)"))
