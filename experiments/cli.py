@@ -138,7 +138,8 @@ def silhouettes_command(out: Path = typer.Option(Path("qualgrasp-silhouettes"), 
                         n: int = typer.Option(24, "--n", help="Number of cell outlines."),
                         horse: bool = typer.Option(True, "--horse/--no-horse",
                                                    help="Also write scikit-image's horse.")) -> None:
-    """Write the bundled real silhouettes (geomstats cells, scikit-image horse) as 512 x 512 PNG images."""
+    """Write the bundled real silhouettes (cell outlines from geomstats, shipped with qualgrasp; scikit-image's
+    horse) as 512 x 512 PNG images."""
     from .silhouettes import write_silhouettes
 
     try:

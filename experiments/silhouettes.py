@@ -3,12 +3,13 @@
 Sources and licences
 --------------------
 * **Cells.** Outlines of mouse osteosarcoma cells (two cell lines, ``dlm8`` and ``dunn``, each
-  under three treatments, ``control``, ``cytd`` and ``jasp``; 650 outlines) shipped with
-  geomstats (MIT licence, copyright Nina Miolane) as
-  ``geomstats/datasets/data/cells/cells.txt`` with ``cell_lines.txt`` and ``treatments.txt``.
-  The files are located with :func:`importlib.util.find_spec` without importing geomstats
-  (which is slow to import) and parsed here: outlines are separated by blank lines, one
-  ``x y`` integer pair per line.
+  under three treatments, ``control``, ``cytd`` and ``jasp``; 650 outlines) from geomstats
+  (``geomstats/datasets/data/cells/cells.txt`` with ``cell_lines.txt`` and ``treatments.txt``,
+  MIT licence, copyright 2018 Nina Miolane). The 133 outlines that pass the selection rule's
+  steps 1 to 4 are shipped with this package, unchanged (integer source pixels), in
+  ``experiments/data/cells.npz`` with the licence notice ``experiments/data/LICENSE-geomstats.md``;
+  :func:`write_cell_data` regenerates the file from geomstats' text files (geomstats is not a
+  dependency).
 * **Horse.** scikit-image's ``skimage.data.horse()`` (bundled with scikit-image, offline; BSD
   licence), a binary silhouette; its outline is the mask's outer pixel contour
   (:func:`cv2.findContours`), resampled and smoothed like the cells' (Gaussian of 1 pixel).
@@ -43,7 +44,7 @@ used for the built-ins, :data:`qualgrasp.qualitative.objects.RADIUS`).
 
 from __future__ import annotations
 
-import importlib.util
+from importlib import resources
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -55,7 +56,7 @@ from shapely.geometry import Polygon
 
 from qualgrasp.qualitative.objects import normalise, place, render_polygon
 
-__all__ = ["MIN_EXTENT", "THIN", "SMOOTHING", "SIZE", "Silhouette", "cells_path", "read_cells",
+__all__ = ["MIN_EXTENT", "THIN", "SMOOTHING", "SIZE", "Silhouette", "parse_cells", "write_cell_data", "read_cells",
            "smooth_outline", "select_cells", "horse", "silhouettes", "write_silhouettes"]
 
 MIN_EXTENT = 50
@@ -108,46 +109,47 @@ class Silhouette:
         return render_polygon(self.polygon(size, rotation, offset), size, noise=noise, seed=seed)
 
 
-def cells_path() -> Path:
-    """Folder holding geomstats' cell files, found without importing geomstats.
-
-    Raises
-    ------
-    FileNotFoundError
-        geomstats is not installed (``pip install geomstats``) or ships no cell data.
-    """
-    spec = importlib.util.find_spec("geomstats")
-    if spec is None or not spec.submodule_search_locations:
-        raise FileNotFoundError("geomstats is not installed: pip install geomstats (its cell outlines "
-                                "are the real silhouettes of the study)")
-    folder = Path(list(spec.submodule_search_locations)[0]) / "datasets" / "data" / "cells"
-    if not (folder / "cells.txt").is_file():
-        raise FileNotFoundError(f"no cells.txt in {folder}")
-    return folder
+def _data(name: str):
+    """A file shipped in ``qualgrasp/experiments/data``."""
+    return resources.files("qualgrasp.experiments") / "data" / name
 
 
-def _lines(path: Path) -> list[str]:
-    return [line.strip() for line in path.read_text().split("\n") if line.strip()]
-
-
-def read_cells() -> list[tuple[np.ndarray, str, str]]:
-    """Every cell outline with its cell line and treatment.
-
-    Returns
-    -------
-    list of (numpy.ndarray, str, str)
-        ``(m, 2)`` float outline (source pixels, repeated consecutive and closing points removed),
-        cell line, treatment; in file order.
-    """
-    folder = cells_path()
+def parse_cells(folder: str | Path) -> list[tuple[np.ndarray, str, str]]:
+    """Every cell outline of geomstats' text files in ``folder`` (``cells.txt``,
+    ``cell_lines.txt``, ``treatments.txt``): ``(m, 2)`` integer source pixels (repeated
+    consecutive and closing points removed), cell line and treatment, in file order."""
+    folder = Path(folder)
+    lines_of = lambda name: [v.strip() for v in (folder / name).read_text().split("\n") if v.strip()]  # noqa: E731
     blocks = [b for b in (folder / "cells.txt").read_text().split("\n\n") if b.strip()]
-    lines, treatments = _lines(folder / "cell_lines.txt"), _lines(folder / "treatments.txt")
     out = []
-    for block, line, treatment in zip(blocks, lines, treatments):
+    for block, line, treatment in zip(blocks, lines_of("cell_lines.txt"), lines_of("treatments.txt")):
         xy = np.array([[float(v) for v in row.split()] for row in block.strip().split("\n")])
         keep = np.any(xy != np.roll(xy, -1, axis=0), axis=1)  # drops repeats and the closing point
         out.append((xy[keep], line, treatment))
     return out
+
+
+def write_cell_data(folder: str | Path, path: str | Path) -> int:
+    """Write the cells that pass the selection rule's steps 1 to 4 (from geomstats' text files in
+    ``folder``, see :func:`parse_cells`) to ``path`` (``.npz``: ``xy`` all points (int16),
+    ``offsets``, ``index`` in ``cells.txt``, ``line``, ``treatment``); return how many."""
+    kept = [(i, xy, line, treatment) for i, (xy, line, treatment) in enumerate(parse_cells(folder))
+            if _passes(xy)]
+    np.savez_compressed(
+        path, xy=np.concatenate([xy for _, xy, _, _ in kept]).astype(np.int16),
+        offsets=np.cumsum([0] + [len(xy) for _, xy, _, _ in kept]),
+        index=np.array([i for i, *_ in kept]), line=np.array([v for _, _, v, _ in kept]),
+        treatment=np.array([v for *_, v in kept]))
+    return len(kept)
+
+
+def read_cells() -> list[tuple[int, np.ndarray, str, str]]:
+    """The shipped cell outlines: ``(index in cells.txt, (m, 2) float outline in source pixels,
+    cell line, treatment)``, in file order."""
+    with _data("cells.npz").open("rb") as fh, np.load(fh) as d:
+        xy, offsets = d["xy"].astype(np.float64), d["offsets"]
+        return [(int(i), xy[a:b], str(line), str(treatment)) for i, a, b, line, treatment
+                in zip(d["index"], offsets[:-1], offsets[1:], d["line"], d["treatment"])]
 
 
 def smooth_outline(xy: np.ndarray, sigma: float = SMOOTHING) -> np.ndarray:
@@ -176,16 +178,21 @@ def _solidity(poly: Polygon) -> float:
     return float(poly.area / poly.convex_hull.area)
 
 
+def _passes(xy: np.ndarray) -> bool:
+    """Rule steps 1 to 4 on a raw outline (source pixels)."""
+    extent = np.ptp(xy, axis=0) if len(xy) else np.zeros(2)
+    if len(xy) < 40 or extent.min() < MIN_EXTENT or not Polygon(xy).is_valid:
+        return False
+    poly = Polygon(smooth_outline(xy))
+    return poly.is_valid and not _thin(normalise(poly))
+
+
 def _valid_cells() -> dict[tuple[str, str], list[tuple[int, Polygon]]]:
-    """Kept cells (rule steps 1 to 3) per (cell line, treatment), as smoothed polygons."""
+    """Kept cells (rule steps 1 to 4) per (cell line, treatment), as smoothed polygons."""
     groups: dict[tuple[str, str], list[tuple[int, Polygon]]] = {g: [] for g in _GROUPS}
-    for index, (xy, line, treatment) in enumerate(read_cells()):
-        extent = np.ptp(xy, axis=0) if len(xy) else np.zeros(2)
-        if len(xy) < 40 or extent.min() < MIN_EXTENT or not Polygon(xy).is_valid:
-            continue
-        poly = Polygon(smooth_outline(xy))
-        if poly.is_valid and (line, treatment) in groups and not _thin(normalise(poly)):
-            groups[(line, treatment)].append((index, poly))
+    for index, xy, line, treatment in read_cells():
+        if (line, treatment) in groups and _passes(xy):
+            groups[(line, treatment)].append((index, Polygon(smooth_outline(xy))))
     return groups
 
 
@@ -220,7 +227,8 @@ def select_cells(n: int = 24) -> list[Silhouette]:
         for k in picks:
             index, poly = ranked[k]
             chosen.append(Silhouette(f"cell-{index:03d}-{g[0]}-{g[1]}", normalise(poly),
-                                     "geomstats/datasets/data/cells/cells.txt (MIT)", _solidity(poly)))
+                                     "geomstats cells.txt, shipped as experiments/data/cells.npz (MIT)",
+                                     _solidity(poly)))
     return chosen
 
 
