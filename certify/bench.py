@@ -22,11 +22,21 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
+import numpy as np
+from rich.console import Console
+from rich.progress import Progress
+from rich.table import Table
+
 from .certificates import verify
-from .closure import force_closure
+from .chunk import Options
+from .closure import force_closure, form_closure
+from .fastpath import certify_table
+from .grasp import grasp_to_dict
+from .quality import epsilon, epsilon_linearised
+from .report import certify_grasp
 from .samples import random_grasps
 from .solvers import make_solver
-from .solvers.reference import CvxpySolver
+from .table import grasps_table
 
 __all__ = ["KINDS", "BenchRow", "run_bench", "print_bench"]
 
@@ -65,11 +75,6 @@ def _time(fn, items, progress=None) -> float:
 
 def _batch_seconds(grasps) -> float:
     """Seconds of the columnar batch path on ``grasps`` (table built outside the timing)."""
-    from .chunk import Options
-    from .fastpath import certify_table
-    from .grasp import grasp_to_dict
-    from .report import certify_grasp
-    from .table import grasps_table
 
     table = grasps_table([grasp_to_dict(g) for g in grasps])
     lines = list(range(1, len(grasps) + 1))
@@ -88,7 +93,6 @@ def run_bench(n: int = 20000, seed: int = 0, reference_n: int = 300,
               progress: bool = True) -> list[BenchRow]:
     """Time every route of the module docstring on ``n`` grasps per kind (``reference_n`` for the
     routes slower than a millisecond per grasp)."""
-    from rich.progress import Progress
 
     rows = []
     with Progress(transient=True, disable=not progress) as bar:
@@ -103,8 +107,8 @@ def run_bench(n: int = 20000, seed: int = 0, reference_n: int = 300,
                        ("clarabel direct", make_solver("clarabel"), few)]
             if kwargs["dim"] == 2 or kwargs["model"] == "frictionless":
                 solvers.append(("scipy linprog (HiGHS)", make_solver("linprog"), few))
-            solvers += [("cvxpy + Parameters (reference)", CvxpySolver(parametric=True), few),
-                        ("cvxpy rebuilt per grasp", CvxpySolver(parametric=False), few)]
+            solvers += [("cvxpy + Parameters (reference)", make_solver("reference"), few),
+                        ("cvxpy rebuilt per grasp", make_solver("reference-rebuilt"), few)]
             for name, solver, items in solvers:
                 force_closure(grasps[0], solver=solver)  # build structure outside the timing
                 routes.append((name, len(items),
@@ -121,8 +125,6 @@ def run_bench(n: int = 20000, seed: int = 0, reference_n: int = 300,
 
 def print_bench(rows: list[BenchRow]) -> None:
     """Print the benchmark table with rich."""
-    from rich.console import Console
-    from rich.table import Table
 
     table = Table(title="closure certification, time per grasp (same grasps, same run, one process)")
     for col in ("kind", "route", "grasps", "us/grasp", "grasps/s", "x batch"):
@@ -157,7 +159,6 @@ def compare_routes(grasps, kind: str = "", a: str = "fast", b: str = "reference"
     grasps on which they contradict each other, and those one route left degenerate (within
     tolerance of the boundary) that the other decided with a certificate passing the exact
     re-check."""
-    from .closure import form_closure
 
     test = form_closure if frictionless else force_closure
     sa, sb = make_solver(a), make_solver(b)
@@ -178,7 +179,6 @@ def compare_routes(grasps, kind: str = "", a: str = "fast", b: str = "reference"
 
 def _proves(grasp, verdict, frictionless: bool) -> bool:
     """A decisive verdict whose certificate passes the exact re-check (False for None)."""
-    from .certificates import verify
 
     return verdict is not None and verdict.status != "degenerate" and verify(
         grasp, verdict.certificate, status=verdict.status, frictionless=frictionless).ok
@@ -210,9 +210,6 @@ def run_quality_bench(n: int = 30, seed: int = 0, budget: int = 200_000) -> list
     reached and the time per grasp, and for point contacts how far the 8-edge linearisation's
     epsilon falls below the exact-cone value (relative to ``hi``; the true error lies between
     that and the same relative to ``lo``)."""
-    import numpy as np
-
-    from .quality import epsilon, epsilon_linearised
 
     rows = []
     for kind, kwargs in QUALITY_KINDS.items():
@@ -236,8 +233,6 @@ def run_quality_bench(n: int = 30, seed: int = 0, budget: int = 200_000) -> list
 
 
 def print_quality_bench(rows: list[QualityRow]) -> None:
-    from rich.console import Console
-    from rich.table import Table
 
     table = Table(title="Ferrari-Canny epsilon: bound gap, time per grasp, 8-edge linearisation error")
     for col in ("kind", "norm", "grasps", "gap median", "gap worst", "ms median", "ms worst",

@@ -169,18 +169,39 @@ def margin_of(blocks, x) -> float:
 def verify(grasp: Grasp, certificate: Certificate, *, status: str | None = None,
            margin: float | None = None, frictionless: bool = False,
            tol: Tolerances = Tolerances()) -> Check:
-    """Re-check ``certificate`` against ``grasp`` without a solver.
+    """Re-check ``certificate`` against ``grasp`` without a solver, in exact rational arithmetic
+    on the float data (module docstring).
 
     Parameters
     ----------
     grasp : Grasp
     certificate : Certificate
+        From :func:`qualgrasp.certify.force_closure` or :func:`~qualgrasp.certify.form_closure`,
+        or read back from a results file (:meth:`Certificate.from_json`).
     status : str, optional
         The claimed status; checked against the certificate's kind.
     margin : float, optional
         The claimed margin; an interior certificate must support it.
     frictionless : bool
         Check form closure (every contact frictionless) instead of force closure.
+    tol : Tolerances
+        The tolerances the verdict was made with.
+
+    Returns
+    -------
+    Check
+        Truthy when the certificate proves the claim; otherwise ``reason`` says what failed.
+        A malformed certificate is a failed check, never an exception.
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import Contact, Grasp, force_closure, verify
+    >>> g = Grasp((Contact((1, 0), (-1, 0), "point", 0.5), Contact((-1, 0), (1, 0), "point", 0.5)))
+    >>> v = force_closure(g)
+    >>> bool(verify(g, v.certificate, status=v.status, margin=v.margin))
+    True
+    >>> verify(g, v.certificate, status=v.status, margin=0.3).reason
+    'claimed margin 0.3 exceeds the certified 0.25'
     """
     socp = certificate.layout == "forces"  # a planar grasp may be certified by its 2-D cones
     try:

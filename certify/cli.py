@@ -13,8 +13,12 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
+from . import models
 from .batch import certify_file, verify_file
+from .bench import print_bench, print_quality_bench, run_bench, run_quality_bench
 from .errors import CertifyError
+from .samples import write_random_grasp_file
+from .table import count_grasps
 
 __all__ = ["register"]
 
@@ -39,7 +43,6 @@ def certify_command(
     Exit code 1 when some rows are errors or failed their own re-check, 2 when the run could not
     start (unreadable input, resume refused).
     """
-    from .table import count_grasps
 
     total = count_grasps(grasps)
     with Progress(TextColumn("certify"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
@@ -105,7 +108,6 @@ def bench_command(
     With --quality: epsilon bound gaps and time per grasp, and the error of the 8-edge cone
     linearisation other toolkits use, on --n random grasps in closure per kind.
     """
-    from .bench import print_bench, print_quality_bench, run_bench, run_quality_bench
 
     if quality:
         print_quality_bench(run_quality_bench(n=n, seed=seed))
@@ -118,13 +120,12 @@ def sample_command(
     n: int = typer.Option(100_000, "--n", help="Number of grasps."),
     dim: int = typer.Option(2, help="2 (planar) or 3 (spatial)."),
     contacts: int = typer.Option(3, help="Contacts per grasp."),
-    model: str = typer.Option("point", help="frictionless, point or soft."),
+    model: str = typer.Option("point", help="Contact model: " + ", ".join(models.names()) + "."),
     seed: int = typer.Option(0, help="Random seed."),
 ) -> None:
     """Write a random grasp set, for trying the toolkit and for benchmarks at scale.
 
     Contacts are placed around a random blob; about a third of the grasps are in closure."""
-    from .samples import write_random_grasp_file
 
     count = write_random_grasp_file(output, n, seed=seed, dim=dim, n_contacts=contacts, model=model)
     console.print(f"wrote {count} grasps to {output}")

@@ -131,20 +131,73 @@ def farkas_from_arrays(C: np.ndarray, arrays, layout: str, y: np.ndarray,
 
 def force_closure(grasp: Grasp, *, method: str = "fast", solver=None, socp: bool = False,
                   tol: Tolerances = Tolerances()) -> Verdict:
-    """Force closure of ``grasp`` under its declared contact models.
+    """Force closure of ``grasp`` under its declared contact models, with a certificate.
 
-    Planar friction cones are exact two-edge cones (an LP); spatial point and soft contacts use
-    exact second-order cones (an SOCP). ``method`` is ``'fast'`` or ``'reference'`` (cvxpy); pass a
-    ``solver`` from :func:`qualgrasp.certify.solvers.make_solver` to reuse prebuilt structure across calls.
-    ``socp=True`` solves a planar grasp with 2-D second-order cones instead of edges (same
-    verdict, margin on the cone scale ``mu f_n - abs(f_t)``; a cross-check of the LP).
+    Planar contacts are exact polyhedral cones (an LP: friction cones are their two edges, a pad's
+    cone the edges at its two ends); spatial point and soft contacts exact second-order cones (an
+    SOCP). The closure programme and the verdict rules are those of :mod:`qualgrasp.certify.problem`
+    and :func:`decide`.
+
+    Parameters
+    ----------
+    grasp : Grasp
+        The grasp (contacts, torque ``center`` and ``length``).
+    method : {'fast', 'reference'}
+        Solver route: the fast route (compiled enumeration, barrier method, clarabel) or the
+        readable cvxpy formulation. Both give the same verdict.
+    solver : object, optional
+        A solver from :func:`qualgrasp.certify.solvers.make_solver`, to reuse prebuilt structure
+        across calls (overrides ``method``).
+    socp : bool
+        Solve a planar grasp with 2-D second-order cones instead of edges (same verdict, margin on
+        the cone scale ``mu f_n - abs(f_t)``; a cross-check of the LP). Not for pads.
+    tol : Tolerances
+        Numerical tolerances of the verdict.
+
+    Returns
+    -------
+    Verdict
+        ``status`` (``closure``, ``no_closure`` or ``degenerate``), the min-weight ``margin``
+        (``t*``, 0 unless in closure) and the ``certificate``.
+
+    Raises
+    ------
+    SolverError
+        The solver failed on a full-rank problem (not seen in practice).
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import Contact, Grasp, force_closure
+    >>> g = Grasp((Contact((1, 0), (-1, 0), "point", 0.5), Contact((-1, 0), (1, 0), "point", 0.5)))
+    >>> v = force_closure(g)
+    >>> v.status, v.margin, v.certificate.kind
+    ('closure', 0.25, 'interior')
     """
     return _grasp_verdict(grasp, False, method, solver, tol, socp)
 
 
 def form_closure(grasp: Grasp, *, method: str = "fast", solver=None,
                  tol: Tolerances = Tolerances()) -> Verdict:
-    """Form closure of ``grasp``: force closure with every contact treated as frictionless."""
+    """Form closure of ``grasp``: force closure with friction ignored at every contact (each
+    contact replaced by its model's frictionless counterpart; a pad stays a pad with ``mu = 0``).
+
+    Parameters
+    ----------
+    grasp : Grasp
+    method, solver, tol
+        As for :func:`force_closure`.
+
+    Returns
+    -------
+    Verdict
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import Contact, Grasp, form_closure
+    >>> g = Grasp((Contact((1, 0), (-1, 0), "point", 0.5), Contact((-1, 0), (1, 0), "point", 0.5)))
+    >>> form_closure(g).status  # two frictionless contacts cannot hold a planar object
+    'no_closure'
+    """
     return _grasp_verdict(grasp, True, method, solver, tol)
 
 
@@ -161,10 +214,36 @@ def _grasp_verdict(grasp, frictionless, method, solver, tol, socp=False) -> Verd
 
 def positive_span(vectors, *, method: str = "fast", solver=None,
                   tol: Tolerances = Tolerances()) -> Verdict:
-    """Do the rows of ``vectors`` (shape ``(k, d)``) positively span ``R^d``?
+    """Do the rows of ``vectors`` positively span ``R^d``?
 
     True iff they have rank ``d`` and a strictly positive combination of them is zero. In the
     plane, unit normals positively span iff their largest angular gap is below pi.
+
+    Parameters
+    ----------
+    vectors : array_like
+        ``(k, d)`` finite vectors.
+    method, solver, tol
+        As for :func:`force_closure`.
+
+    Returns
+    -------
+    Verdict
+        ``closure`` when they positively span, with a certificate re-checkable by
+        :func:`qualgrasp.certify.verify_span`.
+
+    Raises
+    ------
+    GraspError
+        ``vectors`` is not a finite 2-D array.
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import positive_span
+    >>> positive_span([[1, 0], [-0.5, 0.9], [-0.5, -0.9]]).status
+    'closure'
+    >>> positive_span([[1, 0], [0, 1], [-1, 0.1]]).status  # all in the upper half plane
+    'no_closure'
     """
     V = np.asarray(vectors, dtype=float)
     if V.ndim != 2 or not np.isfinite(V).all():

@@ -282,6 +282,15 @@ def grasp_from_dict(d: Any) -> Grasp:
     ``frictionless`` otherwise. Other keys of a contact are ignored; other top-level keys are kept
     in ``meta``.
 
+    Parameters
+    ----------
+    d : mapping
+        One grasp of a grasp set, as parsed JSON.
+
+    Returns
+    -------
+    Grasp
+
     Raises
     ------
     GraspError
@@ -305,6 +314,16 @@ def grasp_from_dict(d: Any) -> Grasp:
 
 def grasp_to_dict(grasp: Grasp) -> dict[str, Any]:
     """The grasp-set schema of ``grasp`` (inverse of :func:`grasp_from_dict`).
+
+    Parameters
+    ----------
+    grasp : Grasp
+
+    Returns
+    -------
+    dict
+        ``id`` (when set), ``contacts`` (``p``, ``n``, ``model`` and the model's parameters),
+        ``center``, ``length`` and the ``meta`` fields.
 
     Examples
     --------

@@ -38,13 +38,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import clarabel
 import numpy as np
+import scipy.sparse as sp
 from scipy.spatial import ConvexHull, QhullError
 
+from ._kernels.epsilon import planar_epsilon as kernel_planar_epsilon
 from .closure import Verdict, force_closure
 from .grasp import Grasp
-from ._kernels.epsilon import planar_epsilon as kernel_planar_epsilon
 from .problem import System, grasp_system
+from .solvers.clarabel_direct import settings
 
 __all__ = ["NORMS", "Epsilon", "epsilon", "planar_epsilon", "epsilon_of_points", "epsilon_linearised"]
 
@@ -127,6 +130,22 @@ def epsilon(grasp: Grasp, norm: str = "L1", *, rel_gap: float = 0.01, budget: in
     -------
     Epsilon
         Bounds with the ``center`` and ``length`` used; 0 unless the grasp is in force closure.
+
+    Raises
+    ------
+    ValueError
+        Unknown ``norm``.
+
+    Examples
+    --------
+    Two antipodal point contacts on the unit circle with ``mu = 0.5`` (exact in the plane):
+
+    >>> from qualgrasp.certify import Contact, Grasp
+    >>> from qualgrasp.certify.quality import epsilon
+    >>> g = Grasp((Contact((1, 0), (-1, 0), "point", 0.5), Contact((-1, 0), (1, 0), "point", 0.5)))
+    >>> e = epsilon(g, "L1")
+    >>> round(e.lo, 6), e.exact, e.center, e.length
+    (0.333333, True, (0.0, 0.0), 1.0)
     """
     _check_norm(norm)
     verdict = verdict or force_closure(grasp)
@@ -231,8 +250,6 @@ class _Pieces:
         tangent-plane problem has the same solution, so iterating from ``u / norm(u)`` converges
         to it, and this minorant is then tight to second order around it.
         """
-        import clarabel
-        import scipy.sparse as sp
 
         nb, r, d = self.T.shape
         nt = 1 if norm == "L1" else nb
@@ -253,7 +270,6 @@ class _Pieces:
             b += [0.0] * (1 + rk)
         A = sp.csc_matrix(np.array(rows))
         q = np.r_[np.zeros(d), np.ones(nt)]
-        from .solvers.clarabel_direct import settings
 
         sol = clarabel.DefaultSolver(sp.csc_matrix((n, n)), q, A, np.array(b), cones,
                                      settings()).solve()
@@ -317,10 +333,6 @@ class _CellSolver:
     """
 
     def __init__(self, pieces: _Pieces, m: int, norm: str) -> None:
-        import clarabel
-        import scipy.sparse as sp
-
-        from .solvers.clarabel_direct import settings
 
         self.pieces, self.m, self.norm = pieces, m, norm
         self.rk = [int(np.count_nonzero(np.abs(t).sum(axis=1))) for t in pieces.T]

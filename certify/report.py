@@ -63,9 +63,35 @@ class Report:
 def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
                   tol: Tolerances = Tolerances(), quality: bool = True, eps_gap: float = 0.01,
                   eps_budget: int = 200_000) -> Report:
-    """Force closure, form closure, the re-check of both certificates and, with ``quality``,
-    the L1 and L-infinity epsilon of ``grasp`` (spatial bounds refined to ``eps_gap`` or
-    ``eps_budget`` cells of directions per norm, see :func:`qualgrasp.certify.quality.epsilon`)."""
+    """Certify one grasp end to end: force and form closure, the re-check of both certificates
+    and, with ``quality``, the L1 and L-infinity Ferrari-Canny epsilon.
+
+    Parameters
+    ----------
+    grasp : Grasp
+    method, solver, tol
+        As for :func:`qualgrasp.certify.force_closure`.
+    quality : bool
+        Compute the epsilons (with the grasp's ``center`` and ``length``).
+    eps_gap, eps_budget
+        Spatial epsilon: relative gap to reach and most work (see
+        :func:`qualgrasp.certify.quality.epsilon`).
+
+    Returns
+    -------
+    Report
+        Both verdicts, whether both certificates re-checked, the epsilons; :meth:`Report.row` is
+        the results-file row.
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import Contact, Grasp, certify_grasp
+    >>> g = Grasp((Contact((1, 0), (-1, 0), "pad", mu=0.5, width=0.4),
+    ...            Contact((-1, 0), (1, 0), "pad", mu=0.5, width=0.4)))
+    >>> r = certify_grasp(g)
+    >>> r.force.status, r.form.status, r.verified, round(r.epsilons["L1"].hi, 4)
+    ('closure', 'no_closure', True, 0.4667)
+    """
     force = force_closure(grasp, method=method, solver=solver, tol=tol)
     form = force if grasp.frictionless else form_closure(grasp, method=method, solver=solver, tol=tol)
     ok = all(

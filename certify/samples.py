@@ -2,34 +2,45 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
 
+from . import models as registry
 from .grasp import Contact, Grasp
+from .table import CONTACT, GRASP_SCHEMA, is_parquet
 
-__all__ = ["random_grasp", "random_grasps", "textbook_grasps"]
+__all__ = ["RANGES", "random_grasp", "random_grasps", "textbook_grasps", "random_grasp_table", "write_random_grasp_file"]
+
+
+#: Ranges of the uniform draws of each model parameter.
+RANGES = {"mu": (0.2, 1.0), "torsion": (0.05, 0.5), "width": (0.05, 0.6)}
 
 
 def random_grasp(rng: np.random.Generator, *, dim: int = 2, n_contacts: int = 3,
-                 model: str = "point", mu: tuple[float, float] = (0.2, 1.0),
-                 torsion: tuple[float, float] = (0.05, 0.5), spread: float = 0.7) -> Grasp:
+                 model: str = "point", mu: tuple[float, float] = RANGES["mu"],
+                 torsion: tuple[float, float] = RANGES["torsion"],
+                 width: tuple[float, float] = RANGES["width"], spread: float = 0.7) -> Grasp:
     """A random grasp on a blob around the origin.
 
     Contact points lie at radius 0.7 to 1.3 in uniformly random directions; each inward normal is
     the direction to the origin plus Gaussian noise of size ``spread``, so that roughly half of
-    the grasps are in closure for the default sizes. ``mu`` and ``torsion`` are uniform ranges.
+    the grasps are in closure for the default sizes. ``model`` is any registered contact model;
+    its parameters are drawn uniformly from the ranges ``mu``, ``torsion``, ``width`` (in the
+    model's parameter order, after the normal).
     """
+    ranges = {"mu": mu, "torsion": torsion, "width": width}
+    spec = registry.get(model)
     contacts = []
     for _ in range(n_contacts):
         u = rng.normal(size=dim)
         u /= np.linalg.norm(u)
         p = u * rng.uniform(0.7, 1.3)
         n = -u + spread * rng.normal(size=dim)
-        if model == "frictionless":
-            contacts.append(Contact(p, n))
-        elif model == "point":
-            contacts.append(Contact(p, n, "point", rng.uniform(*mu)))
-        else:
-            contacts.append(Contact(p, n, "soft", rng.uniform(*mu), rng.uniform(*torsion)))
+        params = {par.name: rng.uniform(*ranges[par.name]) for par in spec.params}
+        contacts.append(Contact(p, n, model, **params))
     return Grasp(tuple(contacts))
 
 
@@ -81,6 +92,9 @@ def textbook_grasps() -> list[Grasp]:
     * ``antipodal-3d-point``: the same in space (not: rotation about the grasp line is free);
       ``antipodal-3d-soft``: soft contacts (force closure).
     * ``cube-7``: 7 frictionless contacts on the cube's faces (spatial form closure).
+    * ``pads-2d-frictionless``: two frictionless flat pads on opposite faces (they resist rotation
+      but not sliding along the faces: not in closure); ``pads-2d``: the same with friction
+      (force closure).
     """
     s = 0.5
     disc = [(np.cos(a), np.sin(a)) for a in (0.3, 1.9, 3.4, 5.0)]
@@ -95,20 +109,22 @@ def textbook_grasps() -> list[Grasp]:
         Grasp((Contact((0, 0, 1), (0, 0, -1), "soft", 0.5, 0.1),
                Contact((0, 0, -1), (0, 0, 1), "soft", 0.5, 0.1)), id="antipodal-3d-soft"),
         Grasp(CUBE_7, center=(0, 0, 0), id="cube-7"),
+        Grasp((Contact((1, 0), (-1, 0), "pad", mu=0.0, width=0.4),
+               Contact((-1, 0), (1, 0), "pad", mu=0.0, width=0.4)), center=(0, 0), id="pads-2d-frictionless"),
+        Grasp((Contact((1, 0), (-1, 0), "pad", mu=0.5, width=0.4),
+               Contact((-1, 0), (1, 0), "pad", mu=0.5, width=0.4)), center=(0, 0), id="pads-2d"),
     ]
     return gs
 
 
 def random_grasp_table(seed: int, count: int, *, dim: int = 2, n_contacts: int = 3,
-                       model: str = "point", mu: tuple[float, float] = (0.2, 1.0),
-                       torsion: tuple[float, float] = (0.05, 0.5), spread: float = 0.7,
+                       model: str = "point", mu: tuple[float, float] = RANGES["mu"],
+                       torsion: tuple[float, float] = RANGES["torsion"],
+                       width: tuple[float, float] = RANGES["width"], spread: float = 0.7,
                        start: int = 0):
     """An Arrow grasp table (:data:`qualgrasp.certify.table.GRASP_SCHEMA`) of ``count`` random grasps drawn
     like :func:`random_grasp` (same distribution, vectorised; not the same draws), ids
     ``r{start}, r{start+1}, ...``; ``center`` and ``length`` left to their defaults."""
-    import pyarrow as pa
-
-    from .table import CONTACT, GRASP_SCHEMA
 
     rng = np.random.default_rng(seed)
     m = n_contacts
@@ -119,13 +135,10 @@ def random_grasp_table(seed: int, count: int, *, dim: int = 2, n_contacts: int =
     total = count * m
     lists = lambda a: pa.ListArray.from_arrays(pa.array(np.arange(0, total * dim + 1, dim, dtype=np.int32)),
                                                pa.array(a.reshape(-1)))
-    if model == "frictionless":
-        mus = pa.nulls(total, pa.float64())
-    else:
-        mus = pa.array(rng.uniform(*mu, size=total))
-    tors = pa.array(rng.uniform(*torsion, size=total)) if model == "soft" else pa.nulls(total, pa.float64())
-    fields = {"p": lists(p), "n": lists(n), "model": pa.array(np.full(total, model, dtype=object)),
-              "mu": mus, "torsion": tors}
+    ranges = {"mu": mu, "torsion": torsion, "width": width}
+    fields = {"p": lists(p), "n": lists(n), "model": pa.array(np.full(total, model, dtype=object))}
+    for par in registry.get(model).params:
+        fields[par.name] = pa.array(rng.uniform(*ranges[par.name], size=total))
     contacts = pa.StructArray.from_arrays(
         [fields.get(f.name, pa.nulls(total, f.type)) for f in CONTACT], fields=list(CONTACT))
     per_row = pa.ListArray.from_arrays(pa.array(np.arange(0, total + 1, m, dtype=np.int32)), contacts)
@@ -137,11 +150,7 @@ def random_grasp_table(seed: int, count: int, *, dim: int = 2, n_contacts: int =
 def write_random_grasp_file(path, count: int, *, seed: int = 0, chunk: int = 500_000, **kwargs) -> int:
     """Write ``count`` random grasps (:func:`random_grasp_table`) to a Parquet or JSON Lines file,
     ``chunk`` at a time, so that memory stays bounded; return how many were written."""
-    import json
 
-    import pyarrow.parquet as pq
-
-    from .table import GRASP_SCHEMA, is_parquet
 
     written = 0
     writer = pq.ParquetWriter(path, GRASP_SCHEMA) if is_parquet(path) else None

@@ -3,11 +3,20 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import typer
 from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
+
+from .demo import demo_steps, run_demo
+from . import figures
+from .silhouettes import silhouettes as bundled
+from .silhouettes import write_silhouettes
+from .study import BUILTINS, SETTINGS, compare, workload
+from .style import check_formats
 
 __all__ = ["register"]
 
@@ -28,9 +37,6 @@ def demo_command(out: Path = typer.Option(Path("qualgrasp-demo"), "--out", help=
     The paper's figures 3 to 8; FormGrasp and ForceGrasp on the built-in camera images, certified
     and every certificate re-checked; the comparison study (quick setting); a Markdown report.
     """
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
-    from .demo import demo_steps, run_demo
 
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                   console=console) as bar:
@@ -63,14 +69,12 @@ def figures_command(out: Path = typer.Option(Path("qualgrasp-figures"), "--out",
                     formats: str = typer.Option("pdf,png", "--formats",
                                                 help="Comma-separated file formats, e.g. pdf,png,svg.")) -> None:
     """Draw the paper's figures 3 to 8 from the toolkit's own computations and say where they went."""
-    from .figures import make_figures
-    from .style import check_formats
 
     try:
         kinds = check_formats([f.strip() for f in formats.split(",") if f.strip()])
     except ValueError as exc:
         raise typer.BadParameter(str(exc), param_hint="--formats") from exc
-    paths = make_figures(out, formats=kinds, progress=lambda message: console.print(message))
+    paths = figures.make_figures(out, formats=kinds, progress=lambda message: console.print(message))
     for path in paths:
         console.print(f"wrote {path}", soft_wrap=True)  # paths stay whole, for copy and paste
     console.print(f"{len(paths)} files in {out}", soft_wrap=True)
@@ -93,12 +97,7 @@ def compare_command(
                                                                  "size (default: the setting's)."),
 ) -> None:
     """Compare qualitative grasps with the quantitative baseline: quality, time, robustness."""
-    from dataclasses import replace
 
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
-    from .silhouettes import silhouettes as bundled
-    from .study import BUILTINS, SETTINGS, compare, workload
 
     if setting not in SETTINGS:
         raise typer.BadParameter(f"use one of {', '.join(SETTINGS)}", param_hint="--setting")
@@ -140,7 +139,6 @@ def silhouettes_command(out: Path = typer.Option(Path("qualgrasp-silhouettes"), 
                                                    help="Also write scikit-image's horse.")) -> None:
     """Write the bundled real silhouettes (cell outlines from geomstats, shipped with qualgrasp; scikit-image's
     horse) as 512 x 512 PNG images."""
-    from .silhouettes import write_silhouettes
 
     try:
         paths = write_silhouettes(out, n, with_horse=horse)

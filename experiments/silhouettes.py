@@ -44,17 +44,17 @@ used for the built-ins, :data:`qualgrasp.qualitative.objects.RADIUS`).
 
 from __future__ import annotations
 
-from importlib import resources
 from dataclasses import dataclass
+from importlib import resources
 from pathlib import Path
 
 import cv2
 import numpy as np
 import shapely
+from qualgrasp.qualitative.objects import normalise, place, render_polygon
 from scipy import ndimage
 from shapely.geometry import Polygon
-
-from qualgrasp.qualitative.objects import normalise, place, render_polygon
+from skimage import data
 
 __all__ = ["MIN_EXTENT", "THIN", "SMOOTHING", "SIZE", "Silhouette", "parse_cells", "write_cell_data", "read_cells",
            "smooth_outline", "select_cells", "horse", "silhouettes", "write_silhouettes"]
@@ -234,7 +234,6 @@ def select_cells(n: int = 24) -> list[Silhouette]:
 
 def horse() -> Silhouette:
     """scikit-image's horse silhouette (bundled, offline), its outline smoothed like the cells'."""
-    from skimage import data
 
     mask = ~data.horse()  # True on the horse
     found, _ = cv2.findContours(mask.astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)

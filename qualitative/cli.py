@@ -2,11 +2,22 @@
 
 from __future__ import annotations
 
+import json
+import math
 from pathlib import Path
 
 import typer
 
+from ..certify.io import write_grasps
 from . import procedures
+from .errors import FormulaError, QualitativeError, TraceError
+from .grasp_plot import synthesis_figure
+from .outline import outline_image, outline_to_dict
+from .plot import outline_figure
+from .regions import feasible_regions, regions_to_dict
+from .st0 import evaluate_file
+from .synthesis import synthesize
+from .vision import read_image
 
 __all__ = ["register"]
 
@@ -27,8 +38,6 @@ def st0_command(
 
     Exit code 2 when the formula does not parse or the trace file is malformed.
     """
-    from .errors import FormulaError, TraceError
-    from .st0 import evaluate_file
 
     try:
         values = evaluate_file(formula, trace)
@@ -52,10 +61,6 @@ def outline_command(
     Coordinates in the JSON are pixels of the input image, x = column, y = row. Exit code 2 when
     the image cannot be read or does not hold exactly one whole object.
     """
-    import json
-
-    from .errors import QualitativeError
-    from .outline import outline_image, outline_to_dict
 
     try:
         outline = outline_image(image, threshold=threshold, largest=largest)
@@ -86,12 +91,6 @@ def regions_command(
     and smallest bounding-circle diameter. With --json: points and inward unit normals as lists of
     [x, y] in pixels of the input image (x = column, y = row). Exit code 2 on unusable input.
     """
-    import json
-
-    from .errors import QualitativeError
-    from .outline import outline_image
-    from .regions import feasible_regions, regions_to_dict
-    from .vision import read_image
 
     try:
         outline = outline_image(image, threshold=threshold, largest=largest)
@@ -100,7 +99,6 @@ def regions_command(
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(2)
     if plot is not None:
-        from .plot import outline_figure
 
         outline_figure(outline, regions, read_image(image)).savefig(plot, dpi=120)
     if as_json:
@@ -141,13 +139,7 @@ def synthesize_command(
     and a summary. Exit code 0 (with an empty file) when no grasp exists, 1 when a synthesised grasp
     fails certification, 2 on unusable input or options.
     """
-    import math
 
-    from ..certify.io import write_grasps
-
-    from .errors import QualitativeError
-    from .synthesis import synthesize
-    from .vision import read_image
 
     if mu is not None and theta_min is not None:
         typer.echo("error: give --mu or --theta-min, not both", err=True)
@@ -163,7 +155,6 @@ def synthesize_command(
         raise typer.Exit(2)
     write_grasps(output, result.grasps)
     if plot is not None:
-        from .grasp_plot import synthesis_figure
 
         synthesis_figure(result, read_image(image)).savefig(plot, dpi=110)
     friction = "frictionless" if result.mu is None else f"mu {result.mu:.4g}"

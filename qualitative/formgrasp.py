@@ -46,11 +46,11 @@ from functools import cache
 
 import numpy as np
 
-from qualgrasp.certify.wrench import torque
+from ..certify.wrench import torque
 
 from .candidates import GAP, Candidates, separated
 from .errors import SynthesisError
-from .zones import Zones, _cross, free_depth, unit_wrenches, zones
+from .zones import Zones, free_depth, unit_wrenches, zones
 
 __all__ = ["ERROR", "FormGrasp", "form_grasps", "closure_depth4", "line_of_action_exit", "ray_edges",
            "zone_steps"]
@@ -182,7 +182,7 @@ def form_grasps(cands: Candidates, contour: np.ndarray, center: np.ndarray, leng
 
 
 def _det(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
-    return np.einsum("...k,...k->...", a, _cross(b, c))
+    return np.einsum("...k,...k->...", a, torque(b, c))
 
 
 def closure_depth4(a: np.ndarray) -> np.ndarray:
@@ -205,7 +205,7 @@ def closure_depth4(a: np.ndarray) -> np.ndarray:
     C = np.stack([_det(a1, a2, a3), -_det(a0, a2, a3), _det(a0, a1, a3), -_det(a0, a1, a2)], axis=1)
     inside = (C > 0).all(axis=1) | (C < 0).all(axis=1)
     faces = [(a1, a2, a3), (a0, a2, a3), (a0, a1, a3), (a0, a1, a2)]
-    area = np.stack([np.linalg.norm(_cross(q - p, r - p), axis=1) for p, q, r in faces], axis=1)
+    area = np.stack([np.linalg.norm(torque(q - p, r - p), axis=1) for p, q, r in faces], axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
         dist = np.abs(C) / area
     return np.where(inside, -dist.min(axis=1), np.inf)

@@ -29,7 +29,7 @@ from shapely.geometry.base import BaseGeometry
 
 from .forcegrasp import ForceGrasp, friction_cone, friction_zone
 from .formgrasp import FormGrasp, line_of_action_exit, zone_steps
-from .plot import STYLE, _frame
+from .plot import STYLE, draw_frame
 from .synthesis import Synthesis
 from .zones import Zones
 
@@ -156,7 +156,7 @@ def plot_form_step(ax: Axes, synth: Synthesis, k: int, count: int, image: np.nda
     """
     grasp = synth.found[k]
     bounds = _view(synth, 0.35)
-    _frame(ax, synth.outline, image)
+    draw_frame(ax, synth.outline, image)
     _set_view(ax, bounds)
     _regions(ax, synth)
     z = zones if zones is not None else zone_steps(grasp, synth.center, synth.length)[count - 1]
@@ -176,7 +176,7 @@ def plot_grasp(ax: Axes, synth: Synthesis, k: int, image: np.ndarray | None = No
     """
     grasp = synth.found[k]
     size = synth.outline.size
-    _frame(ax, synth.outline, image)
+    draw_frame(ax, synth.outline, image)
     _set_view(ax, _view(synth, 0.12))
     _regions(ax, synth)
     if isinstance(grasp, ForceGrasp):
@@ -293,7 +293,7 @@ def synthesis_figure(synth: Synthesis, image: np.ndarray | None = None, count: i
         fig = Figure(figsize=(7.5, 6.0), layout="constrained")
         FigureCanvasAgg(fig)
         ax = fig.subplots()
-        _frame(ax, synth.outline, image)
+        draw_frame(ax, synth.outline, image)
         _regions(ax, synth)
         P = np.asarray(synth.candidates.points)
         ax.plot(P[:, 0], P[:, 1], ".", color="black", ms=4, zorder=5)

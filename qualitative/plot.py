@@ -20,7 +20,7 @@ from matplotlib.path import Path as MplPath
 from .outline import NAMES, Outline
 from .regions import Region
 
-__all__ = ["STYLE", "plot_outline", "plot_regions", "outline_figure", "curvature_handles"]
+__all__ = ["STYLE", "draw_frame", "plot_outline", "plot_regions", "outline_figure", "curvature_handles"]
 
 # Colour and marker of each curvature type; point-like types are drawn as markers at the apex.
 STYLE = {
@@ -34,7 +34,8 @@ STYLE = {
 }
 
 
-def _frame(ax: Axes, outline: Outline, image: np.ndarray | None) -> None:
+def draw_frame(ax: Axes, outline: Outline, image: np.ndarray | None) -> None:
+    """Draw the image faintly (if given) and the object's contour on ``ax``, in pixels (y down)."""
     if image is not None:
         ax.imshow(image, cmap="gray", vmin=0, vmax=255 if np.asarray(image).dtype == np.uint8 else None,
                   alpha=0.35, interpolation="nearest")
@@ -67,7 +68,7 @@ def plot_outline(ax: Axes, outline: Outline, image: np.ndarray | None = None, la
     -------
     matplotlib.axes.Axes
     """
-    _frame(ax, outline, image)
+    draw_frame(ax, outline, image)
     normals = outline.normals()
     offset = 0.05 * outline.size
     for seg in outline.segments:
@@ -141,7 +142,7 @@ def plot_regions(ax: Axes, outline: Outline, regions: Sequence[Region], image: n
     -------
     matplotlib.axes.Axes
     """
-    _frame(ax, outline, image)
+    draw_frame(ax, outline, image)
     for seg in outline.segments:
         if seg.is_point:
             ax.plot(*seg.position, ls="none", ms=5, color="0.4", marker=STYLE[seg.symbol]["marker"], zorder=2)

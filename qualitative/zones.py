@@ -76,7 +76,7 @@ import shapely
 from shapely.geometry import MultiPoint
 from shapely.geometry.base import BaseGeometry
 
-from qualgrasp.certify.wrench import wrench
+from ..certify.wrench import torque, wrench
 
 from .errors import ZoneError
 
@@ -327,14 +327,6 @@ def _combos(k: int) -> tuple[np.ndarray, np.ndarray]:
     return pairs, triples
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Cross product over the last axis (numpy's own is slow on small arrays)."""
-    a, b = np.broadcast_arrays(a, b)
-    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
-                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
-
-
 def _unit(v: np.ndarray) -> np.ndarray:
     """Rows normalised; rows too short to have a direction become 0 (their value is then 0)."""
     norm = np.linalg.norm(v, axis=-1, keepdims=True)
@@ -355,13 +347,13 @@ def _depth(a: np.ndarray) -> np.ndarray:
     cands = [a]
     if len(pairs):
         ai, aj = a[:, pairs[:, 0]], a[:, pairs[:, 1]]
-        cands += [_unit(ai + aj), _unit(_cross(ai, aj))]
+        cands += [_unit(ai + aj), _unit(torque(ai, aj))]
     if len(triples):
         # equal values on a triple: y normal to the plane through the three points a_i, a_j, a_k
         ai, aj, ak = (a[:, triples[:, m]] for m in range(3))
-        cands.append(_unit(_cross(aj - ai, ak - ai)))
+        cands.append(_unit(torque(aj - ai, ak - ai)))
     # vectors orthogonal to a_0 (one of them non-zero): they cover a rank-one set of constraints
-    cands += [_unit(_cross(a[:, :1], axis)) for axis in np.eye(3)[[0, 2]]]
+    cands += [_unit(torque(a[:, :1], axis)) for axis in np.eye(3)[[0, 2]]]
     y = np.concatenate(cands, axis=1)
     y = np.concatenate([y, -y], axis=1)
     valid = np.linalg.norm(y, axis=2) > 0.5
@@ -408,7 +400,7 @@ def _extreme_rays(C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     D = C @ Q  # the constraints within the complement, where the cone is pointed
     if rank == 3:
         i, j = np.triu_indices(len(D), 1)
-        cand = _cross(D[i], D[j])
+        cand = torque(D[i], D[j])
     elif rank == 2:
         cand = np.column_stack([-D[:, 1], D[:, 0]])
     else:  # rank 1: a half-line on each side

@@ -8,7 +8,7 @@ import numpy as np
 
 from .._kernels.barrier import socp_dual_barrier
 from ..problem import ClosureProblem
-from . import Solution
+from .base import Solution
 
 __all__ = ["BarrierSolver", "barrier_arrays", "EXIT_BELOW", "GAP_TOL"]
 

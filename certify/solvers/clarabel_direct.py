@@ -18,7 +18,7 @@ import scipy.sparse as sp
 
 from ..errors import SolverError
 from ..problem import ClosureProblem
-from . import Solution
+from .base import Solution
 
 __all__ = ["ClarabelSolver", "settings"]
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from .._kernels.lp import lp_enumerate, lp_planar
 from ..problem import ClosureProblem
-from . import Solution
+from .base import Solution
 
 __all__ = ["FEAS", "bases", "enumerate_lp", "solve_enumeration", "EnumerationSolver"]
 

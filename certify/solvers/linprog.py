@@ -13,7 +13,7 @@ from scipy.optimize import linprog
 
 from ..errors import SolverError
 from ..problem import ClosureProblem
-from . import Solution
+from .base import Solution
 
 __all__ = ["LinprogSolver"]
 

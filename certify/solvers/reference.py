@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import SolverError
 from ..problem import ClosureProblem
-from . import Solution
+from .base import Solution
 
 __all__ = ["CvxpySolver"]
 

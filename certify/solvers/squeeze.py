@@ -22,7 +22,7 @@ import numpy as np
 from .._kernels.cones import farkas_direction, squeeze_direction
 from ..cones import LORENTZ
 from ..problem import ClosureProblem, block_arrays
-from . import Solution
+from .base import Solution
 
 __all__ = ["squeeze_solution", "squeeze_farkas"]
 
