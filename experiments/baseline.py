@@ -50,7 +50,7 @@ from certify import Contact, Grasp, Report, certify_grasp
 from certify.fastpath import planar_screen
 from qualitative.candidates import object_frame
 from qualitative.errors import QualitativeError
-from qualitative.outline import Outline, outline_contour, resample
+from qualitative.outline import DEFAULT_SCALE, Outline, outline_contour, resample
 from qualitative.synthesis import MU
 from qualitative.vision import ImageSource, extract_contour
 
@@ -58,7 +58,7 @@ __all__ = ["MU", "Budget", "Boundary", "BaselineResult", "boundary", "boundary_o
            "baseline", "screen_grasps"]
 
 _CHUNK = 50_000  # rows per screening call (bounds memory)
-_SAMPLES, _SMOOTHING = 1024, 0.004  # outline_contour's defaults (the fallback below uses them)
+_SAMPLES, _SMOOTHING = 1024, DEFAULT_SCALE  # outline_contour's defaults (the fallback below uses them)
 
 
 @dataclass(frozen=True)
@@ -187,7 +187,7 @@ def boundary(image: ImageSource, *, threshold: float | None = None, largest: boo
         points, perimeter = resample(contour, _SAMPLES)
         smoothed = ndimage.gaussian_filter1d(points, _SMOOTHING * _SAMPLES, axis=0, mode="wrap")
         size = 2.0 * cv2.minEnclosingCircle(points.astype(np.float32))[1]
-        return boundary_of(Outline((), points, smoothed, perimeter, float(size)))
+        return boundary_of(Outline((), points, smoothed, perimeter, float(size), _SMOOTHING))
 
 
 def _screen(points, normals, mu, center, length, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

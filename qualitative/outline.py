@@ -38,13 +38,25 @@ Conventions
   (-pi, 0), ``}`` pi, ``{`` -pi) must add up to 2 pi; for an extracted outline the measured
   turnings must add up to 2 pi and each must have its symbol's sign.
 
+Scale
+-----
+An outline is computed at a **scale** ``s``: the standard deviation of the Gaussian smoothing of the
+contour as a fraction of its perimeter ``P`` (``sigma = s * P`` pixels), so the same object at
+another size in the image gives the same string at the same ``s``. The default ``s = 0.004``
+(:data:`DEFAULT_SCALE`) describes features down to about a percent of the perimeter. The lengths
+of the extraction are tied to the scale: the corner window is ``WINDOW * s * P`` (``WINDOW = 5``,
+0.02 P at the default; it is also the shortest line-like run and the distance under which corners
+merge), so at coarser scales small features (notches, bumps) are smoothed away rather than read as
+corners. Angles and the straightness threshold do not change with the scale. Scales run up to
+:data:`SCALE_MAX`.
+
 Extraction (curvature scale space style; every threshold is an angle or a fraction of the
 perimeter ``P``, so the string does not depend on position, rotation or scale):
 
 1. resample the contour at ``samples`` (1024) points evenly spaced by arc length (``h = P / samples``);
-2. smooth with a periodic Gaussian of ``smoothing * P`` (0.004 P); turning angle ``phi_i`` at every
-   sample (they add up to exactly 2 pi for a simple contour);
-3. corners: greedily, the window of ``corner_window * P`` (0.02 P) holding the largest absolute
+2. smooth with a periodic Gaussian of ``s * P`` (0.004 P at the default scale); turning angle
+   ``phi_i`` at every sample (they add up to exactly 2 pi for a simple contour);
+3. corners: greedily, the window of ``WINDOW * s * P`` (0.02 P) holding the largest absolute
    turning, while that turning exceeds ``corner_angle`` (30 degrees), re-centred on its sharpest
    sample; then widened by up to half a window on each side (keeping at least a third of each
    piece between corners), because a corner's rounding by pixels, anti-aliasing and smoothing
@@ -92,6 +104,9 @@ __all__ = [
     "NAMES",
     "LINE_LIKE",
     "POINT_LIKE",
+    "DEFAULT_SCALE",
+    "WINDOW",
+    "SCALE_MAX",
     "Segment",
     "Outline",
     "canonical",
@@ -121,6 +136,15 @@ CONVEX_POINTS = ">}"
 _LINES, _POINTS, _CURVES = frozenset(LINE_LIKE), frozenset(POINT_LIKE), frozenset(CURVES)
 _RANK = {s: i for i, s in enumerate(SYMBOLS)}
 _TURNING_TOLERANCE = 1e-6
+
+DEFAULT_SCALE = 0.004
+"""Default scale: Gaussian standard deviation of the smoothing, fraction of the perimeter."""
+
+WINDOW = 5.0
+"""Corner window (also the shortest run and the corner merging distance), in scales."""
+
+SCALE_MAX = 0.03
+"""Coarsest scale accepted (fraction of the perimeter); the coarse end of :func:`outline_contour_scales`."""
 
 
 # --------------------------------------------------------------------------------------------------
@@ -350,6 +374,8 @@ class Outline:
         Length of the contour, pixels.
     size : float
         Diameter of the contour's minimum enclosing circle, pixels (the object's size).
+    scale : float
+        Standard deviation of the Gaussian smoothing it was computed at, fraction of the perimeter.
     """
 
     segments: tuple[Segment, ...]
@@ -357,6 +383,7 @@ class Outline:
     smoothed: np.ndarray
     perimeter: float
     size: float
+    scale: float = DEFAULT_SCALE
 
     @property
     def raw_string(self) -> str:
@@ -631,23 +658,90 @@ def _segment(item: list, points: np.ndarray, phi: np.ndarray, half: int, spacing
                    _frozen(span), position, endpoints)
 
 
-def outline_contour(contour: np.ndarray, *, samples: int = 1024, smoothing: float = 0.004,
-                    corner_window: float = 0.02, corner_angle: float = math.radians(30),
+def _check_scale(scale: float, name: str = "scale") -> float:
+    """``scale`` as a float in ``(0, SCALE_MAX]``, or ValueError naming it and its units."""
+    try:
+        value = float(scale)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number (a fraction of the perimeter), got {scale!r}") from None
+    if not (math.isfinite(value) and 0 < value <= SCALE_MAX):
+        raise ValueError(f"{name} must be a fraction of the perimeter in (0, {SCALE_MAX:g}], got {scale!r}")
+    return value
+
+
+def _prepare(contour: np.ndarray, samples: int) -> tuple[np.ndarray, float, float]:
+    """Checked, positively oriented contour resampled by arc length: points, perimeter, size (pixels)."""
+    contour = np.asarray(contour, dtype=np.float64)
+    if contour.ndim != 2 or contour.shape[1] != 2 or len(contour) < 3:
+        raise ContourError(f"expected an (m, 2) contour with m >= 3 points, got shape {contour.shape}")
+    if not np.all(np.isfinite(contour)):
+        raise ContourError("the contour has NaN or infinite coordinates")
+    area = signed_area(contour)
+    if area == 0:
+        raise ContourError("the contour encloses no area")
+    if area < 0:
+        contour = contour[::-1]
+    points, perimeter = resample(contour, samples)
+    size = 2.0 * cv2.minEnclosingCircle(points.astype(np.float32))[1]
+    return points, perimeter, float(size)
+
+
+@dataclass(frozen=True)
+class _Params:
+    """Extraction parameters at one scale; lengths in samples, angles in radians."""
+
+    sigma: float  # Gaussian standard deviation
+    half: int  # half the corner window
+    corner_angle: float
+    cusp_angle: float
+    straight: float
+    flat_angle: float
+
+
+def _params(scale: float, samples: int, corner_window: float | None, corner_angle: float,
+            cusp_angle: float, straight: float, flat_angle: float) -> _Params:
+    window = WINDOW * scale if corner_window is None else corner_window
+    return _Params(scale * samples, max(1, round(window * samples / 2)), corner_angle, cusp_angle,
+                   straight, flat_angle)
+
+
+def _describe(points: np.ndarray, p: _Params) -> tuple[np.ndarray, np.ndarray, list[list]]:
+    """Smoothed contour, turning per sample and well-formed items ``[symbol, start, stop, turning]``.
+
+    The items are in contour order (not yet rotated to the canonical start).
+    """
+    smoothed = ndimage.gaussian_filter1d(points, p.sigma, axis=0, mode="wrap")
+    phi = _turning(smoothed)
+    winding = phi.sum() / (2 * np.pi)
+    if abs(winding - 1) > 1e-6:
+        raise ContourError(f"the contour is not a simple closed curve: its tangent turns {winding:.3g} times")
+    items = _items(phi, p.half, len(points), p.corner_angle, p.cusp_angle, p.straight, p.flat_angle)
+    items = _repair(items, phi, p.corner_angle, p.cusp_angle, p.flat_angle)
+    return smoothed, phi, items
+
+
+def outline_contour(contour: np.ndarray, *, scale: float = DEFAULT_SCALE, samples: int = 1024,
+                    corner_window: float | None = None, corner_angle: float = math.radians(30),
                     cusp_angle: float = math.radians(125), straight: float = 0.25,
                     flat_angle: float = math.radians(10)) -> Outline:
-    """The qualitative outline of a closed contour.
+    """The qualitative outline of a closed contour at one scale.
 
     Parameters
     ----------
     contour : numpy.ndarray
         ``(m, 2)`` closed contour (x, y), pixels, closing point not repeated; either orientation
         (it is reversed when its shoelace area is negative).
+    scale : float
+        Standard deviation of the Gaussian smoothing, as a fraction of the perimeter, in
+        ``(0, SCALE_MAX]`` (default :data:`DEFAULT_SCALE`, 0.004). Features narrower than about
+        two scales are smoothed away; the corner window follows it (see ``corner_window``).
+        :func:`finger_scale` converts a finger pad's width into a scale.
     samples : int
         Number of samples after resampling by arc length.
-    smoothing : float
-        Standard deviation of the Gaussian smoothing, as a fraction of the perimeter.
-    corner_window : float
-        Width of the window in which concentrated turning makes a corner, fraction of the perimeter.
+    corner_window : float, optional
+        Width of the window in which concentrated turning makes a corner, fraction of the
+        perimeter. Default ``WINDOW * scale`` (5 scales: 0.02 at the default scale); it is also
+        the shortest line-like run and the distance under which corners merge.
     corner_angle : float
         Smallest turning (radians) within a window that makes an angle (default 30 degrees).
     cusp_angle : float
@@ -661,39 +755,35 @@ def outline_contour(contour: np.ndarray, *, samples: int = 1024, smoothing: floa
     Returns
     -------
     Outline
-        Well formed (checked with :func:`validate`), segments in canonical order.
+        Well formed (checked with :func:`validate`), segments in canonical order, with the
+        ``scale`` it was computed at.
 
     Raises
     ------
     ContourError
         Degenerate or self-intersecting contour, or one without a well-formed description.
+    ValueError
+        ``scale`` not in ``(0, SCALE_MAX]``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> square = np.array([[0, 0], [100, 0], [100, 100], [0, 100]], float)
+    >>> outline_contour(square).string
+    '/>/>/>/>'
+    >>> outline_contour(square, scale=0.01).scale
+    0.01
     """
-    contour = np.asarray(contour, dtype=np.float64)
-    if contour.ndim != 2 or contour.shape[1] != 2 or len(contour) < 3:
-        raise ContourError(f"expected an (m, 2) contour with m >= 3 points, got shape {contour.shape}")
-    if not np.all(np.isfinite(contour)):
-        raise ContourError("the contour has NaN or infinite coordinates")
-    area = signed_area(contour)
-    if area == 0:
-        raise ContourError("the contour encloses no area")
-    if area < 0:
-        contour = contour[::-1]
-    points, perimeter = resample(contour, samples)
-    smoothed = ndimage.gaussian_filter1d(points, smoothing * samples, axis=0, mode="wrap")
-    phi = _turning(smoothed)
-    winding = phi.sum() / (2 * np.pi)
-    if abs(winding - 1) > 1e-6:
-        raise ContourError(f"the contour is not a simple closed curve: its tangent turns {winding:.3g} times")
-    half = max(1, round(corner_window * samples / 2))
-    items = _items(phi, half, samples, corner_angle, cusp_angle, straight, flat_angle)
-    items = _repair(items, phi, corner_angle, cusp_angle, flat_angle)
+    scale = _check_scale(scale)
+    points, perimeter, size = _prepare(contour, samples)
+    p = _params(scale, samples, corner_window, corner_angle, cusp_angle, straight, flat_angle)
+    smoothed, phi, items = _describe(points, p)
     string = "".join(item[0] for item in items)
     r = _least_rotation(string)
     items = items[r:] + items[:r]
     spacing = perimeter / samples
-    segments = tuple(_segment(item, points, phi, half, spacing) for item in items)
-    size = 2.0 * cv2.minEnclosingCircle(points.astype(np.float32))[1]
-    outline = Outline(segments, _frozen(points), _frozen(smoothed), perimeter, float(size))
+    segments = tuple(_segment(item, points, phi, p.half, spacing) for item in items)
+    outline = Outline(segments, _frozen(points), _frozen(smoothed), perimeter, size, scale)
     validate(outline)
     return outline
 
@@ -742,14 +832,17 @@ def _items(phi: np.ndarray, half: int, samples: int, corner_angle: float, cusp_a
     return items
 
 
-def outline_image(src: ImageSource, *, threshold: float | None = None, largest: bool = False,
-                  subpixel: bool = True, **options) -> Outline:
-    """The qualitative outline of the object in an image.
+def outline_image(src: ImageSource, *, scale: float = DEFAULT_SCALE, threshold: float | None = None,
+                  largest: bool = False, subpixel: bool = True, **options) -> Outline:
+    """The qualitative outline of the object in an image at one scale.
 
     Parameters
     ----------
     src : str, pathlib.Path or numpy.ndarray
         Image file or array (see :func:`qualitative.vision.read_image`).
+    scale : float
+        Standard deviation of the Gaussian smoothing, fraction of the perimeter, in
+        ``(0, SCALE_MAX]`` (default :data:`DEFAULT_SCALE`, 0.004; see :func:`outline_contour`).
     threshold : float, optional
         Grey level separating object and background, in the input's units; default Otsu's.
     largest : bool
@@ -757,24 +850,32 @@ def outline_image(src: ImageSource, *, threshold: float | None = None, largest: 
     subpixel : bool
         Refine the contour to sub-pixel accuracy.
     **options
-        Extraction parameters of :func:`outline_contour`.
+        Other extraction parameters of :func:`outline_contour`.
 
     Returns
     -------
     Outline
         Coordinates in pixels of the input image (x = column, y = row).
+
+    Examples
+    --------
+    >>> from qualitative.objects import render
+    >>> outline_image(render("figure3")).string
+    '/}(</{)>'
     """
+    scale = _check_scale(scale)
     contour = extract_contour(src, threshold=threshold, largest=largest, subpixel=subpixel)
-    return outline_contour(contour, **options)
+    return outline_contour(contour, scale=scale, **options)
 
 
 def outline_to_dict(outline: Outline) -> dict:
     """JSON-ready description of an outline.
 
-    Keys: ``string`` (canonical), ``size`` and ``perimeter`` (pixels) and ``segments``, in canonical
-    order, each with ``symbol``, ``name``, ``start``/``stop`` (samples of the resampled contour),
-    ``arc`` (pixels along the contour), ``turning`` (radians), ``points`` (list of [x, y]) and, for
-    point-like elements, ``position`` ([x, y]) or, for straight lines, ``endpoints``.
+    Keys: ``string`` (canonical), ``scale`` (fraction of the perimeter), ``size`` and ``perimeter``
+    (pixels) and ``segments``, in canonical order, each with ``symbol``, ``name``, ``start``/``stop``
+    (samples of the resampled contour), ``arc`` (pixels along the contour), ``turning`` (radians),
+    ``points`` (list of [x, y]) and, for point-like elements, ``position`` ([x, y]) or, for straight
+    lines, ``endpoints``.
     """
     segments = []
     for seg in outline.segments:
@@ -785,5 +886,5 @@ def outline_to_dict(outline: Outline) -> dict:
         if seg.endpoints is not None:
             row["endpoints"] = seg.endpoints.tolist()
         segments.append(row)
-    return {"string": outline.string, "size": outline.size, "perimeter": outline.perimeter,
-            "segments": segments}
+    return {"string": outline.string, "scale": outline.scale, "size": outline.size,
+            "perimeter": outline.perimeter, "segments": segments}
