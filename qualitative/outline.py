@@ -57,8 +57,15 @@ perimeter ``P``, so the string does not depend on position, rotation or scale):
 2. smooth with a periodic Gaussian of ``s * P`` (0.004 P at the default scale); turning angle
    ``phi_i`` at every sample (they add up to exactly 2 pi for a simple contour);
 3. corners: greedily, the window of ``WINDOW * s * P`` (0.02 P) holding the largest absolute
-   turning, while that turning exceeds ``corner_angle`` (30 degrees), re-centred on its sharpest
-   sample; then widened by up to half a window on each side (keeping at least a third of each
+   turning in excess of its background, while that excess exceeds ``corner_angle`` (30 degrees),
+   re-centred on its sharpest sample. The background is the turning the surrounding curve would
+   put in the window anyway: the smallest same-signed turning per sample on each flank (one
+   window on either side), the larger of the two, times the window's length; it is zero next to a
+   straight line or a change of sign, so polygon corners are untouched, but a curve that is
+   tight for the window (a disc or a long rounded end at a coarse scale) is not chopped into
+   corners: a corner is turning concentrated with respect to its surroundings, as in curvature
+   scale space corner detectors (Mokhtarian and Suomela 1998 compare a curvature maximum with its
+   neighbouring minima). The chosen window is then widened by up to half a window on each side (keeping at least a third of each
    piece between corners), because a corner's rounding by pixels, anti-aliasing and smoothing
    spills past the window and belongs to the corner, not to its neighbours. A corner turning at
    least ``cusp_angle`` (125 degrees) is a cusp, otherwise an angle: the thin tip of a cusp is lost
@@ -79,7 +86,10 @@ perimeter ``P``, so the string does not depend on position, rotation or scale):
    cusp with no curve neighbour becomes an angle (two straight lines cannot meet in a cusp; its
    turning may then exceed pi, e.g. the blunt tip of a leg narrower than the window); when neither
    ``)`` nor three convex points remain, the line-like element turning most positively becomes
-   ``)``.
+   ``)`` (or, when none turns positively, the largest convex corner with its two neighbours);
+   finally, when the symbols cannot add up to 2 pi (a string counts a cusp as exactly +-pi and an
+   angle as less, while a measured cusp turns 140 to 170 degrees and a blunt angle may exceed
+   pi: ``>({/>/>/``), the weakest inward (outward) cusp becomes an angle until they can.
 
 Resolution: features need a few windows (0.02 P each) of contour; the built-in objects keep their
 strings from 0.5x to 2x (objects 100 to 450 pixels across) with pixel noise up to 20 grey levels
@@ -143,8 +153,13 @@ DEFAULT_SCALE = 0.004
 WINDOW = 5.0
 """Corner window (also the shortest run and the corner merging distance), in scales."""
 
-SCALE_MAX = 0.03
-"""Coarsest scale accepted (fraction of the perimeter); the coarse end of :func:`outline_contour_scales`."""
+SCALE_MAX = 0.032
+"""Coarsest scale (fraction of the perimeter): 8 times the default, the coarse end of the hierarchy.
+
+The corner window is then ``WINDOW * 0.032 = 0.16`` of the perimeter: six windows go round the
+contour, just enough for the three corners and three sides of a triangle. Coarser, corner windows
+would cover most of the contour and the description degenerates.
+"""
 
 
 # --------------------------------------------------------------------------------------------------
@@ -245,16 +260,17 @@ def _check_string_turning(string: str) -> None:
             f"{lo / math.pi:g} pi and {hi / math.pi:g} pi, which excludes 2 pi")
 
 
-def _check_outline_turning(outline: "Outline") -> None:
-    total = sum(seg.turning for seg in outline.segments)
+def _check_turnings(symbols: str, turnings) -> None:
+    """Measured turnings (radians) of the elements ``symbols``: 2 pi in total, each of its symbol's sign."""
+    total = sum(turnings)
     if abs(total - 2 * math.pi) > _TURNING_TOLERANCE:
         raise OutlineError(f"turning (total 2 pi): the segments turn by {total / math.pi:.6g} pi in total")
-    for seg in outline.segments:
-        sign = {"/": 0, ")": 1, "(": -1, ">": 1, "<": -1, "}": 1, "{": -1}[seg.symbol]
-        if sign and np.sign(seg.turning) != sign:
+    for symbol, turning in zip(symbols, turnings):
+        sign = {"/": 0, ")": 1, "(": -1, ">": 1, "<": -1, "}": 1, "{": -1}[symbol]
+        if sign and np.sign(turning) != sign:
             raise OutlineError(
-                f"turning (sign): segment {seg.symbol!r} ({NAMES[seg.symbol]}) turns by "
-                f"{math.degrees(seg.turning):.3g} degrees, of the wrong sign")
+                f"turning (sign): segment {symbol!r} ({NAMES[symbol]}) turns by "
+                f"{math.degrees(turning):.3g} degrees, of the wrong sign")
 
 
 def validate(outline: Union[str, "Outline"]) -> None:
@@ -279,7 +295,7 @@ def validate(outline: Union[str, "Outline"]) -> None:
     if isinstance(outline, str):
         _check_string_turning(string)
     else:
-        _check_outline_turning(outline)
+        _check_turnings(string, [seg.turning for seg in outline.segments])
 
 
 def is_well_formed(outline: Union[str, "Outline"]) -> bool:
@@ -468,17 +484,45 @@ def _window_sums(phi: np.ndarray, half: int) -> np.ndarray:
     return c[i + half] - c[i - half]
 
 
+def _flank_minima(a: np.ndarray, width: int) -> np.ndarray:
+    """``m[j] = min(a[j:j + width])``, cyclically."""
+    wrapped = np.concatenate([a, a[:width - 1]])
+    return np.lib.stride_tricks.sliding_window_view(wrapped, width).min(axis=1)
+
+
+def _background(phi: np.ndarray, half: int) -> tuple[np.ndarray, np.ndarray]:
+    """Turning of the surrounding curve that a window centred at each sample would carry anyway.
+
+    For the window ``[i - half, i + half)``, the smallest same-signed turning per sample on each of
+    its flanks ``[i - 3 half, i - half)`` and ``[i + half, i + 3 half)``, the larger of the two, times
+    the window's length; for convex (first array) and concave turning (second). Zero next to a
+    straight line or a change of sign.
+    """
+    n, width = len(phi), 2 * half
+    out = []
+    for a in (np.maximum(phi, 0.0), np.maximum(-phi, 0.0)):
+        m = _flank_minima(a, width)
+        i = np.arange(n)
+        out.append(width * np.maximum(m[(i - 3 * half) % n], m[(i + half) % n]))
+    return out[0], out[1]
+
+
 def _find_corners(phi: np.ndarray, half: int, threshold: float) -> list[tuple[int, int]]:
-    """Greedy corner windows ``[start, start + 2 half)`` (start may be negative: cyclic)."""
+    """Greedy corner windows ``[start, start + 2 half)`` (start may be negative: cyclic).
+
+    A window's strength is its turning in excess of its :func:`_background`: turning concentrated
+    in the window, not the steady turning of a curve that is tight for the window's size (a disc
+    at a coarse scale, a long rounded end) and would otherwise be chopped into corners.
+    """
     n = len(phi)
+    convex, concave = _background(phi, half)
+    sums = _window_sums(phi, half)
+    strength = np.abs(sums) - np.where(sums > 0, convex, concave)
     free = np.ones(n, bool)
     corners = []
     while True:
-        sums = np.abs(_window_sums(np.where(free, phi, 0.0), half))
-        blocked = _window_sums((~free).astype(float), half) > 0  # window overlaps a corner
-        sums[blocked] = 0.0
-        i = int(np.argmax(sums))
-        if sums[i] < threshold:
+        i = int(np.argmax(strength))
+        if strength[i] < threshold:
             return sorted(corners)
         # Centre the window on the sharpest sample when that window is still free.
         span = np.arange(i - half, i + half) % n
@@ -487,6 +531,9 @@ def _find_corners(phi: np.ndarray, half: int, threshold: float) -> list[tuple[in
         start = c - half if free[window].all() else i - half
         free[np.arange(start, start + 2 * half) % n] = False
         corners.append((start % n, start % n + 2 * half))
+        # Windows overlapping the corner are out; the others do not contain it, so their sums
+        # stand.
+        strength[np.arange(start - half + 1, start + 3 * half) % n] = 0.0
 
 
 def _label_runs(kappa: np.ndarray, straight: float) -> list[list]:
@@ -603,12 +650,52 @@ def _repair(items: list[list], phi: np.ndarray, corner_angle: float, cusp_angle:
         # Bounded outlines need a convex curve or three convex points; the turning must then be
         # carried by some line-like element that was judged straight or concave.
         best = max((item for item in items if item[0] in _LINES), key=lambda it: it[3], default=None)
-        if best is None or best[3] <= 0:
+        if best is not None and best[3] > 0:
+            best[0] = ")"
+            return _repair(items, phi, corner_angle, cusp_angle, flat_angle)
+        # Otherwise the turning sits in one or two huge corners (more than pi each: a blob whose
+        # corner windows cover most of it at a coarse scale): the largest convex corner and its
+        # neighbours become one convex curve.
+        corners = [i for i, item in enumerate(items) if item[0] in CONVEX_POINTS]
+        if not corners:
             raise ContourError("the contour cannot be described by a well-formed outline at this scale "
                                "(it is too thin or too small)")
-        best[0] = ")"
+        i = max(corners, key=lambda k: items[k][3])
+        items[:] = items[i - 1:] + items[:i - 1] if i else items[-1:] + items[:-1]  # corner at 1
+        for _ in range(min(2, len(items) - 1)):  # the predecessor absorbs the corner, then the successor
+            merge(0, ")")
+        if items[0][3] <= 0:
+            raise ContourError("the contour cannot be described by a well-formed outline at this scale "
+                               "(it is too thin or too small)")
+        items[0][0] = ")"
         return _repair(items, phi, corner_angle, cusp_angle, flat_angle)
+    _close_up(items)
     return items
+
+
+def _close_up(items: list[list]) -> None:
+    """Make the symbols allow a total turning of 2 pi, changing cusps into angles if they do not.
+
+    A string counts a cusp as exactly +-pi and an angle as strictly less, while a measured cusp
+    turns about 140 to 170 degrees and a blunt angle (a cusp without a curve neighbour, see
+    :func:`_repair`) may turn more than pi. Without a convex curve, ``{`` then leaves too little
+    turning for the rest (``>({/>/>/``: less than 3 pi - pi); without a concave one, ``}`` too
+    much. The weakest such cusp becomes an angle of the same sign until 2 pi is allowed: an angle
+    takes any turning up to pi, and rule 1 (three convex points) guarantees this ends.
+    """
+    target = 2 * math.pi
+    while True:
+        lo, lo_closed, hi, hi_closed = _turning_range("".join(item[0] for item in items))
+        if not (target < hi or (hi_closed and math.isclose(target, hi))):
+            cusp, angle = "{", "<"  # too little turning allowed
+        elif not (target > lo or (lo_closed and math.isclose(target, lo))):
+            cusp, angle = "}", ">"  # too much
+        else:
+            return
+        cusps = [item for item in items if item[0] == cusp]
+        if not cusps:
+            return  # cannot happen with rule 1 satisfied; validate() would report it
+        min(cusps, key=lambda item: abs(item[3]))[0] = angle
 
 
 def _tls_line(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
