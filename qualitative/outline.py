@@ -1015,9 +1015,10 @@ def finger_scale(outline: Outline | np.ndarray, finger_width: float, *, samples:
     A pad of width ``W`` pressed on the contour averages it over ``W``; the Gaussian that does the
     same has its +-2 sigma span equal to the pad, ``sigma = W / 4`` (close to the standard
     deviation ``W / sqrt(12) = 0.29 W`` of the pad's own box average). Bumps and dents narrower
-    than about half a pad are then smoothed away; wider ones remain. With ``W = finger_width * D``
-    (``D`` the object's size, the diameter of its minimum enclosing circle, as in
-    :mod:`qualitative.regions`) and ``P`` the perimeter, the scale is
+    than about three quarters of a pad are then smoothed away, wider ones remain (measured on the
+    built-in square: a semicircular bump is gone up to 0.8 pad, kept from 0.85). With
+    ``W = finger_width * D`` (``D`` the object's size, the diameter of its minimum enclosing
+    circle, as in :mod:`qualitative.regions`) and ``P`` the perimeter, the scale is
     ``finger_width * D / (4 * P)``.
 
     Parameters
