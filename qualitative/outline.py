@@ -71,23 +71,24 @@ perimeter ``P``, so the string does not depend on position, rotation or scale):
 1. resample the contour at ``samples`` (1024) points evenly spaced by arc length (``h = P / samples``);
 2. smooth with a periodic Gaussian of ``s * P`` (0.004 P at the default scale); turning angle
    ``phi_i`` at every sample (they add up to exactly 2 pi for a simple contour);
-3. corners: greedily, the window of ``WINDOW * s * P`` (0.02 P) holding the largest absolute
-   turning in excess of its background, while that excess exceeds ``corner_angle`` (30 degrees),
-   re-centred on its sharpest sample. The background is the turning the surrounding curve would
-   put in the window anyway: the smallest same-signed turning per sample on each flank (one
-   window on either side), the larger of the two, times the window's length; it is zero next to a
-   straight line or a change of sign, so polygon corners are untouched, but a curve that is
-   tight for the window (a disc or a long rounded end at a coarse scale) is not chopped into
-   corners: a corner is turning concentrated with respect to its surroundings, as in curvature
-   scale space corner detectors (Mokhtarian and Suomela 1998 compare a curvature maximum with its
-   neighbouring minima). The chosen window is then widened by up to half a window on each side (keeping at least a third of each
-   piece between corners), because a corner's rounding by pixels, anti-aliasing and smoothing
+3. corners: greedily, the window of ``WINDOW * s * P`` (0.02 P) holding the largest absolute turning
+   in excess of its background, while that excess exceeds ``corner_angle`` (30 degrees), re-centred
+   on its sharpest sample. The background is the turning the surrounding curve would put in the
+   window anyway: the smallest same-signed turning per sample on each flank (one window on either
+   side), the larger of the two, times the window's length; it is zero next to a straight line or a
+   change of sign, so polygon corners are untouched, but a curve that is tight for the window (a
+   disc or a long rounded end at a coarse scale) is not chopped into corners: a corner is turning
+   concentrated with respect to its surroundings, as in curvature scale space corner detectors
+   (Mokhtarian and Suomela 1998 compare a curvature maximum with its neighbouring minima). The
+   chosen window is then widened by up to half a window on each side (keeping at least a third of
+   each piece between corners), because a corner's rounding by pixels, anti-aliasing and smoothing
    spills past the window and belongs to the corner, not to its neighbours. A corner turning at
-   least ``cusp_angle`` (125 degrees) is a cusp, otherwise an angle: the thin tip of a cusp is lost
-   at image resolution and smoothing blunts it, so imaged cusps measure about 140 to 170 degrees,
-   while an angle of 125 degrees has an interior angle of 55 degrees. Corners closer than a
-   window merge (scale-space semantics: rounded corners and notches smaller than the window are
-   corners);
+   least ``cusp_angle`` (125 degrees), also after removing its background over its span, is a cusp,
+   otherwise an angle (the widened span holds some of the neighbouring curves' turning, which must
+   not make a right angle next to an arc a cusp at coarse scales): the thin tip of a cusp is lost at
+   image resolution and smoothing blunts it, so imaged cusps measure about 140 to 170 degrees, while
+   an angle of 125 degrees has an interior angle of 55 degrees. Corners closer than a window merge
+   (scale-space semantics: rounded corners and notches smaller than the window are corners);
 4. between corners, a piece shorter than a window is a corner if it turns at least
    ``corner_angle``, else a straight link. In longer pieces each sample is straight if
    ``abs(kappa) * P / (2 pi) < straight`` (0.25: the curvature relative to that of a disc of the
@@ -526,7 +527,8 @@ def _background(phi: np.ndarray, half: int) -> tuple[np.ndarray, np.ndarray]:
     return out[0], out[1]
 
 
-def _find_corners(phi: np.ndarray, half: int, threshold: float) -> list[tuple[int, int]]:
+def _find_corners(phi: np.ndarray, half: int, threshold: float,
+                  background: tuple[np.ndarray, np.ndarray]) -> list[tuple[int, int]]:
     """Greedy corner windows ``[start, start + 2 half)`` (start may be negative: cyclic).
 
     A window's strength is its turning in excess of its :func:`_background`: turning concentrated
@@ -534,7 +536,7 @@ def _find_corners(phi: np.ndarray, half: int, threshold: float) -> list[tuple[in
     at a coarse scale, a long rounded end) and would otherwise be chopped into corners.
     """
     n = len(phi)
-    convex, concave = _background(phi, half)
+    convex, concave = background
     sums = _window_sums(phi, half)
     strength = np.abs(sums) - np.where(sums > 0, convex, concave)
     free = np.ones(n, bool)
@@ -915,7 +917,8 @@ def _items(phi: np.ndarray, half: int, samples: int, corner_angle: float, cusp_a
     """Corners and classified runs between them, ``[symbol, start, stop, turning]`` in contour order."""
     n = len(phi)
     symbol_of = {0: "/", 1: ")", -1: "("}
-    corners = _find_corners(phi, half, corner_angle)
+    background = _background(phi, half)
+    corners = _find_corners(phi, half, corner_angle, background)
     if not corners:
         runs = _classify_piece(phi, samples, straight, 2 * half, flat_angle)
         if len(runs) > 1 and runs[0][0] == runs[-1][0]:  # the first run continues the last one
@@ -926,7 +929,15 @@ def _items(phi: np.ndarray, half: int, samples: int, corner_angle: float, cusp_a
     items = []
     for k, (start, stop) in enumerate(spans):
         turning = float(phi[np.arange(start, stop) % n].sum())
-        items.append([_point_symbol(turning, corner_angle, cusp_angle), start, stop, turning])
+        # A cusp by its own turning: the widened span also holds some of the neighbouring curves'
+        # (their background rate times its length), which must not make a corner next to an arc
+        # a cusp at coarse scales.
+        rate = background[0 if turning > 0 else 1][(corners[k][0] + half) % n] / (2 * half)
+        own = abs(turning) - rate * (stop - start)
+        symbol = _point_symbol(turning, corner_angle, cusp_angle)
+        if symbol and own < cusp_angle:
+            symbol = ">" if turning > 0 else "<"
+        items.append([symbol, start, stop, turning])
         nxt = spans[(k + 1) % len(spans)][0] + (n if k + 1 == len(spans) else 0)
         if nxt - stop >= 2 * half:
             idx = np.arange(stop, nxt) % n
@@ -1054,7 +1065,8 @@ def finger_scale(outline: Outline | np.ndarray, finger_width: float, *, samples:
     """
     width = float(finger_width)
     if not (math.isfinite(width) and width > 0):
-        raise ValueError(f"finger_width must be a positive fraction of the object's size, got {finger_width!r}")
+        raise ValueError(
+            f"finger_width must be a positive fraction of the object's size, got {finger_width!r}")
     if isinstance(outline, Outline):
         size, perimeter = outline.size, outline.perimeter
     else:
