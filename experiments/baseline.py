@@ -50,7 +50,7 @@ from qualgrasp.certify import Contact, Grasp, Report, certify_grasp
 from qualgrasp.certify.fastpath import planar_screen
 from qualgrasp.qualitative.candidates import object_frame
 from qualgrasp.qualitative.errors import QualitativeError
-from qualgrasp.qualitative.outline import Outline, outline_contour, resample
+from qualgrasp.qualitative.outline import DEFAULT_SCALE, Outline, outline_contour, resample
 from qualgrasp.qualitative.procedures import Procedure
 from qualgrasp.qualitative.synthesis import MU, choose
 from qualgrasp.qualitative.vision import ImageSource, extract_contour
@@ -59,7 +59,7 @@ __all__ = ["MU", "Budget", "Boundary", "BaselineResult", "boundary", "boundary_o
            "baseline", "screen_grasps"]
 
 _CHUNK = 50_000  # rows per screening call (bounds memory)
-_SAMPLES, _SMOOTHING = 1024, 0.004  # outline_contour's defaults (the fallback below uses them)
+_SAMPLES, _SMOOTHING = 1024, DEFAULT_SCALE  # outline_contour's defaults (the fallback below uses them)
 
 
 @dataclass(frozen=True)
@@ -188,7 +188,7 @@ def boundary(image: ImageSource, *, threshold: float | None = None, largest: boo
         points, perimeter = resample(contour, _SAMPLES)
         smoothed = ndimage.gaussian_filter1d(points, _SMOOTHING * _SAMPLES, axis=0, mode="wrap")
         size = 2.0 * cv2.minEnclosingCircle(points.astype(np.float32))[1]
-        return boundary_of(Outline((), points, smoothed, perimeter, float(size)))
+        return boundary_of(Outline((), points, smoothed, perimeter, float(size), _SMOOTHING))
 
 
 def _screen(points, normals, mu, center, length, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

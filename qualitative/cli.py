@@ -12,7 +12,7 @@ from ..certify.io import write_grasps
 from . import procedures
 from .errors import FormulaError, QualitativeError, TraceError
 from .grasp_plot import synthesis_figure
-from .outline import outline_image, outline_to_dict
+from .outline import DEFAULT_SCALE, SCALE_MAX, outline_image, outline_scales, outline_to_dict
 from .plot import outline_figure
 from .regions import feasible_regions, regions_to_dict
 from .st0 import evaluate_file
@@ -50,7 +50,14 @@ def st0_command(
 
 def outline_command(
     image: Path = typer.Argument(..., help="Image file (PNG, JPEG, anything OpenCV reads)."),
-    as_json: bool = typer.Option(False, "--json", help="Print a JSON object with keys string and segments."),
+    scale: float | None = typer.Option(None, "--scale", help="Smoothing scale: the Gaussian's standard "
+                                       "deviation as a fraction of the object's perimeter, in (0, 0.032] "
+                                       "(default 0.004)."),
+    scales: bool = typer.Option(False, "--scales", help="Print the scale hierarchy instead: one line per "
+                                "range of scales (fractions of the perimeter) and its string."),
+    as_json: bool = typer.Option(False, "--json", help="Print a JSON object with keys string, scale and "
+                                 "segments (with --scales: a JSON list of objects lo, hi, string, corners, "
+                                 "convex)."),
     largest: bool = typer.Option(False, "--largest",
                                  help="With several objects, describe the largest whole one."),
     threshold: float | None = typer.Option(None, "--threshold", help="Grey level separating object and "
@@ -58,16 +65,37 @@ def outline_command(
 ) -> None:
     """Print the qualitative outline (canonical curvature-type string) of the object in an image.
 
-    Coordinates in the JSON are pixels of the input image, x = column, y = row. Exit code 2 when
-    the image cannot be read or does not hold exactly one whole object.
+    With --scale S, at that smoothing scale (a finger pad of width W feels the outline at about
+    W / (4 * perimeter)); with --scales, the hierarchy from 0.004 to 0.032: one line per interval,
+    lo..hi<TAB>string. Coordinates in the JSON are pixels of the input image, x = column, y = row.
+    Exit code 2 when the image cannot be read or does not hold exactly one whole object, or on a
+    bad --scale.
     """
 
+    if scale is not None and scales:
+        typer.echo("error: --scale and --scales exclude each other", err=True)
+        raise typer.Exit(2)
+    if scale is not None and not (math.isfinite(scale) and 0 < scale <= SCALE_MAX):
+        typer.echo(f"error: --scale must be a fraction of the object's perimeter in (0, {SCALE_MAX:g}], "
+                   f"got {scale:g}", err=True)
+        raise typer.Exit(2)
     try:
-        outline = outline_image(image, threshold=threshold, largest=largest)
+        if scales:
+            hierarchy = outline_scales(image, threshold=threshold, largest=largest)
+        else:
+            outline = outline_image(image, scale=DEFAULT_SCALE if scale is None else scale,
+                                    threshold=threshold, largest=largest)
     except QualitativeError as err:
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(2)
-    typer.echo(json.dumps(outline_to_dict(outline)) if as_json else outline.string)
+    if scales and as_json:
+        typer.echo(json.dumps([{"lo": i.lo, "hi": i.hi, "string": i.string, "corners": i.corners,
+                                "convex": i.convex} for i in hierarchy]))
+    elif scales:
+        for i in hierarchy:
+            typer.echo(f"{i.lo:.4g}..{i.hi:.4g}\t{i.string}")
+    else:
+        typer.echo(json.dumps(outline_to_dict(outline)) if as_json else outline.string)
 
 
 def regions_command(

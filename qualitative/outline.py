@@ -38,22 +38,57 @@ Conventions
   (-pi, 0), ``}`` pi, ``{`` -pi) must add up to 2 pi; for an extracted outline the measured
   turnings must add up to 2 pi and each must have its symbol's sign.
 
+Scale
+-----
+An outline is computed at a **scale** ``s``: the standard deviation of the Gaussian smoothing of the
+contour as a fraction of its perimeter ``P`` (``sigma = s * P`` pixels), so the same object at
+another size in the image gives the same string at the same ``s``. The default ``s = 0.004``
+(:data:`DEFAULT_SCALE`) describes features down to about a percent of the perimeter. The lengths
+of the extraction are tied to the scale: the corner window is ``WINDOW * s * P`` (``WINDOW = 5``,
+0.02 P at the default; it is also the shortest line-like run and the distance under which corners
+merge), so at coarser scales small features (notches, bumps) are smoothed away rather than read as
+corners. Angles and the straightness threshold do not change with the scale. Scales run up to
+:data:`SCALE_MAX` (0.032).
+
+A finger pad of width ``W`` feels the outline at the scale ``W / (4 P)`` (a Gaussian whose
++-2 sigma span is the pad, :func:`finger_scale`); for the project's pad of 0.08 of the object's
+size ``D``, that is ``0.02 D / P``: 0.0064 for a disc, less for objects whose perimeter is long
+for their size (0.004 to 0.009 for the study's silhouettes), never more than 0.01 (``P >= 2 D``).
+
+:func:`outline_scales` (an image) and :func:`outline_contour_scales` (a contour) give the
+**hierarchy** (curvature scale space, Mokhtarian and Mackworth 1992): the intervals of scale over
+which the string stays the same (:class:`ScaleInterval`), from the default scale 0.004 (fine) to
+:data:`SCALE_MAX` (coarse: there 21 of the 24 study cells have no concave symbol left, while deep
+concavities such as the polygon's notch, figure 3's slot or the horse's legs remain), found on a
+geometric grid (4 scales per octave) and located by bisection to 1 %. The image is segmented and
+the contour resampled once; only the smoothing and the classification are repeated per scale.
+Real silhouettes give many short intervals at fine scales, where wiggles hover around the angle
+thresholds.
+
 Extraction (curvature scale space style; every threshold is an angle or a fraction of the
 perimeter ``P``, so the string does not depend on position, rotation or scale):
 
 1. resample the contour at ``samples`` (1024) points evenly spaced by arc length (``h = P / samples``);
-2. smooth with a periodic Gaussian of ``smoothing * P`` (0.004 P); turning angle ``phi_i`` at every
-   sample (they add up to exactly 2 pi for a simple contour);
-3. corners: greedily, the window of ``corner_window * P`` (0.02 P) holding the largest absolute
-   turning, while that turning exceeds ``corner_angle`` (30 degrees), re-centred on its sharpest
-   sample; then widened by up to half a window on each side (keeping at least a third of each
-   piece between corners), because a corner's rounding by pixels, anti-aliasing and smoothing
+2. smooth with a periodic Gaussian of ``s * P`` (0.004 P at the default scale); turning angle
+   ``phi_i`` at every sample (they add up to exactly 2 pi for a simple contour);
+3. corners: greedily, the window of ``WINDOW * s * P`` (0.02 P) holding the largest absolute turning
+   in excess of its background, while that excess exceeds ``corner_angle`` (30 degrees), re-centred
+   on its sharpest sample. The background is the turning the surrounding curve would put in the
+   window anyway: the smallest same-signed turning per sample on each flank (one window on either
+   side), the larger of the two, times the window's length; it is zero next to a straight line or a
+   change of sign, so polygon corners are untouched, but a curve that is tight for the window (a
+   disc or a long rounded end at a coarse scale) is not chopped into corners: a corner is turning
+   concentrated with respect to its surroundings, as in curvature scale space corner detectors
+   (Mokhtarian and Suomela 1998 compare a curvature maximum with its neighbouring minima). The
+   chosen window is then widened by up to half a window on each side (keeping at least a third of
+   each piece between corners), because a corner's rounding by pixels, anti-aliasing and smoothing
    spills past the window and belongs to the corner, not to its neighbours. A corner turning at
-   least ``cusp_angle`` (125 degrees) is a cusp, otherwise an angle: the thin tip of a cusp is lost
-   at image resolution and smoothing blunts it, so imaged cusps measure about 140 to 170 degrees,
-   while an angle of 125 degrees has an interior angle of 55 degrees. Corners closer than a
-   window merge (scale-space semantics: rounded corners and notches smaller than the window are
-   corners);
+   least ``cusp_angle`` (125 degrees), also after removing its background over its span, is a cusp,
+   otherwise an angle (the widened span holds some of the neighbouring curves' turning, which must
+   not make a right angle next to an arc a cusp at coarse scales): the thin tip of a cusp is lost at
+   image resolution and smoothing blunts it, so imaged cusps measure about 140 to 170 degrees, while
+   an angle of 125 degrees has an interior angle of 55 degrees. Corners closer than a window merge
+   (scale-space semantics: rounded corners and notches smaller than the window are corners);
 4. between corners, a piece shorter than a window is a corner if it turns at least
    ``corner_angle``, else a straight link. In longer pieces each sample is straight if
    ``abs(kappa) * P / (2 pi) < straight`` (0.25: the curvature relative to that of a disc of the
@@ -67,7 +102,10 @@ perimeter ``P``, so the string does not depend on position, rotation or scale):
    cusp with no curve neighbour becomes an angle (two straight lines cannot meet in a cusp; its
    turning may then exceed pi, e.g. the blunt tip of a leg narrower than the window); when neither
    ``)`` nor three convex points remain, the line-like element turning most positively becomes
-   ``)``.
+   ``)`` (or, when none turns positively, the largest convex corner with its two neighbours);
+   finally, when the symbols cannot add up to 2 pi (a string counts a cusp as exactly +-pi and an
+   angle as less, while a measured cusp turns 140 to 170 degrees and a blunt angle may exceed
+   pi: ``>({/>/>/``), the weakest inward (outward) cusp becomes an angle until they can.
 
 Resolution: features need a few windows (0.02 P each) of contour; the built-in objects keep their
 strings from 0.5x to 2x (objects 100 to 450 pixels across) with pixel noise up to 20 grey levels
@@ -92,6 +130,9 @@ __all__ = [
     "NAMES",
     "LINE_LIKE",
     "POINT_LIKE",
+    "DEFAULT_SCALE",
+    "WINDOW",
+    "SCALE_MAX",
     "Segment",
     "Outline",
     "canonical",
@@ -100,6 +141,10 @@ __all__ = [
     "resample",
     "outline_contour",
     "outline_image",
+    "ScaleInterval",
+    "finger_scale",
+    "outline_contour_scales",
+    "outline_scales",
     "outline_to_dict",
 ]
 
@@ -121,6 +166,20 @@ CONVEX_POINTS = ">}"
 _LINES, _POINTS, _CURVES = frozenset(LINE_LIKE), frozenset(POINT_LIKE), frozenset(CURVES)
 _RANK = {s: i for i, s in enumerate(SYMBOLS)}
 _TURNING_TOLERANCE = 1e-6
+
+DEFAULT_SCALE = 0.004
+"""Default scale: Gaussian standard deviation of the smoothing, fraction of the perimeter."""
+
+WINDOW = 5.0
+"""Corner window (also the shortest run and the corner merging distance), in scales."""
+
+SCALE_MAX = 0.032
+"""Coarsest scale (fraction of the perimeter): 8 times the default, the coarse end of the hierarchy.
+
+The corner window is then ``WINDOW * 0.032 = 0.16`` of the perimeter: six windows go round the
+contour, just enough for the three corners and three sides of a triangle. Coarser, corner windows
+would cover most of the contour and the description degenerates.
+"""
 
 
 # --------------------------------------------------------------------------------------------------
@@ -221,16 +280,17 @@ def _check_string_turning(string: str) -> None:
             f"{lo / math.pi:g} pi and {hi / math.pi:g} pi, which excludes 2 pi")
 
 
-def _check_outline_turning(outline: "Outline") -> None:
-    total = sum(seg.turning for seg in outline.segments)
+def _check_turnings(symbols: str, turnings) -> None:
+    """Measured turnings (radians) of the elements ``symbols``: 2 pi in total, each of its symbol's sign."""
+    total = sum(turnings)
     if abs(total - 2 * math.pi) > _TURNING_TOLERANCE:
         raise OutlineError(f"turning (total 2 pi): the segments turn by {total / math.pi:.6g} pi in total")
-    for seg in outline.segments:
-        sign = {"/": 0, ")": 1, "(": -1, ">": 1, "<": -1, "}": 1, "{": -1}[seg.symbol]
-        if sign and np.sign(seg.turning) != sign:
+    for symbol, turning in zip(symbols, turnings):
+        sign = {"/": 0, ")": 1, "(": -1, ">": 1, "<": -1, "}": 1, "{": -1}[symbol]
+        if sign and np.sign(turning) != sign:
             raise OutlineError(
-                f"turning (sign): segment {seg.symbol!r} ({NAMES[seg.symbol]}) turns by "
-                f"{math.degrees(seg.turning):.3g} degrees, of the wrong sign")
+                f"turning (sign): segment {symbol!r} ({NAMES[symbol]}) turns by "
+                f"{math.degrees(turning):.3g} degrees, of the wrong sign")
 
 
 def validate(outline: Union[str, "Outline"]) -> None:
@@ -255,7 +315,7 @@ def validate(outline: Union[str, "Outline"]) -> None:
     if isinstance(outline, str):
         _check_string_turning(string)
     else:
-        _check_outline_turning(outline)
+        _check_turnings(string, [seg.turning for seg in outline.segments])
 
 
 def is_well_formed(outline: Union[str, "Outline"]) -> bool:
@@ -350,6 +410,8 @@ class Outline:
         Length of the contour, pixels.
     size : float
         Diameter of the contour's minimum enclosing circle, pixels (the object's size).
+    scale : float
+        Standard deviation of the Gaussian smoothing it was computed at, fraction of the perimeter.
     """
 
     segments: tuple[Segment, ...]
@@ -357,6 +419,7 @@ class Outline:
     smoothed: np.ndarray
     perimeter: float
     size: float
+    scale: float = DEFAULT_SCALE
 
     @property
     def raw_string(self) -> str:
@@ -441,17 +504,46 @@ def _window_sums(phi: np.ndarray, half: int) -> np.ndarray:
     return c[i + half] - c[i - half]
 
 
-def _find_corners(phi: np.ndarray, half: int, threshold: float) -> list[tuple[int, int]]:
-    """Greedy corner windows ``[start, start + 2 half)`` (start may be negative: cyclic)."""
+def _flank_minima(a: np.ndarray, width: int) -> np.ndarray:
+    """``m[j] = min(a[j:j + width])``, cyclically."""
+    wrapped = np.concatenate([a, a[:width - 1]])
+    return np.lib.stride_tricks.sliding_window_view(wrapped, width).min(axis=1)
+
+
+def _background(phi: np.ndarray, half: int) -> tuple[np.ndarray, np.ndarray]:
+    """Turning of the surrounding curve that a window centred at each sample would carry anyway.
+
+    For the window ``[i - half, i + half)``, the smallest same-signed turning per sample on each of
+    its flanks ``[i - 3 half, i - half)`` and ``[i + half, i + 3 half)``, the larger of the two, times
+    the window's length; for convex (first array) and concave turning (second). Zero next to a
+    straight line or a change of sign.
+    """
+    n, width = len(phi), 2 * half
+    out = []
+    for a in (np.maximum(phi, 0.0), np.maximum(-phi, 0.0)):
+        m = _flank_minima(a, width)
+        i = np.arange(n)
+        out.append(width * np.maximum(m[(i - 3 * half) % n], m[(i + half) % n]))
+    return out[0], out[1]
+
+
+def _find_corners(phi: np.ndarray, half: int, threshold: float,
+                  background: tuple[np.ndarray, np.ndarray]) -> list[tuple[int, int]]:
+    """Greedy corner windows ``[start, start + 2 half)`` (start may be negative: cyclic).
+
+    A window's strength is its turning in excess of its :func:`_background`: turning concentrated
+    in the window, not the steady turning of a curve that is tight for the window's size (a disc
+    at a coarse scale, a long rounded end) and would otherwise be chopped into corners.
+    """
     n = len(phi)
+    convex, concave = background
+    sums = _window_sums(phi, half)
+    strength = np.abs(sums) - np.where(sums > 0, convex, concave)
     free = np.ones(n, bool)
     corners = []
     while True:
-        sums = np.abs(_window_sums(np.where(free, phi, 0.0), half))
-        blocked = _window_sums((~free).astype(float), half) > 0  # window overlaps a corner
-        sums[blocked] = 0.0
-        i = int(np.argmax(sums))
-        if sums[i] < threshold:
+        i = int(np.argmax(strength))
+        if strength[i] < threshold:
             return sorted(corners)
         # Centre the window on the sharpest sample when that window is still free.
         span = np.arange(i - half, i + half) % n
@@ -460,6 +552,9 @@ def _find_corners(phi: np.ndarray, half: int, threshold: float) -> list[tuple[in
         start = c - half if free[window].all() else i - half
         free[np.arange(start, start + 2 * half) % n] = False
         corners.append((start % n, start % n + 2 * half))
+        # Windows overlapping the corner are out; the others do not contain it, so their sums
+        # stand.
+        strength[np.arange(start - half + 1, start + 3 * half) % n] = 0.0
 
 
 def _label_runs(kappa: np.ndarray, straight: float) -> list[list]:
@@ -576,12 +671,52 @@ def _repair(items: list[list], phi: np.ndarray, corner_angle: float, cusp_angle:
         # Bounded outlines need a convex curve or three convex points; the turning must then be
         # carried by some line-like element that was judged straight or concave.
         best = max((item for item in items if item[0] in _LINES), key=lambda it: it[3], default=None)
-        if best is None or best[3] <= 0:
+        if best is not None and best[3] > 0:
+            best[0] = ")"
+            return _repair(items, phi, corner_angle, cusp_angle, flat_angle)
+        # Otherwise the turning sits in one or two huge corners (more than pi each: a blob whose
+        # corner windows cover most of it at a coarse scale): the largest convex corner and its
+        # neighbours become one convex curve.
+        corners = [i for i, item in enumerate(items) if item[0] in CONVEX_POINTS]
+        if not corners:
             raise ContourError("the contour cannot be described by a well-formed outline at this scale "
                                "(it is too thin or too small)")
-        best[0] = ")"
+        i = max(corners, key=lambda k: items[k][3])
+        items[:] = items[i - 1:] + items[:i - 1] if i else items[-1:] + items[:-1]  # corner at 1
+        for _ in range(min(2, len(items) - 1)):  # the predecessor absorbs the corner, then the successor
+            merge(0, ")")
+        if items[0][3] <= 0:
+            raise ContourError("the contour cannot be described by a well-formed outline at this scale "
+                               "(it is too thin or too small)")
+        items[0][0] = ")"
         return _repair(items, phi, corner_angle, cusp_angle, flat_angle)
+    _close_up(items)
     return items
+
+
+def _close_up(items: list[list]) -> None:
+    """Make the symbols allow a total turning of 2 pi, changing cusps into angles if they do not.
+
+    A string counts a cusp as exactly +-pi and an angle as strictly less, while a measured cusp
+    turns about 140 to 170 degrees and a blunt angle (a cusp without a curve neighbour, see
+    :func:`_repair`) may turn more than pi. Without a convex curve, ``{`` then leaves too little
+    turning for the rest (``>({/>/>/``: less than 3 pi - pi); without a concave one, ``}`` too
+    much. The weakest such cusp becomes an angle of the same sign until 2 pi is allowed: an angle
+    takes any turning up to pi, and rule 1 (three convex points) guarantees this ends.
+    """
+    target = 2 * math.pi
+    while True:
+        lo, lo_closed, hi, hi_closed = _turning_range("".join(item[0] for item in items))
+        if not (target < hi or (hi_closed and math.isclose(target, hi))):
+            cusp, angle = "{", "<"  # too little turning allowed
+        elif not (target > lo or (lo_closed and math.isclose(target, lo))):
+            cusp, angle = "}", ">"  # too much
+        else:
+            return
+        cusps = [item for item in items if item[0] == cusp]
+        if not cusps:
+            return  # cannot happen with rule 1 satisfied; validate() would report it
+        min(cusps, key=lambda item: abs(item[3]))[0] = angle
 
 
 def _tls_line(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -631,23 +766,90 @@ def _segment(item: list, points: np.ndarray, phi: np.ndarray, half: int, spacing
                    _frozen(span), position, endpoints)
 
 
-def outline_contour(contour: np.ndarray, *, samples: int = 1024, smoothing: float = 0.004,
-                    corner_window: float = 0.02, corner_angle: float = math.radians(30),
+def _check_scale(scale: float, name: str = "scale") -> float:
+    """``scale`` as a float in ``(0, SCALE_MAX]``, or ValueError naming it and its units."""
+    try:
+        value = float(scale)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number (a fraction of the perimeter), got {scale!r}") from None
+    if not (math.isfinite(value) and 0 < value <= SCALE_MAX):
+        raise ValueError(f"{name} must be a fraction of the perimeter in (0, {SCALE_MAX:g}], got {scale!r}")
+    return value
+
+
+def _prepare(contour: np.ndarray, samples: int) -> tuple[np.ndarray, float, float]:
+    """Checked, positively oriented contour resampled by arc length: points, perimeter, size (pixels)."""
+    contour = np.asarray(contour, dtype=np.float64)
+    if contour.ndim != 2 or contour.shape[1] != 2 or len(contour) < 3:
+        raise ContourError(f"expected an (m, 2) contour with m >= 3 points, got shape {contour.shape}")
+    if not np.all(np.isfinite(contour)):
+        raise ContourError("the contour has NaN or infinite coordinates")
+    area = signed_area(contour)
+    if area == 0:
+        raise ContourError("the contour encloses no area")
+    if area < 0:
+        contour = contour[::-1]
+    points, perimeter = resample(contour, samples)
+    size = 2.0 * cv2.minEnclosingCircle(points.astype(np.float32))[1]
+    return points, perimeter, float(size)
+
+
+@dataclass(frozen=True)
+class _Params:
+    """Extraction parameters at one scale; lengths in samples, angles in radians."""
+
+    sigma: float  # Gaussian standard deviation
+    half: int  # half the corner window
+    corner_angle: float
+    cusp_angle: float
+    straight: float
+    flat_angle: float
+
+
+def _params(scale: float, samples: int, corner_window: float | None, corner_angle: float,
+            cusp_angle: float, straight: float, flat_angle: float) -> _Params:
+    window = WINDOW * scale if corner_window is None else corner_window
+    return _Params(scale * samples, max(1, round(window * samples / 2)), corner_angle, cusp_angle,
+                   straight, flat_angle)
+
+
+def _describe(points: np.ndarray, p: _Params) -> tuple[np.ndarray, np.ndarray, list[list]]:
+    """Smoothed contour, turning per sample and well-formed items ``[symbol, start, stop, turning]``.
+
+    The items are in contour order (not yet rotated to the canonical start).
+    """
+    smoothed = ndimage.gaussian_filter1d(points, p.sigma, axis=0, mode="wrap")
+    phi = _turning(smoothed)
+    winding = phi.sum() / (2 * np.pi)
+    if abs(winding - 1) > 1e-6:
+        raise ContourError(f"the contour is not a simple closed curve: its tangent turns {winding:.3g} times")
+    items = _items(phi, p.half, len(points), p.corner_angle, p.cusp_angle, p.straight, p.flat_angle)
+    items = _repair(items, phi, p.corner_angle, p.cusp_angle, p.flat_angle)
+    return smoothed, phi, items
+
+
+def outline_contour(contour: np.ndarray, *, scale: float = DEFAULT_SCALE, samples: int = 1024,
+                    corner_window: float | None = None, corner_angle: float = math.radians(30),
                     cusp_angle: float = math.radians(125), straight: float = 0.25,
                     flat_angle: float = math.radians(10)) -> Outline:
-    """The qualitative outline of a closed contour.
+    """The qualitative outline of a closed contour at one scale.
 
     Parameters
     ----------
     contour : numpy.ndarray
         ``(m, 2)`` closed contour (x, y), pixels, closing point not repeated; either orientation
         (it is reversed when its shoelace area is negative).
+    scale : float
+        Standard deviation of the Gaussian smoothing, as a fraction of the perimeter, in
+        ``(0, SCALE_MAX]`` (default :data:`DEFAULT_SCALE`, 0.004). Features narrower than about
+        two scales are smoothed away; the corner window follows it (see ``corner_window``).
+        :func:`finger_scale` converts a finger pad's width into a scale.
     samples : int
         Number of samples after resampling by arc length.
-    smoothing : float
-        Standard deviation of the Gaussian smoothing, as a fraction of the perimeter.
-    corner_window : float
-        Width of the window in which concentrated turning makes a corner, fraction of the perimeter.
+    corner_window : float, optional
+        Width of the window in which concentrated turning makes a corner, fraction of the
+        perimeter. Default ``WINDOW * scale`` (5 scales: 0.02 at the default scale); it is also
+        the shortest line-like run and the distance under which corners merge.
     corner_angle : float
         Smallest turning (radians) within a window that makes an angle (default 30 degrees).
     cusp_angle : float
@@ -661,39 +863,35 @@ def outline_contour(contour: np.ndarray, *, samples: int = 1024, smoothing: floa
     Returns
     -------
     Outline
-        Well formed (checked with :func:`validate`), segments in canonical order.
+        Well formed (checked with :func:`validate`), segments in canonical order, with the
+        ``scale`` it was computed at.
 
     Raises
     ------
     ContourError
         Degenerate or self-intersecting contour, or one without a well-formed description.
+    ValueError
+        ``scale`` not in ``(0, SCALE_MAX]``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> square = np.array([[0, 0], [100, 0], [100, 100], [0, 100]], float)
+    >>> outline_contour(square).string
+    '/>/>/>/>'
+    >>> outline_contour(square, scale=0.01).scale
+    0.01
     """
-    contour = np.asarray(contour, dtype=np.float64)
-    if contour.ndim != 2 or contour.shape[1] != 2 or len(contour) < 3:
-        raise ContourError(f"expected an (m, 2) contour with m >= 3 points, got shape {contour.shape}")
-    if not np.all(np.isfinite(contour)):
-        raise ContourError("the contour has NaN or infinite coordinates")
-    area = signed_area(contour)
-    if area == 0:
-        raise ContourError("the contour encloses no area")
-    if area < 0:
-        contour = contour[::-1]
-    points, perimeter = resample(contour, samples)
-    smoothed = ndimage.gaussian_filter1d(points, smoothing * samples, axis=0, mode="wrap")
-    phi = _turning(smoothed)
-    winding = phi.sum() / (2 * np.pi)
-    if abs(winding - 1) > 1e-6:
-        raise ContourError(f"the contour is not a simple closed curve: its tangent turns {winding:.3g} times")
-    half = max(1, round(corner_window * samples / 2))
-    items = _items(phi, half, samples, corner_angle, cusp_angle, straight, flat_angle)
-    items = _repair(items, phi, corner_angle, cusp_angle, flat_angle)
+    scale = _check_scale(scale)
+    points, perimeter, size = _prepare(contour, samples)
+    p = _params(scale, samples, corner_window, corner_angle, cusp_angle, straight, flat_angle)
+    smoothed, phi, items = _describe(points, p)
     string = "".join(item[0] for item in items)
     r = _least_rotation(string)
     items = items[r:] + items[:r]
     spacing = perimeter / samples
-    segments = tuple(_segment(item, points, phi, half, spacing) for item in items)
-    size = 2.0 * cv2.minEnclosingCircle(points.astype(np.float32))[1]
-    outline = Outline(segments, _frozen(points), _frozen(smoothed), perimeter, float(size))
+    segments = tuple(_segment(item, points, phi, p.half, spacing) for item in items)
+    outline = Outline(segments, _frozen(points), _frozen(smoothed), perimeter, size, scale)
     validate(outline)
     return outline
 
@@ -719,7 +917,8 @@ def _items(phi: np.ndarray, half: int, samples: int, corner_angle: float, cusp_a
     """Corners and classified runs between them, ``[symbol, start, stop, turning]`` in contour order."""
     n = len(phi)
     symbol_of = {0: "/", 1: ")", -1: "("}
-    corners = _find_corners(phi, half, corner_angle)
+    background = _background(phi, half)
+    corners = _find_corners(phi, half, corner_angle, background)
     if not corners:
         runs = _classify_piece(phi, samples, straight, 2 * half, flat_angle)
         if len(runs) > 1 and runs[0][0] == runs[-1][0]:  # the first run continues the last one
@@ -730,7 +929,15 @@ def _items(phi: np.ndarray, half: int, samples: int, corner_angle: float, cusp_a
     items = []
     for k, (start, stop) in enumerate(spans):
         turning = float(phi[np.arange(start, stop) % n].sum())
-        items.append([_point_symbol(turning, corner_angle, cusp_angle), start, stop, turning])
+        # A cusp by its own turning: the widened span also holds some of the neighbouring curves'
+        # (their background rate times its length), which must not make a corner next to an arc
+        # a cusp at coarse scales.
+        rate = background[0 if turning > 0 else 1][(corners[k][0] + half) % n] / (2 * half)
+        own = abs(turning) - rate * (stop - start)
+        symbol = _point_symbol(turning, corner_angle, cusp_angle)
+        if symbol and own < cusp_angle:
+            symbol = ">" if turning > 0 else "<"
+        items.append([symbol, start, stop, turning])
         nxt = spans[(k + 1) % len(spans)][0] + (n if k + 1 == len(spans) else 0)
         if nxt - stop >= 2 * half:
             idx = np.arange(stop, nxt) % n
@@ -742,9 +949,243 @@ def _items(phi: np.ndarray, half: int, samples: int, corner_angle: float, cusp_a
     return items
 
 
-def outline_image(src: ImageSource, *, threshold: float | None = None, largest: bool = False,
-                  subpixel: bool = True, **options) -> Outline:
-    """The qualitative outline of the object in an image.
+def outline_image(src: ImageSource, *, scale: float = DEFAULT_SCALE, threshold: float | None = None,
+                  largest: bool = False, subpixel: bool = True, **options) -> Outline:
+    """The qualitative outline of the object in an image at one scale.
+
+    Parameters
+    ----------
+    src : str, pathlib.Path or numpy.ndarray
+        Image file or array (see :func:`qualgrasp.qualitative.vision.read_image`).
+    scale : float
+        Standard deviation of the Gaussian smoothing, fraction of the perimeter, in
+        ``(0, SCALE_MAX]`` (default :data:`DEFAULT_SCALE`, 0.004; see :func:`outline_contour`).
+    threshold : float, optional
+        Grey level separating object and background, in the input's units; default Otsu's.
+    largest : bool
+        With several objects, describe the largest instead of raising.
+    subpixel : bool
+        Refine the contour to sub-pixel accuracy.
+    **options
+        Other extraction parameters of :func:`outline_contour`.
+
+    Returns
+    -------
+    Outline
+        Coordinates in pixels of the input image (x = column, y = row).
+
+    Examples
+    --------
+    >>> from qualgrasp.qualitative.objects import render
+    >>> outline_image(render("figure3")).string
+    '/}(</{)>'
+    """
+    scale = _check_scale(scale)
+    contour = extract_contour(src, threshold=threshold, largest=largest, subpixel=subpixel)
+    return outline_contour(contour, scale=scale, **options)
+
+
+# --------------------------------------------------------------------------------------------------
+# Scales
+
+
+@dataclass(frozen=True)
+class ScaleInterval:
+    """A range of scales over which an object's outline string does not change.
+
+    Attributes
+    ----------
+    lo, hi : float
+        Bounds of the range, scales (Gaussian standard deviations as fractions of the perimeter).
+        Inner bounds are located to a relative tolerance (see :func:`outline_contour_scales`).
+    string : str
+        The canonical outline string over the range.
+    corners : int
+        Number of point-like symbols (angles and cusps) in the string.
+    """
+
+    lo: float
+    hi: float
+    string: str
+    corners: int
+
+    @property
+    def middle(self) -> float:
+        """Geometric middle of the range, ``sqrt(lo * hi)`` (the grid is geometric)."""
+        return math.sqrt(self.lo * self.hi)
+
+    @property
+    def convex(self) -> bool:
+        """True when the string has no concave symbol (``(``, ``<`` or ``{``)."""
+        return not any(s in "(<{" for s in self.string)
+
+
+def finger_scale(outline: Outline | np.ndarray, finger_width: float, *, samples: int = 1024) -> float:
+    """The scale at which a finger pad of a given width feels the object's outline.
+
+    A pad of width ``W`` pressed on the contour averages it over ``W``; the Gaussian that does the
+    same has its +-2 sigma span equal to the pad, ``sigma = W / 4`` (close to the standard
+    deviation ``W / sqrt(12) = 0.29 W`` of the pad's own box average). Bumps and dents narrower
+    than about three quarters of a pad are then smoothed away, wider ones remain (measured on the
+    built-in square: a semicircular bump is gone up to 0.8 pad, kept from 0.85). With
+    ``W = finger_width * D`` (``D`` the object's size, the diameter of its minimum enclosing
+    circle, as in :mod:`qualgrasp.qualitative.regions`) and ``P`` the perimeter, the scale is
+    ``finger_width * D / (4 * P)``.
+
+    Parameters
+    ----------
+    outline : Outline or numpy.ndarray
+        An extracted outline (its :attr:`~Outline.size` and :attr:`~Outline.perimeter`), or an
+        ``(m, 2)`` closed contour in pixels (resampled like :func:`outline_contour` does).
+    finger_width : float
+        Pad width, fraction of the object's size (the project's default is
+        :data:`qualgrasp.qualitative.regions.FINGER_WIDTH`, 0.08).
+    samples : int
+        Resampling of a contour given as an array.
+
+    Returns
+    -------
+    float
+        Scale, fraction of the perimeter (pass it as ``scale`` to :func:`outline_contour`); for a
+        disc and the default pad, ``0.08 / (4 pi) = 0.0064``.
+
+    Raises
+    ------
+    ValueError
+        ``finger_width`` not positive and finite.
+    ContourError
+        Unusable contour.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> square = np.array([[0, 0], [100, 0], [100, 100], [0, 100]], float)
+    >>> round(finger_scale(square, 0.08), 5)  # 0.08 * 100 sqrt(2) / (4 * 400)
+    0.00707
+    """
+    width = float(finger_width)
+    if not (math.isfinite(width) and width > 0):
+        raise ValueError(
+            f"finger_width must be a positive fraction of the object's size, got {finger_width!r}")
+    if isinstance(outline, Outline):
+        size, perimeter = outline.size, outline.perimeter
+    else:
+        _, perimeter, size = _prepare(outline, samples)
+    return width * size / (4.0 * perimeter)
+
+
+def _string_at(points: np.ndarray, scale: float, options: dict) -> str:
+    """Canonical string at one scale, checked well formed (string and measured turnings)."""
+    p = _params(scale, len(points), None, **options)
+    try:
+        items = _describe(points, p)[2]
+    except ContourError as err:
+        raise ContourError(f"at scale {scale:.6g}: {err}") from None
+    raw = "".join(item[0] for item in items)
+    try:
+        validate(raw)
+        _check_turnings(raw, [item[3] for item in items])
+    except OutlineError as err:  # a bug of the extraction: the repair must prevent it
+        raise OutlineError(f"at scale {scale:.6g}: {err}") from None
+    return canonical(raw)
+
+
+def outline_contour_scales(contour: np.ndarray, *, fine: float = DEFAULT_SCALE, coarse: float = SCALE_MAX,
+                           per_octave: int = 4, tolerance: float = 0.01, samples: int = 1024,
+                           corner_angle: float = math.radians(30), cusp_angle: float = math.radians(125),
+                           straight: float = 0.25,
+                           flat_angle: float = math.radians(10)) -> tuple[ScaleInterval, ...]:
+    """The scale hierarchy of a contour's outline (curvature scale space), from fine to coarse.
+
+    The contour is resampled once; at each scale only the smoothing and the classification of
+    :func:`outline_contour` are repeated. The string is computed on a geometric grid of
+    ``per_octave`` scales per doubling from ``fine`` to ``coarse`` (both included); where two
+    neighbouring scales differ, the change is located by bisection (geometric middles) until the
+    bracket is narrower than a factor ``1 + tolerance``, and a boundary is put at the bracket's
+    geometric middle. Strings seen inside a bracket become intervals of their own. A change that
+    reverts within one grid step is not seen.
+
+    Parameters
+    ----------
+    contour : numpy.ndarray
+        ``(m, 2)`` closed contour (x, y), pixels, either orientation.
+    fine, coarse : float
+        Scale range covered, fractions of the perimeter, ``0 < fine < coarse <= SCALE_MAX``. Default
+        from :data:`DEFAULT_SCALE` (0.004, the fine end: the first interval's string is the default
+        outline) to :data:`SCALE_MAX` (0.032, where the built-in objects and most real cells have
+        become convex blobs: no concave symbol).
+    per_octave : int
+        Grid scales per doubling of the scale (4: neighbours about 19 % apart).
+    tolerance : float
+        Relative accuracy of the inner bounds: each lies within a factor ``sqrt(1 + tolerance)`` of
+        the true change (for the extraction's own, deterministic string).
+    samples : int
+        Number of samples after resampling by arc length.
+    corner_angle, cusp_angle, straight, flat_angle : float
+        As for :func:`outline_contour` (the corner window is ``WINDOW`` scales at every scale).
+
+    Returns
+    -------
+    tuple of ScaleInterval
+        Contiguous (``hi`` of one is ``lo`` of the next), increasing, from ``fine`` to ``coarse``;
+        consecutive strings differ; every string is well formed.
+
+    Raises
+    ------
+    ContourError
+        Unusable contour, or no well-formed description at some scale (naming it).
+    ValueError
+        Bad range, grid or tolerance.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> square = np.array([[0, 0], [100, 0], [100, 100], [0, 100]], float)
+    >>> [(round(i.lo, 4), round(i.hi, 4), i.string) for i in outline_contour_scales(square)]
+    [(0.004, 0.032, '/>/>/>/>')]
+    """
+    fine, coarse = _check_scale(fine, "fine"), _check_scale(coarse, "coarse")
+    if not fine < coarse:
+        raise ValueError(f"fine ({fine:g}) must be smaller than coarse ({coarse:g})")
+    if int(per_octave) != per_octave or per_octave < 1:
+        raise ValueError(f"per_octave must be a positive integer, got {per_octave!r}")
+    if not 0 < tolerance < 1:
+        raise ValueError(f"tolerance must be in (0, 1), got {tolerance!r}")
+    options = {"corner_angle": corner_angle, "cusp_angle": cusp_angle, "straight": straight,
+               "flat_angle": flat_angle}
+    points = _prepare(contour, samples)[0]
+    steps = max(1, math.ceil(per_octave * math.log2(coarse / fine) - 1e-9))
+    grid = fine * (coarse / fine) ** (np.arange(steps + 1) / steps)
+    grid[-1] = coarse
+    seen = [(float(s), _string_at(points, float(s), options)) for s in grid]
+
+    def refine(lo: float, a: str, hi: float, b: str) -> list[tuple[float, str]]:
+        # Scales strictly between lo and hi, with their strings, until every change is bracketed.
+        if a == b or hi / lo <= 1 + tolerance:
+            return []
+        mid = math.sqrt(lo * hi)
+        m = _string_at(points, mid, options)
+        return refine(lo, a, mid, m) + [(mid, m)] + refine(mid, m, hi, b)
+
+    sampled = [seen[0]]
+    for (lo, a), (hi, b) in zip(seen, seen[1:]):
+        sampled += refine(lo, a, hi, b) + [(hi, b)]
+    intervals: list[ScaleInterval] = []
+    lo = fine
+    for (s, a), (t, b) in zip(sampled, sampled[1:] + [(coarse, None)]):
+        if a != b:
+            hi = coarse if b is None else math.sqrt(s * t)
+            intervals.append(ScaleInterval(lo, hi, a, sum(c in _POINTS for c in a)))
+            lo = hi
+    return tuple(intervals)
+
+
+def outline_scales(src: ImageSource, *, threshold: float | None = None, largest: bool = False,
+                   subpixel: bool = True, **options) -> tuple[ScaleInterval, ...]:
+    """The scale hierarchy of the outline of the object in an image, from fine to coarse.
+
+    The image is segmented and its contour extracted once (see :func:`outline_image`); the
+    hierarchy is that of :func:`outline_contour_scales`.
 
     Parameters
     ----------
@@ -757,24 +1198,31 @@ def outline_image(src: ImageSource, *, threshold: float | None = None, largest: 
     subpixel : bool
         Refine the contour to sub-pixel accuracy.
     **options
-        Extraction parameters of :func:`outline_contour`.
+        Range, grid and extraction parameters of :func:`outline_contour_scales`.
 
     Returns
     -------
-    Outline
-        Coordinates in pixels of the input image (x = column, y = row).
+    tuple of ScaleInterval
+        From ``fine`` (default 0.004) to ``coarse`` (default :data:`SCALE_MAX`, 0.032).
+
+    Examples
+    --------
+    >>> from qualgrasp.qualitative.objects import render
+    >>> outline_scales(render("disc"))[0].string
+    ')'
     """
     contour = extract_contour(src, threshold=threshold, largest=largest, subpixel=subpixel)
-    return outline_contour(contour, **options)
+    return outline_contour_scales(contour, **options)
 
 
 def outline_to_dict(outline: Outline) -> dict:
     """JSON-ready description of an outline.
 
-    Keys: ``string`` (canonical), ``size`` and ``perimeter`` (pixels) and ``segments``, in canonical
-    order, each with ``symbol``, ``name``, ``start``/``stop`` (samples of the resampled contour),
-    ``arc`` (pixels along the contour), ``turning`` (radians), ``points`` (list of [x, y]) and, for
-    point-like elements, ``position`` ([x, y]) or, for straight lines, ``endpoints``.
+    Keys: ``string`` (canonical), ``scale`` (fraction of the perimeter), ``size`` and ``perimeter``
+    (pixels) and ``segments``, in canonical order, each with ``symbol``, ``name``, ``start``/``stop``
+    (samples of the resampled contour), ``arc`` (pixels along the contour), ``turning`` (radians),
+    ``points`` (list of [x, y]) and, for point-like elements, ``position`` ([x, y]) or, for straight
+    lines, ``endpoints``.
     """
     segments = []
     for seg in outline.segments:
@@ -785,5 +1233,5 @@ def outline_to_dict(outline: Outline) -> dict:
         if seg.endpoints is not None:
             row["endpoints"] = seg.endpoints.tolist()
         segments.append(row)
-    return {"string": outline.string, "size": outline.size, "perimeter": outline.perimeter,
-            "segments": segments}
+    return {"string": outline.string, "scale": outline.scale, "size": outline.size,
+            "perimeter": outline.perimeter, "segments": segments}
