@@ -19,11 +19,15 @@ Examples
 ('closure', True)
 """
 
-from .certify import (Certificate, Check, Contact, Grasp, Report, Verdict, certify_grasp, force_closure,
-                      form_closure, grasp_from_dict, grasp_to_dict, positive_span, verify)
-from .certify.errors import CertificateError, CertifyError, GraspError, GraspFileError, SolverError
-from .certify.quality import Epsilon, epsilon
-from .qualitative.synthesis import Synthesis, synthesize
+# Absolute imports: this file is also the repository root's __init__.py, which pytest imports
+# under the folder's name when it collects tests/; absolute imports load the installed package
+# whatever that folder is called.
+from qualgrasp.certify import (Certificate, Check, Contact, Grasp, Report, Verdict, certify_grasp,
+                               force_closure, form_closure, grasp_from_dict, grasp_to_dict, positive_span,
+                               verify)
+from qualgrasp.certify.errors import CertificateError, CertifyError, GraspError, GraspFileError, SolverError
+from qualgrasp.certify.quality import Epsilon, epsilon
+from qualgrasp.qualitative.synthesis import Synthesis, synthesize
 
 __all__ = [
     "Contact", "Grasp", "grasp_from_dict", "grasp_to_dict",

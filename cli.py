@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import typer
 
-from .certify import cli as certify_cli
-from .experiments import cli as experiments_cli
-from .qualitative import cli as qualitative_cli
+from qualgrasp.certify import cli as certify_cli
+from qualgrasp.experiments import cli as experiments_cli
+from qualgrasp.qualitative import cli as qualitative_cli
 
 __all__ = ["app", "main"]
 
