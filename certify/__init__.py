@@ -16,11 +16,12 @@ from .closure import Verdict, force_closure, form_closure, positive_span
 from .errors import CertificateError, CertifyError, GraspError, GraspFileError, SolverError
 from .grasp import Contact, Grasp, grasp_from_dict, grasp_to_dict
 from .report import Report, certify_grasp
+from .chunk import Options, certify_arrow
 
 __all__ = [
     "Contact", "Grasp", "grasp_from_dict", "grasp_to_dict",
     "Verdict", "force_closure", "form_closure", "positive_span",
     "Certificate", "Check", "Tolerances", "verify", "verify_span",
-    "Report", "certify_grasp",
+    "Report", "certify_grasp", "Options", "certify_arrow",
     "CertifyError", "GraspError", "GraspFileError", "CertificateError", "SolverError",
 ]

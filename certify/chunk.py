@@ -6,7 +6,8 @@ messages for both). An Arrow chunk goes through the columnar path
 (:func:`qualgrasp.certify.fastpath.certify_table`); every row it does not settle, like every row
 of a JSON chunk, goes through the per-grasp path (:func:`certify_rows`). A bad row becomes an
 ``error`` row naming its line, the field and the problem: a chunk always gives exactly one
-results row per input row, in order.
+results row per input row, in order. A grasp's extra top-level fields are carried through
+(:func:`qualgrasp.certify.results.carried_name`).
 
 Re-checking (:func:`verify_chunk`) mirrors it: Arrow chunks are proved in bulk by the rigorous
 floating-point kernels (:func:`qualgrasp.certify.recheck.recheck_table`), every other row by
@@ -15,6 +16,7 @@ floating-point kernels (:func:`qualgrasp.certify.recheck.recheck_table`), every 
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from typing import Any, Sequence
 
@@ -23,15 +25,15 @@ import pyarrow.compute as pc
 
 from .certificates import Tolerances
 from .columns import GraspColumns, grasp_columns, value_columns
-from .errors import CertifyError
+from .errors import CertifyError, GraspFileError
 from .fastpath import certify_table
 from .recheck import recheck_table
 from .report import certify_grasp, verify_row
-from .results import error_row
+from .results import carried_name, error_row
 from .solvers import make_solver
 from .table import Chunk, chunk_values, table_to_rows
 
-__all__ = ["Options", "certify_rows", "certify_values", "certify_chunk_results", "verify_rows",
+__all__ = ["Options", "certify_rows", "certify_values", "certify_chunk_results", "certify_arrow", "verify_rows",
            "verify_chunk", "status_counts"]
 
 
@@ -55,18 +57,35 @@ def certify_rows(cols: GraspColumns, rows: Sequence[int], lines: Sequence[int],
     out = []
     for i, line in zip(rows, lines):
         gid = cols.id_of(i)
-        message = cols.message(i)
+        carried, message = _carried(cols.meta[i] if cols.meta else None)
+        message = cols.message(i) or message
         if message is None:
             try:
                 grasp = cols.grasps([i])[0]
                 report = certify_grasp(grasp, solver=solver, tol=tol, quality=options.quality,
                                        eps_gap=options.eps_gap, eps_budget=options.eps_budget)
-                out.append(report.row(line=line))
+                out.append({**report.row(line=line), **carried})
                 continue
             except CertifyError as err:
                 message = str(err)
-        out.append(error_row(f"line {line}: {message}", id=gid, line=line))
+        out.append({**error_row(f"line {line}: {message}", id=gid, line=line), **carried})
     return out
+
+
+def _carried(meta: dict | None) -> tuple[dict, str | None]:
+    """A grasp's extra top-level fields under their results names, and the problem of one that
+    cannot be written back as JSON (NaN, nested too deeply), if any."""
+    if not meta:
+        return {}, None
+    out = {}
+    for key, value in meta.items():
+        try:
+            json.dumps(value, allow_nan=False)
+        except (ValueError, TypeError, RecursionError) as err:
+            reason = "nested too deeply" if isinstance(err, RecursionError) else str(err)
+            return {}, f"{key}: cannot be carried to the results ({reason})"
+        out[carried_name(key)] = value
+    return out, None
 
 
 def certify_values(values: Sequence[Any], lines: Sequence[int], options: Options = Options(),
@@ -82,13 +101,66 @@ def certify_chunk_results(chunk: Chunk, options: Options, tol: Tolerances = Tole
     for JSON Lines (per-grasp path)."""
     if not isinstance(chunk.rows, pa.Table):
         return certify_values(chunk_values(chunk), chunk.lines, options, tol)
-    lines = chunk.lines
-    cols = grasp_columns(chunk.rows)
+    return _certify_arrow_rows(chunk.rows, chunk.lines, options, tol)
+
+
+def _certify_arrow_rows(table: pa.Table, lines, options: Options, tol: Tolerances) -> pa.Table:
+    cols = grasp_columns(table)
 
     def slow(rows):
         return certify_rows(cols, rows, [lines[i] for i in rows], options, tol)
 
-    return certify_table(cols, lines, options, tol, slow=slow)
+    return certify_table(table, lines, options, tol, slow=slow, columns=cols)
+
+
+def certify_arrow(data: Any, options: Options = Options(), tol: Tolerances = Tolerances()) -> pa.Table:
+    """Certify grasps held in memory as Arrow data: a :class:`pyarrow.Table` or record batch, or
+    any object with the Arrow PyCapsule stream interface (``__arrow_c_stream__``: pandas and
+    polars data frames, DuckDB results, ...).
+
+    Any layout :func:`qualgrasp.certify.columns.grasp_columns` reads is accepted (list, large or
+    fixed-size lists of any float or integer width, dictionary or large strings, optional
+    fields absent); extra columns are carried through.
+
+    Parameters
+    ----------
+    data : pyarrow.Table, pyarrow.RecordBatch or an Arrow stream object
+        One grasp per row: ``contacts`` (list of structs ``p``, ``n``, ``model``, ``mu``, ...),
+        optional ``id``, ``center``, ``length``.
+    options : Options
+        What is computed (method, quality).
+    tol : Tolerances
+
+    Returns
+    -------
+    pyarrow.Table
+        The results (:data:`qualgrasp.certify.results.RESULT_SCHEMA`, then the carried columns),
+        one row per input row; ``line`` is the row number (1-based).
+
+    Raises
+    ------
+    GraspFileError
+        ``data`` is not Arrow tabular data.
+
+    Examples
+    --------
+    >>> import pyarrow as pa
+    >>> from qualgrasp.certify.chunk import Options, certify_arrow
+    >>> t = pa.table({"id": ["g1"], "contacts": [[
+    ...     {"p": [1.0, 0.0], "n": [-1.0, 0.0], "mu": 0.5}, {"p": [-1.0, 0.0], "n": [1.0, 0.0], "mu": 0.5}]],
+    ...     "note": ["mine"]})
+    >>> r = certify_arrow(t, Options(quality=False))
+    >>> r.column("status").to_pylist(), r.column("note").to_pylist()
+    (['closure'], ['mine'])
+    """
+    if isinstance(data, pa.RecordBatch):
+        data = pa.Table.from_batches([data])
+    if not isinstance(data, pa.Table):
+        try:
+            data = pa.table(data)
+        except (TypeError, ValueError, pa.ArrowException) as err:
+            raise GraspFileError(f"cannot read the data as an Arrow table: {err}") from None
+    return _certify_arrow_rows(data, range(1, data.num_rows + 1), options, tol)
 
 
 def _verify_one(cols: GraspColumns, i: int, line: int, row: Any, tol: Tolerances) -> tuple[str, tuple | None]:

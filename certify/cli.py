@@ -6,10 +6,12 @@ Each command is a thin wrapper over a public function (:func:`qualgrasp.certify.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
@@ -19,10 +21,20 @@ from .bench import print_bench, print_quality_bench, run_bench, run_quality_benc
 from .errors import CertifyError
 from .samples import write_random_grasp_file
 from .table import count_grasps
+from .validation import MAX_CONTACTS
 
 __all__ = ["register"]
 
 console = Console(stderr=True)
+
+#: The solver routes a run may use (``qualgrasp bench`` times the others).
+METHODS = ("fast", "reference")
+
+
+def _fail(message: str) -> None:
+    """Print a one-line error (no markup interpreted in it) and exit with code 2."""
+    console.print("[red]error:[/red]", escape(message), soft_wrap=True)
+    raise typer.Exit(2)
 
 
 def certify_command(
@@ -41,9 +53,18 @@ def certify_command(
     """Certify form and force closure of every grasp, one results line per grasp line.
 
     Exit code 1 when some rows are errors or failed their own re-check, 2 when the run could not
-    start (unreadable input, resume refused).
+    start (unreadable input, bad option, output naming the input or a folder, resume refused).
     """
-
+    if method not in METHODS:
+        _fail(f"--method must be one of {', '.join(METHODS)}, got {method!r}")
+    if not (math.isfinite(eps_gap) and 0 < eps_gap < 1):
+        _fail(f"--eps-gap must be a fraction between 0 and 1 (relative gap hi - lo <= gap * hi), got {eps_gap}")
+    if eps_budget < 1:
+        _fail(f"--eps-budget must be at least 1 direction cell, got {eps_budget}")
+    if workers < 0:
+        _fail(f"--workers must be 0 (all cores) or a number of processes, got {workers}")
+    if chunk_size < 1:
+        _fail(f"--chunk-size must be at least 1 grasp, got {chunk_size}")
     total = count_grasps(grasps)
     with Progress(TextColumn("certify"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
                   console=console, disable=quiet) as bar:
@@ -54,8 +75,7 @@ def certify_command(
                                    eps_gap=eps_gap, eps_budget=eps_budget, workers=workers or None,
                                    dask=dask, resume=resume, chunk_size=chunk_size)
         except CertifyError as err:
-            console.print(f"[red]error:[/red] {err}")
-            raise typer.Exit(2)
+            _fail(str(err))
     if not quiet:
         table = Table(title=f"{summary.rows} grasps -> {output}")
         table.add_column("status")
@@ -80,11 +100,12 @@ def verify_command(
     workers: int = typer.Option(0, help="Worker processes (0: all cores)."),
 ) -> None:
     """Re-check every certificate without a solver; print the id of each one that fails."""
+    if workers < 0:
+        _fail(f"--workers must be 0 (all cores) or a number of processes, got {workers}")
     try:
         summary = verify_file(results, grasps, workers=workers or None)
     except CertifyError as err:
-        console.print(f"[red]error:[/red] {err}")
-        raise typer.Exit(2)
+        _fail(str(err))
     for gid, reason in summary.failures:
         typer.echo(f"{gid}\t{reason}")
     checked = summary.rows - summary.errors
@@ -108,6 +129,8 @@ def bench_command(
     With --quality: epsilon bound gaps and time per grasp, and the error of the 8-edge cone
     linearisation other toolkits use, on --n random grasps in closure per kind.
     """
+    if n < 1 or reference_n < 0:
+        _fail(f"--n must be at least 1 and --reference-n at least 0, got {n} and {reference_n}")
 
     if quality:
         print_quality_bench(run_quality_bench(n=n, seed=seed))
@@ -126,6 +149,20 @@ def sample_command(
     """Write a random grasp set, for trying the toolkit and for benchmarks at scale.
 
     Contacts are placed around a random blob; about a third of the grasps are in closure."""
+    if n < 0:
+        _fail(f"--n must be a number of grasps (>= 0), got {n}")
+    if dim not in (2, 3):
+        _fail(f"--dim must be 2 (planar) or 3 (spatial), got {dim}")
+    if not 1 <= contacts <= MAX_CONTACTS:
+        _fail(f"--contacts must be between 1 and {MAX_CONTACTS}, got {contacts}")
+    if model not in models.names():
+        _fail(f"--model must be one of {', '.join(models.names())}, got {model!r}")
+    if dim not in models.get(model).dims:
+        _fail(f"--model {model} exists in {' and '.join(map(str, models.get(model).dims))} dimensions only, "
+              f"not with --dim {dim}")
+    if output.is_dir():
+        _fail(f"the output {output} is a folder; give a file name (.jsonl or .parquet)")
+    output.parent.mkdir(parents=True, exist_ok=True)
 
     count = write_random_grasp_file(output, n, seed=seed, dim=dim, n_contacts=contacts, model=model)
     console.print(f"wrote {count} grasps to {output}")

@@ -27,10 +27,11 @@ import pyarrow.compute as pc
 
 from . import models as registry
 from .grasp import Grasp, grasps_from_checked
-from .validation import (ABSENT, MAX_CONTACTS, UNKNOWN, CheckedGrasps, ContactData, GraspData, check_grasps,
+from .table import READ_ERROR
+from .validation import (ABSENT, MAX_CONTACTS, TOP_LEVEL, UNKNOWN, CheckedGrasps, ContactData, GraspData, check_grasps,
                          contact_data, grasp_data, param_names, show)
 
-__all__ = ["GraspColumns", "grasp_columns", "value_columns"]
+__all__ = ["GraspColumns", "grasp_columns", "value_columns", "extra_columns"]
 
 
 @dataclass
@@ -349,5 +350,15 @@ def grasp_columns(table: pa.Table) -> GraspColumns:
         else:
             data.length_given = np.asarray(col.is_valid(), dtype=bool)
             data.length = np.where(data.length_given, values, np.nan)
+    if READ_ERROR in names:
+        unreadable = table.column(READ_ERROR).combine_chunks()
+        for i in np.flatnonzero(np.asarray(unreadable.is_valid(), dtype=bool)):
+            data.errors[i] = unreadable[i].as_py()
     checked = check_grasps(data, contacts)
     return _padded(checked, data.count, ids, None)
+
+
+def extra_columns(table: pa.Table) -> list[str]:
+    """Names of a grasp table's own extra top-level columns (not ``id``, ``contacts``, ``center``,
+    ``length``): a user's data, carried through to the results."""
+    return [name for name in table.column_names if name not in TOP_LEVEL and name != READ_ERROR]

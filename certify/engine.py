@@ -35,9 +35,9 @@ import pyarrow.parquet as pq
 from .chunk import Options, certify_chunk_results, status_counts
 from .errors import CertifyError, GraspFileError
 from .results import RESULT_SCHEMA, RESULT_WRITE_OPTIONS
-from .table import Chunk, count_grasps, is_parquet, iter_chunks, rows_to_table, table_to_rows
+from .table import Chunk, input_format, is_parquet, iter_chunks, rows_to_table, table_to_rows
 
-__all__ = ["RunSummary", "run", "certify_chunk"]
+__all__ = ["RunSummary", "run", "check_paths", "certify_chunk"]
 
 
 @dataclass
@@ -82,7 +82,7 @@ def _write_part(results, path: Path) -> None:
     tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")  # writers never share a temporary
     if path.suffix == ".arrow":
         table = results if isinstance(results, pa.Table) else rows_to_table(results)
-        with pa.ipc.new_file(tmp, RESULT_SCHEMA, options=_IPC) as writer:
+        with pa.ipc.new_file(tmp, table.schema, options=_IPC) as writer:
             writer.write_table(table)
     else:
         rows = table_to_rows(results) if isinstance(results, pa.Table) else results
@@ -158,9 +158,11 @@ class _Assembler:
         self.out = None  # opened with the first part, so that nothing is left if no run starts
         self.next, self.ready = 0, set()
 
-    def _open(self):
+    def _open(self, schema: pa.Schema = RESULT_SCHEMA):
+        """The output, opened on first use (Parquet: with the first part's schema, the results
+        columns and any columns carried from the input)."""
         if self.out is None:
-            self.out = (pq.ParquetWriter(self.tmp, RESULT_SCHEMA, **RESULT_WRITE_OPTIONS) if self.parquet
+            self.out = (pq.ParquetWriter(self.tmp, schema, **RESULT_WRITE_OPTIONS) if self.parquet
                         else self.tmp.open("wb"))
         return self.out
 
@@ -170,7 +172,8 @@ class _Assembler:
             self.ready.remove(self.next)
             part = self.parts / _part_name(self.next, self.results)
             if self.parquet:
-                self._open().write_table(_read_part(part))
+                table = _read_part(part)
+                self._open(table.schema).write_table(table)
             else:
                 with part.open("rb") as fh:
                     shutil.copyfileobj(fh, self._open())
@@ -250,11 +253,40 @@ class _DaskPool:
             self.cluster.close()
 
 
+def check_paths(grasps: Path, results: Path, chunk_size: int = 1) -> None:
+    """Refuse a run before any work: an input that is not a grasp set, a chunk size below 1, and
+    an output that is a folder, the input itself (output never overwrites what the run reads) or
+    in a folder that cannot be created or written. The output's folder is created if needed.
+
+    Raises
+    ------
+    GraspFileError
+        With a one-line message naming the problem.
+    """
+    if chunk_size < 1:
+        raise GraspFileError(f"the chunk size must be at least 1 grasp, got {chunk_size}")
+    input_format(grasps)  # raises for a file that is not JSON Lines or Parquet
+    if results.is_dir():
+        raise GraspFileError(f"the output {results} is a folder; give a file name (.jsonl or .parquet)")
+    if results.exists() and os.path.samefile(results, grasps):
+        raise GraspFileError(f"the output {results} is the input file: choose another name (the input "
+                             "is never overwritten)")
+    folder = results.parent if str(results.parent) else Path(".")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise GraspFileError(f"cannot create the output's folder {folder}: {err.strerror or err}") from None
+    if not os.access(folder, os.W_OK):
+        raise GraspFileError(f"cannot write into {folder}")
+
+
 def run(grasps: str | Path, results: str | Path, *, options: Options = Options(),
         workers: int | None = None, dask: str | None = None, resume: bool = False,
         chunk_size: int = 4096,
         progress: Callable[[int], None] | None = None) -> RunSummary:
-    """Certify the grasp set ``grasps`` into ``results`` (formats by extension), in parallel.
+    """Certify the grasp set ``grasps`` into ``results`` in parallel (the input's format is
+    recognised by content, the output's by extension; see :func:`check_paths` for what is
+    refused before any work).
 
     Parameters
     ----------
@@ -271,8 +303,7 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
     """
     start = time.perf_counter()
     grasps, results = Path(grasps), Path(results)
-    if count_grasps(grasps) is None:
-        raise GraspFileError(f"cannot read {grasps}")
+    check_paths(grasps, results, chunk_size)
     workers = workers or os.cpu_count() or 1
     parts = _prepare(grasps, results, chunk_size, options, resume)
     summary = RunSummary()

@@ -32,11 +32,11 @@ from ._kernels.planar import planar_batch
 from ._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
 from .certificates import Tolerances, verify
 from .closure import decide, farkas_from_arrays
-from .columns import GraspColumns, grasp_columns
+from .columns import GraspColumns, extra_columns, grasp_columns
 from .cones import LORENTZ, cone_code
 from .grasp import Contact, Grasp
 from .problem import Block, ClosureProblem, System, conic_columns, grasp_problem, grasp_system
-from .results import CERTIFICATE, RESULT_SCHEMA, result_table
+from .results import CERTIFICATE, RESULT_SCHEMA, carried_name, result_table
 from .solvers import BARRIER_NEAR_ZERO, FastSolver, make_solver
 from .solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
 from .solvers.enumeration import FEAS, bases
@@ -505,15 +505,17 @@ def _group_table(cols: GraspColumns, rows: np.ndarray, lines: np.ndarray, out, o
     }, n)
 
 
-def certify_table(table, lines, options, tol: Tolerances = Tolerances(), slow=None) -> pa.Table:
-    """Results table of a grasp table (rows in input order).
+def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(), slow=None, *,
+                  columns: GraspColumns | None = None) -> pa.Table:
+    """Results table of an Arrow grasp table (rows in input order), with the table's extra
+    columns carried through.
 
-    ``table`` is an Arrow grasp table or its checked columns (:class:`GraspColumns`).
     ``slow(row_indices) -> list of results rows`` certifies rows grasp by grasp (the per-grasp
     path, :func:`qualgrasp.certify.chunk.certify_rows`); it receives every row that the columnar
-    rules do not settle, invalid rows included.
+    rules do not settle, invalid rows included. ``columns``: the table's checked columns, when
+    the caller has them already.
     """
-    cols = table if isinstance(table, GraspColumns) else grasp_columns(table)
+    cols = grasp_columns(table) if columns is None else columns
     lines = (np.arange(lines.start, lines.stop, lines.step) if isinstance(lines, range)
              else np.asarray(lines, dtype=np.int64))
     n = len(lines)
@@ -543,16 +545,23 @@ def certify_table(table, lines, options, tol: Tolerances = Tolerances(), slow=No
         pieces.append(rows_to_table(slow(rest)))
         order.append(rest)
     if not pieces:
-        return RESULT_SCHEMA.empty_table()
+        return _carry(RESULT_SCHEMA.empty_table(), table)
     result = pa.concat_tables(pieces)
     order = np.concatenate(order)
     perm = np.argsort(order, kind="stable")
     starts = np.concatenate([[0], np.flatnonzero(np.diff(perm) != 1) + 1])
     if len(starts) > 64:
-        return result.take(pa.array(perm))
+        return _carry(result.take(pa.array(perm)), table)
     # few runs (one group and a few rows left to the per-grasp path): zero-copy slices
     ends = np.append(starts[1:], len(perm))
-    return pa.concat_tables([result.slice(perm[a], b - a) for a, b in zip(starts, ends)])
+    return _carry(pa.concat_tables([result.slice(perm[a], b - a) for a, b in zip(starts, ends)]), table)
+
+
+def _carry(result: pa.Table, table: pa.Table) -> pa.Table:
+    """``result`` with the input table's extra columns appended (:func:`carried_name`)."""
+    for name in extra_columns(table):
+        result = result.append_column(carried_name(name), table.column(name))
+    return result
 
 
 def _take(value, mask):

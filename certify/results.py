@@ -6,6 +6,11 @@ once (name, Arrow type, meaning, value in an error row); the Arrow schema of Par
 :meth:`qualgrasp.certify.Report.row`), the error row (:func:`error_row`) and the columnar builder
 (:func:`result_table`, used by :mod:`qualgrasp.certify.fastpath`) are all derived from it, so they
 cannot drift apart.
+
+An input's extra top-level fields (columns of a Parquet or Arrow grasp table other than ``id``,
+``contacts``, ``center``, ``length``; other keys of a JSON Lines grasp) are carried through
+unchanged after these columns, under :func:`carried_name` (JSON Lines input gives them to JSON
+Lines results only: a Parquet results file has one schema).
 """
 
 from __future__ import annotations
@@ -16,7 +21,7 @@ from typing import Any, Mapping
 import pyarrow as pa
 
 __all__ = ["Column", "CERTIFICATE", "COLUMNS", "NAMES", "RESULT_SCHEMA", "RESULT_WRITE_OPTIONS",
-           "result_row", "error_row", "result_table"]
+           "carried_name", "result_row", "error_row", "result_table"]
 
 CERTIFICATE = pa.struct([
     ("kind", pa.string()), ("layout", pa.string()), ("values", pa.list_(pa.float64())),
@@ -71,6 +76,14 @@ RESULT_SCHEMA = pa.schema([(c.name, c.type) for c in COLUMNS])
 RESULT_WRITE_OPTIONS = {"use_dictionary": [
     "status", "form_status", "certificate.force.kind", "certificate.force.layout",
     "certificate.form.kind", "certificate.form.layout"]}
+
+
+def carried_name(name: str) -> str:
+    """The results column of an input's extra top-level field ``name``: the same name, or
+    ``input_<name>`` when that is a results column (repeated until free)."""
+    while name in NAMES:
+        name = f"input_{name}"
+    return name
 
 
 def result_row(**values: Any) -> dict[str, Any]:

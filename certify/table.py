@@ -9,10 +9,13 @@ Parquet files hold the same schema as the JSON Lines files of :mod:`qualgrasp.ce
 * results: the columns of :data:`qualgrasp.certify.results.COLUMNS`, with ``certificate`` a
   struct ``{force, form}`` of certificate structs.
 
-The format of a file is chosen by its extension: ``.parquet`` / ``.pq`` for Parquet, anything
-else (``.jsonl``, ``.json``, ``.ndjson``) for JSON Lines. Both are read in chunks of a fixed number
-of grasps, so memory stays bounded whatever the file's size, and a chunk's boundaries do not
-depend on how the file was written (needed to resume an interrupted run).
+An input file's format is recognised by its content (Parquet's magic number, else JSON Lines;
+anything else is refused with a one-line reason); a results file's by its extension
+(``.parquet`` / ``.pq`` for Parquet, anything else for JSON Lines). Both are read in chunks of a
+fixed number of grasps, so memory stays bounded whatever the file's size, and a chunk's
+boundaries do not depend on how the file was written (needed to resume an interrupted run).
+JSON Lines may end lines with ``\\n``, ``\\r\\n`` or ``\\r`` and start with a UTF-8 byte-order
+mark; a line that is too long (:data:`MAX_LINE_BYTES`), not UTF-8 or not JSON is an error row.
 """
 
 from __future__ import annotations
@@ -29,8 +32,9 @@ from .errors import GraspFileError
 from .results import RESULT_SCHEMA
 from .validation import param_names
 
-__all__ = ["CONTACT", "GRASP_SCHEMA", "is_parquet", "Chunk", "iter_chunks", "count_grasps",
-           "grasps_table", "rows_to_table", "table_to_rows", "chunk_values"]
+__all__ = ["CONTACT", "GRASP_SCHEMA", "MAX_LINE_BYTES", "READ_ERROR", "is_parquet", "input_format", "Chunk",
+           "iter_chunks", "count_grasps", "parse_line", "grasps_table", "rows_to_table", "table_to_rows",
+           "chunk_values", "table_values"]
 
 CONTACT = pa.struct([("p", pa.list_(pa.float64())), ("n", pa.list_(pa.float64())), ("model", pa.string())]
                     + [(name, pa.float64()) for name in param_names()])
@@ -42,15 +46,125 @@ GRASP_SCHEMA = pa.schema([
 
 
 def is_parquet(path: str | Path) -> bool:
-    """True for ``.parquet`` / ``.pq`` files (Parquet), False for JSON Lines."""
+    """True for ``.parquet`` / ``.pq`` names: the format a results file is written in (input
+    files are recognised by their content, :func:`input_format`)."""
     return Path(path).suffix.lower() in (".parquet", ".pq")
+
+
+#: Longest line of a JSON Lines file, in bytes; a longer line is an error row, never read whole.
+MAX_LINE_BYTES = 16 << 20
+#: Column of an Arrow chunk marking rows that could not be read (a corrupt Parquet page).
+READ_ERROR = "_qualgrasp_read_error"
+
+_MAGIC = ((b"\x1f\x8b", "gzip-compressed data: decompress it first (gunzip)"),
+          (b"\x89PNG", "a PNG image"), (b"\xff\xd8\xff", "a JPEG image"), (b"%PDF", "a PDF document"),
+          (b"PK\x03\x04", "a zip archive: extract it first"), (b"\xff\xfe", "UTF-16 text: save it as UTF-8"),
+          (b"\xfe\xff", "UTF-16 text: save it as UTF-8"), (b"BZh", "bzip2-compressed data: decompress it first"),
+          (b"\xfd7zXZ", "xz-compressed data: decompress it first"))
+
+
+def _not_grasps(path: Path, what: str) -> GraspFileError:
+    return GraspFileError(f"{path} is not a grasp set (JSON Lines or Parquet): {what}")
+
+
+def input_format(path: str | Path) -> str:
+    """``'parquet'`` or ``'jsonl'``, from the file's content (not its name).
+
+    Raises
+    ------
+    GraspFileError
+        The file cannot be read, or holds something else: compressed or binary data, an image,
+        UTF-16 text, or one JSON document spread over many lines (a JSON array of grasps,
+        pretty-printed JSON); the message says which and how to fix it.
+    """
+    path = Path(path)
+    try:
+        if not path.is_file():
+            raise GraspFileError(f"cannot read {path}: " + ("it is a folder" if path.is_dir() else
+                                 "no such file" if not path.exists() else "not a regular file"))
+        with path.open("rb") as fh:
+            head = fh.read(1 << 16)
+    except OSError as err:
+        raise _open_error(path, err) from None
+    if head.startswith(b"PAR1"):
+        return "parquet"
+    for magic, what in _MAGIC:
+        if head.startswith(magic):
+            raise _not_grasps(path, what)
+    if b"\x00" in head:
+        raise _not_grasps(path, "binary data (NUL bytes)")
+    text = head[3:] if head.startswith(b"\xef\xbb\xbf") else head
+    first = next((line for line in text.replace(b"\r", b"\n").split(b"\n") if line.strip()), b"").strip()
+    if first in (b"[", b"{") or (first.startswith(b"[") and first.endswith(b",")):
+        raise _not_grasps(path, "one JSON document spread over many lines (a JSON array or pretty-printed "
+                                "JSON); write one grasp per line")
+    if first.startswith(b"[") and b'"contacts"' in first:
+        raise _not_grasps(path, "a JSON array of grasps; write one grasp per line")
+    return "jsonl"
+
+
+def _raw_lines(fh, limit: int = MAX_LINE_BYTES) -> Iterator[tuple[int, bytes | None]]:
+    """``(line number, bytes)`` of every line of a binary file (line ends ``\\n``, ``\\r\\n`` or
+    ``\\r`` removed; a UTF-8 byte-order mark at the start removed); ``None`` for a line longer
+    than ``limit``, which is skipped without being held in memory."""
+    number, carry = 0, b""
+    first = True
+    while True:
+        block = fh.read(1 << 20)
+        if not block:
+            break
+        data = carry + block
+        if first:
+            data = data[3:] if data.startswith(b"\xef\xbb\xbf") else data
+            first = False
+        # a \r at the very end may be the first half of \r\n: keep it for the next block
+        cut = len(data) - 1 if data.endswith(b"\r") else len(data)
+        start, n = 0, cut
+        while True:
+            i = data.find(b"\n", start, n)
+            j = data.find(b"\r", start, n)
+            if i < 0 and j < 0:
+                break
+            end = j if (j >= 0 and (i < 0 or j < i)) else i
+            number += 1
+            line = data[start:end]
+            yield number, (None if len(line) > limit else line)
+            start = end + (2 if data[end:end + 2] == b"\r\n" else 1)
+        carry = data[start:]
+        if len(carry) > limit + 1:  # a line longer than the limit: skip to its end
+            number += 1
+            yield number, None
+            carry = _skip_line(fh)
+            if carry is None:
+                return
+    if carry.endswith(b"\r"):  # the file's last line end
+        carry = carry[:-1]
+        number += 1
+        yield number, (carry if len(carry) <= limit else None)
+    elif carry:
+        number += 1
+        yield number, (carry if len(carry) <= limit else None)
+
+
+def _skip_line(fh) -> bytes | None:
+    """Read past the end of the current line; the bytes after it, or None at the end of the file."""
+    while True:
+        block = fh.read(1 << 20)
+        if not block:
+            return None
+        i, j = block.find(b"\n"), block.find(b"\r")
+        ends = [k for k in (i, j) if k >= 0]
+        if ends:
+            end = min(ends)
+            return block[end + (2 if block[end:end + 2] == b"\r\n" else 1):]
 
 
 @dataclass(frozen=True)
 class Chunk:
     """``index``-th chunk of a grasp set: its rows with their line numbers (1-based; JSON Lines
     count blank lines too, Parquet counts rows, as a ``range``). ``rows`` is a list of
-    ``(line, text)`` for JSON Lines and an Arrow table for Parquet."""
+    ``(line, bytes)`` for JSON Lines (``None`` for a line too long to read) and an Arrow table for
+    Parquet."""
 
     index: int
     lines: Sequence[int]
@@ -83,44 +197,77 @@ def _open_error(path: Path, err: Exception) -> GraspFileError:
 
 
 def iter_chunks(path: str | Path, size: int) -> Iterator[Chunk]:
-    """Yield the grasp set at ``path`` in chunks of ``size`` grasps (the last may be shorter)."""
+    """Yield the grasp set at ``path`` in chunks of ``size`` grasps (the last may be shorter); the
+    format is recognised by content (:func:`input_format`).
+
+    Parquet row groups that cannot be decoded (corrupt pages) become rows marked with the
+    :data:`READ_ERROR` column, so that every row still gets its line and the run goes on.
+    """
     path = Path(path)
-    if is_parquet(path):
-        try:
-            # Without pre-buffering, pyarrow (26) keeps every decoded page of the file alive while
-            # iterating batches; buffered reads keep memory bounded by the chunk size.
-            reader = pq.ParquetFile(path, pre_buffer=False, buffer_size=1 << 20)
-        except (OSError, pa.ArrowException) as err:
-            raise _open_error(path, err) from None
-        buffered, start, index = [], 0, 0
-        pending = 0
-        for batch in reader.iter_batches(batch_size=size):
-            buffered.append(batch)
-            pending += batch.num_rows
-            while pending >= size:
-                table = pa.Table.from_batches(buffered).combine_chunks()
-                yield Chunk(index, range(start + 1, start + size + 1), table.slice(0, size))
-                rest = table.slice(size)
-                buffered, pending = rest.to_batches(), rest.num_rows
-                start, index = start + size, index + 1
-        if pending:
-            table = pa.Table.from_batches(buffered, schema=reader.schema_arrow)
-            yield Chunk(index, range(start + 1, start + pending + 1), table)
+    if size < 1:
+        raise GraspFileError(f"chunk size must be at least 1, got {size}")
+    if input_format(path) == "parquet":
+        yield from _parquet_chunks(path, size)
         return
     try:
-        fh = path.open("r", encoding="utf-8")
+        fh = path.open("rb")
     except OSError as err:
         raise _open_error(path, err) from None
     with fh:
         rows, index = [], 0
-        for number, text in enumerate(fh, start=1):
-            if text.strip():
-                rows.append((number, text))
-                if len(rows) == size:
-                    yield Chunk(index, [n for n, _ in rows], rows)
-                    rows, index = [], index + 1
+        for number, raw in _raw_lines(fh):
+            if raw is not None and not raw.strip():
+                continue
+            rows.append((number, raw))
+            if len(rows) == size:
+                yield Chunk(index, [n for n, _ in rows], rows)
+                rows, index = [], index + 1
         if rows:
             yield Chunk(index, [n for n, _ in rows], rows)
+
+
+def _parquet_batches(path: Path, size: int) -> Iterator[pa.RecordBatch]:
+    """The file's rows as record batches of the file's schema plus :data:`READ_ERROR`; a row
+    group that fails to decode gives its remaining rows as null rows with the error."""
+    try:
+        # Without pre-buffering, pyarrow (26) keeps every decoded page of the file alive while
+        # iterating batches; buffered reads keep memory bounded by the chunk size.
+        reader = pq.ParquetFile(path, pre_buffer=False, buffer_size=1 << 20)
+    except (OSError, pa.ArrowException) as err:
+        raise _open_error(path, err) from None
+    schema = reader.schema_arrow.append(pa.field(READ_ERROR, pa.string()))
+    meta = reader.metadata
+    for rg in range(meta.num_row_groups):
+        total, done = meta.row_group(rg).num_rows, 0
+        try:
+            for batch in reader.iter_batches(batch_size=size, row_groups=[rg]):
+                done += batch.num_rows
+                yield pa.RecordBatch.from_arrays(batch.columns + [pa.nulls(batch.num_rows, pa.string())],
+                                                 schema=schema)
+        except (OSError, pa.ArrowException, ValueError) as err:
+            rest = total - done
+            message = f"unreadable Parquet data (row group {rg}): {str(err).splitlines()[0] if str(err) else err}"
+            arrays = [pa.nulls(rest, f.type) for f in reader.schema_arrow] + [pa.array([message] * rest, pa.string())]
+            yield pa.RecordBatch.from_arrays(arrays, schema=schema)
+
+
+def _parquet_chunks(path: Path, size: int) -> Iterator[Chunk]:
+    buffered, start, index = [], 0, 0
+    pending = 0
+    schema = None
+    for batch in _parquet_batches(path, size):
+        schema = batch.schema
+        buffered.append(batch)
+        pending += batch.num_rows
+        while pending >= size:
+            table = pa.Table.from_batches(buffered).combine_chunks()
+            yield Chunk(index, range(start + 1, start + size + 1), table.slice(0, size))
+            rest = table.slice(size)
+            buffered, pending = rest.to_batches(), rest.num_rows
+            start, index = start + size, index + 1
+    if pending:
+        table = pa.Table.from_batches(buffered, schema=schema)
+        yield Chunk(index, range(start + 1, start + pending + 1), table)
 
 
 def clean_value(d: Any) -> Any:
@@ -138,28 +285,43 @@ def table_values(table: pa.Table) -> list:
     return [clean_value(d) for d in table.to_pylist()]
 
 
+def parse_line(raw: bytes | None) -> Any:
+    """A JSON Lines line's value, or a :class:`GraspFileError` saying why it cannot be read
+    (too long, not UTF-8, malformed JSON, nested deeper than Python's parser allows)."""
+    if raw is None:
+        return GraspFileError(f"line longer than {MAX_LINE_BYTES} bytes")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as err:
+        return GraspFileError(f"not valid UTF-8 (byte 0x{raw[err.start]:02x} at column {err.start + 1})")
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as err:
+        return GraspFileError(f"malformed JSON ({err.msg} at column {err.colno})")
+    except RecursionError:
+        return GraspFileError("JSON nested deeper than the parser allows (about 1,000 levels)")
+    except ValueError as err:  # e.g. an integer of more than 4,300 digits
+        return GraspFileError(f"malformed JSON ({err})")
+
+
 def chunk_values(chunk: Chunk) -> list:
-    """Parsed grasp values of a chunk: dicts, or a :class:`GraspFileError` for a malformed line."""
+    """Parsed values of a chunk: dicts (or other JSON values), or a :class:`GraspFileError` for a
+    line that cannot be read."""
     if isinstance(chunk.rows, pa.Table):
         return table_values(chunk.rows)
-    values = []
-    for _, text in chunk.rows:
-        try:
-            values.append(json.loads(text))
-        except json.JSONDecodeError as err:
-            values.append(GraspFileError(f"malformed JSON ({err.msg} at column {err.colno})"))
-    return values
+    return [parse_line(raw) for _, raw in chunk.rows]
 
 
 def count_grasps(path: str | Path) -> int | None:
-    """Number of grasps in the file (Parquet metadata, or a scan of JSON Lines), None if unreadable."""
+    """Number of grasps in the file (Parquet metadata, or a scan of JSON Lines), None if it cannot
+    be read as a grasp set."""
     path = Path(path)
     try:
-        if is_parquet(path):
+        if input_format(path) == "parquet":
             return pq.ParquetFile(path).metadata.num_rows
         with path.open("rb") as fh:
-            return sum(1 for line in fh if line.strip())
-    except (OSError, pa.ArrowException):
+            return sum(1 for _, raw in _raw_lines(fh) if raw is None or raw.strip())
+    except (OSError, pa.ArrowException, GraspFileError):
         return None
 
 

@@ -45,7 +45,7 @@ from .models import MAX_LENGTH, MIN_LENGTH
 
 __all__ = ["MAX_CONTACTS", "MIN_NORMAL", "ABSENT", "UNKNOWN", "ContactData", "GraspData",
            "Checked", "show", "number", "numbers", "contact_data", "grasp_data",
-           "check_contacts", "check_grasps", "grasp_rules", "CheckedGrasps", "param_names"]
+           "check_contacts", "check_grasps", "grasp_rules", "CheckedGrasps", "param_names", "TOP_LEVEL"]
 
 #: Most contacts in one grasp (documented limit; a longer row is an error).
 MAX_CONTACTS = 10_000
@@ -317,7 +317,8 @@ class GraspData:
     raw: dict = field(default_factory=dict)
 
 
-_TOP = ("id", "contacts", "center", "length")
+#: The top-level keys of a grasp (other keys are kept as ``meta`` and carried through).
+TOP_LEVEL = ("id", "contacts", "center", "length")
 
 
 def grasp_data(values: Sequence[Any]) -> tuple[GraspData, ContactData]:
@@ -334,9 +335,11 @@ def grasp_data(values: Sequence[Any]) -> tuple[GraspData, ContactData]:
         gid = d.get("id")
         if gid is not None and (isinstance(gid, bool) or not isinstance(gid, (str, Integral))):
             data.errors[i] = f"id: expected a string or an integer, got {show(gid)}"
+        elif isinstance(gid, str) and not _is_unicode(gid):
+            data.errors[i] = f"id: not valid Unicode (it holds a lone surrogate), got {show(gid)}"
         elif gid is not None:
             data.ids[i] = gid if isinstance(gid, str) else int(gid)
-        data.meta[i] = {k: v for k, v in d.items() if k not in _TOP}
+        data.meta[i] = {k: v for k, v in d.items() if k not in TOP_LEVEL}
         cs = d.get("contacts")
         if not isinstance(cs, (list, tuple)):
             data.errors[i] = data.errors[i] or (
@@ -365,6 +368,15 @@ def grasp_data(values: Sequence[Any]) -> tuple[GraspData, ContactData]:
                 data.length_given[i] = True
                 data.raw[(i, "length")] = d["length"]
     return data, contact_data(contacts)
+
+
+def _is_unicode(text: str) -> bool:
+    """False for a string holding a lone surrogate (JSON allows ``"\\ud800"``; UTF-8 does not)."""
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True
 
 
 @dataclass
