@@ -29,8 +29,7 @@ A certificate is re-checked against the grasp with exact rational arithmetic on 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from fractions import Fraction
+from dataclasses import dataclass
 from typing import Any, Sequence
 
 import numpy as np

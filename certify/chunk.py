@@ -173,7 +173,7 @@ def _verify_one(cols: GraspColumns, i: int, line: int, row: Any, tol: Tolerances
         return status, (row.get("id"), f"results row is for line {row.get('line')}, grasp is line {line}")
     if row.get("id") != gid and str(row.get("id")) != str(gid):
         return status, (row.get("id"), f"id does not match grasp line {line} ({gid!r})")
-    message = cols.message(i)
+    message = cols.message(i) or _carried(cols.meta[i] if cols.meta else None)[1]
     if status == "error":
         if message is None:
             return status, (gid, "row says error but the grasp is valid")

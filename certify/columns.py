@@ -29,7 +29,7 @@ from . import models as registry
 from .grasp import Grasp, grasps_from_checked
 from .table import READ_ERROR
 from .validation import (ABSENT, MAX_CONTACTS, TOP_LEVEL, UNKNOWN, CheckedGrasps, ContactData, GraspData, check_grasps,
-                         contact_data, grasp_data, param_names, show)
+                         grasp_data, show)
 
 __all__ = ["GraspColumns", "grasp_columns", "value_columns", "extra_columns"]
 

@@ -214,6 +214,10 @@ class _LocalPool:
         self.pool.shutdown(cancel_futures=True)
 
 
+DASK_CONNECT_SECONDS = 10
+"""How long to try to reach a dask scheduler before giving up (s)."""
+
+
 class _DaskPool:
     def __init__(self, address: str, workers: int) -> None:
         try:
@@ -226,7 +230,10 @@ class _DaskPool:
             self.client = Client(self.cluster)
         else:
             self.cluster = None
-            self.client = Client(address)
+            try:
+                self.client = Client(address, timeout=DASK_CONNECT_SECONDS)
+            except (OSError, ValueError, TypeError) as err:
+                raise CertifyError(f"--dask: cannot reach a dask scheduler at {address!r} ({err})") from None
         self.capacity = 2 * max(1, len(self.client.scheduler_info()["workers"]))
         self.parts: dict[Any, Path] = {}
 
@@ -305,10 +312,16 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
     grasps, results = Path(grasps), Path(results)
     check_paths(grasps, results, chunk_size)
     workers = workers or os.cpu_count() or 1
-    parts = _prepare(grasps, results, chunk_size, options, resume)
+    # The pool first: a scheduler that cannot be reached leaves nothing behind.
+    pool = _DaskPool(dask, workers) if dask else (_LocalPool(workers) if workers > 1 else None)
+    try:
+        parts = _prepare(grasps, results, chunk_size, options, resume)
+    except BaseException:
+        if pool is not None:
+            pool.close()
+        raise
     summary = RunSummary()
     assembler = _Assembler(parts, results)
-    pool = _DaskPool(dask, workers) if dask else (_LocalPool(workers) if workers > 1 else None)
     pending: dict[Any, tuple[int, int]] = {}
 
     def done(index: int, size: int) -> None:

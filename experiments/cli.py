@@ -8,19 +8,34 @@ from pathlib import Path
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from .demo import demo_steps, run_demo
+from ..certify.checks import OptionError, count_in, output_folder
 from . import figures
+from .demo import demo_steps, run_demo
+from .silhouettes import available_silhouettes, write_silhouettes
 from .silhouettes import silhouettes as bundled
-from .silhouettes import write_silhouettes
 from .study import BUILTINS, SETTINGS, compare, workload
 from .style import check_formats
 
 __all__ = ["register"]
 
 console = Console()
+
+
+def _fail(message: str) -> None:
+    """Print a one-line error (no markup interpreted in it) and exit with code 2."""
+    console.print("[red]error:[/red]", escape(message), soft_wrap=True)
+    raise typer.Exit(2)
+
+
+def _folder(out: Path) -> Path:
+    try:
+        return output_folder(out, "--out")
+    except OptionError as err:
+        _fail(str(err))
 
 
 def register(app: typer.Typer) -> None:
@@ -36,8 +51,9 @@ def demo_command(out: Path = typer.Option(Path("qualgrasp-demo"), "--out", help=
 
     The paper's figures 3 to 8; FormGrasp and ForceGrasp on the built-in camera images, certified
     and every certificate re-checked; the comparison study (quick setting); a Markdown report.
+    Exit code 1 when a certificate failed its re-check, 2 when the output folder is unusable.
     """
-
+    _folder(out)
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                   console=console) as bar:
         task = bar.add_task("demo", total=demo_steps())
@@ -74,6 +90,7 @@ def figures_command(out: Path = typer.Option(Path("qualgrasp-figures"), "--out",
         kinds = check_formats([f.strip() for f in formats.split(",") if f.strip()])
     except ValueError as exc:
         raise typer.BadParameter(str(exc), param_hint="--formats") from exc
+    _folder(out)
     paths = figures.make_figures(out, formats=kinds, progress=lambda message: console.print(message))
     for path in paths:
         console.print(f"wrote {path}", soft_wrap=True)  # paths stay whole, for copy and paste
@@ -103,6 +120,15 @@ def compare_command(
         raise typer.BadParameter(f"use one of {', '.join(SETTINGS)}", param_hint="--setting")
     if folder is not None and not folder.is_dir():
         raise typer.BadParameter(f"{folder} is not a folder", param_hint="FOLDER")
+    available = available_silhouettes()
+    try:
+        count_in(silhouettes, "--silhouettes", 0, available - 1, what="(the bundled cell outlines)")
+        count_in(workers, "--workers", 1, 256, what="processes")
+        if trials is not None:
+            count_in(trials, "--trials", 1, 1000)
+    except OptionError as err:
+        _fail(str(err))
+    _folder(out)
     images: list = sorted(p for p in folder.iterdir() if p.suffix.lower() in _IMAGE_SUFFIXES) if folder else []
     images += list(BUILTINS) if builtins else []
     images += bundled(silhouettes) if silhouettes else []
@@ -129,6 +155,8 @@ def compare_command(
         table.add_row(r.route, str(r.grasps), fmt(r.certified_fraction), fmt(r.eps_median), fmt(r.eps_best),
                       fmt(r.ratio_best), fmt(r.seconds_median), fmt(r.robustness), fmt(r.robustness_paired))
     console.print(table)
+    for name, reason in result.skipped:
+        console.print(f"skipped {escape(name)}: {escape(reason)}", soft_wrap=True)
     for path in result.files:
         console.print(f"wrote {path}", soft_wrap=True)
 
@@ -141,8 +169,12 @@ def silhouettes_command(out: Path = typer.Option(Path("qualgrasp-silhouettes"), 
     horse) as 512 x 512 PNG images."""
 
     try:
+        count_in(n, "--n", 0, available_silhouettes() - 1, what="(the bundled cell outlines)")
+    except OptionError as err:
+        _fail(str(err))
+    _folder(out)
+    try:
         paths = write_silhouettes(out, n, with_horse=horse)
-    except (FileNotFoundError, ValueError) as exc:
-        console.print(f"[red]{exc}[/red]")
-        raise typer.Exit(1) from None
+    except (OSError, ValueError) as exc:
+        _fail(str(exc))
     console.print(f"wrote {len(paths)} images into {out}", soft_wrap=True)

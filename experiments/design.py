@@ -178,6 +178,8 @@ class StudyResult:
         Wall time of the study, seconds.
     files : tuple of pathlib.Path
         Tables and plots written.
+    skipped : tuple of (str, str)
+        Images left out, with the reason (unreadable, no single object).
     """
 
     objects: tuple[str, ...]
@@ -185,5 +187,6 @@ class StudyResult:
     robustness: Mapping[tuple[str, str], float | None]
     seconds: float
     files: tuple[Path, ...] = field(default=())
+    skipped: tuple[tuple[str, str], ...] = field(default=())
 
 

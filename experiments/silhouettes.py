@@ -56,7 +56,7 @@ from scipy import ndimage
 from shapely.geometry import Polygon
 from skimage import data
 
-__all__ = ["MIN_EXTENT", "THIN", "SMOOTHING", "SIZE", "Silhouette", "parse_cells", "write_cell_data", "read_cells",
+__all__ = ["MIN_EXTENT", "THIN", "SMOOTHING", "SIZE", "Silhouette", "available_silhouettes", "parse_cells", "write_cell_data", "read_cells",
            "smooth_outline", "select_cells", "horse", "silhouettes", "write_silhouettes"]
 
 MIN_EXTENT = 50
@@ -242,6 +242,12 @@ def horse() -> Silhouette:
     if not poly.is_valid:  # keep the largest simple piece
         poly = max(getattr(shapely.make_valid(poly), "geoms", []), key=lambda g: g.area)
     return Silhouette("horse", normalise(poly), "skimage.data.horse (BSD-3-Clause)", _solidity(poly))
+
+
+def available_silhouettes() -> int:
+    """How many real silhouettes are bundled: the cells that pass the selection rule, and the
+    horse."""
+    return sum(len(v) for v in _valid_cells().values()) + 1
 
 
 def silhouettes(n: int = 24, with_horse: bool = True) -> list[Silhouette]:

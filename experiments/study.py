@@ -67,9 +67,8 @@ import math
 import time
 import zlib
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterable, Mapping, Sequence
+from typing import Any, Callable, Iterable, Sequence
 
 import cv2
 import numpy as np
@@ -106,7 +105,7 @@ def _as_uint8(image: np.ndarray) -> np.ndarray:
     return np.clip(np.round(image), 0, 255).astype(np.uint8)
 
 
-def subjects(images: Iterable[Any]) -> list[Subject]:
+def subjects(images: Iterable[Any], skipped: list | None = None) -> list[Subject]:
     """Study subjects from built-in object names, image files, arrays or silhouettes.
 
     Parameters
@@ -115,27 +114,44 @@ def subjects(images: Iterable[Any]) -> list[Subject]:
         Each a built-in object name (:data:`qualgrasp.qualitative.objects.NAMES`, rendered at 512 x 512), an
         image path (name: the file's stem), a :class:`qualgrasp.experiments.silhouettes.Silhouette`, a
         :class:`Subject`, a ``(name, array)`` pair or an array (named ``image-<k>``).
+    skipped : list, optional
+        When given, an image that cannot be read is appended to it as ``(name, reason)`` and left
+        out, instead of raising.
 
     Returns
     -------
     list of Subject
         Grey uint8 images (colour converted to luminance, other ranges rounded and clipped).
+
+    Raises
+    ------
+    QualitativeError
+        An image cannot be read (only when ``skipped`` is None).
     """
     out = []
     for k, item in enumerate(images):
-        if isinstance(item, Subject):
-            out.append(item)
-        elif isinstance(item, Silhouette):
-            out.append(Subject(item.name, item.image()))
-        elif isinstance(item, str) and item in NAMES:
-            out.append(Subject(item, render(item)))
-        elif isinstance(item, (str, Path)):
-            out.append(Subject(Path(item).stem, _as_uint8(read_image(item))))
-        elif isinstance(item, tuple):
-            out.append(Subject(str(item[0]), _as_uint8(read_image(item[1]))))
-        else:
-            out.append(Subject(f"image-{k}", _as_uint8(read_image(item))))
+        try:
+            out.append(_subject(k, item))
+        except QualitativeError as err:
+            if skipped is None:
+                raise
+            name = Path(item).name if isinstance(item, (str, Path)) else f"image-{k}"
+            skipped.append((name, f"{type(err).__name__}: {err}"))
     return out
+
+
+def _subject(k: int, item: Any) -> Subject:
+    if isinstance(item, Subject):
+        return item
+    if isinstance(item, Silhouette):
+        return Subject(item.name, item.image())
+    if isinstance(item, str) and item in NAMES:
+        return Subject(item, render(item))
+    if isinstance(item, (str, Path)):
+        return Subject(Path(item).stem, _as_uint8(read_image(item)))
+    if isinstance(item, tuple):
+        return Subject(str(item[0]), _as_uint8(read_image(item[1])))
+    return Subject(f"image-{k}", _as_uint8(read_image(item)))
 
 
 def _pose_matrix(center: np.ndarray, degrees: float, shift: Sequence[float]) -> np.ndarray:
@@ -466,9 +482,16 @@ def compare(images: Iterable[Any], out: str | Path, *, settings: str | Settings 
     """
     start = time.perf_counter()
     settings = SETTINGS[settings] if isinstance(settings, str) else settings
-    items = subjects(images)
+    skipped: list = []
+    items = []
+    for subject in subjects(images, skipped):
+        try:  # an image the vision cannot describe at all has no true object to execute on
+            boundary(subject.image)
+            items.append(subject)
+        except QualitativeError as err:
+            skipped.append((subject.name, f"{type(err).__name__}: {err}"))
     if not items:
-        raise ValueError("no images to compare")
+        raise ValueError("no images to compare" + (f" (skipped: {skipped})" if skipped else ""))
     names = [s.name for s in items]
     if len(set(names)) != len(names):
         raise ValueError(f"object names must be unique, got {names}")
@@ -489,4 +512,5 @@ def compare(images: Iterable[Any], out: str | Path, *, settings: str | Settings 
     if plots:
         files += plot_all(out, object_rows, grasp_rows, robust)
     routes, by_kind = summarise(overall, trial_rows)
-    return StudyResult(tuple(names), routes, by_kind, time.perf_counter() - start, tuple(files))
+    return StudyResult(tuple(names), routes, by_kind, time.perf_counter() - start, tuple(files),
+                       tuple(skipped))

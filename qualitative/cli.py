@@ -8,7 +8,9 @@ from pathlib import Path
 
 import typer
 
+from ..certify.checks import FIGURE_SUFFIXES, number_in, output_file
 from ..certify.io import write_grasps
+from ..certify.models import MAX_MU
 from . import procedures
 from .errors import FormulaError, QualitativeError, TraceError
 from .grasp_plot import synthesis_figure
@@ -20,6 +22,25 @@ from .synthesis import synthesize
 from .vision import read_image
 
 __all__ = ["register"]
+
+
+def _fail(message: str) -> None:
+    """Print a one-line error and exit with code 2."""
+    typer.echo(f"error: {message}", err=True)
+    raise typer.Exit(2)
+
+
+def _threshold(threshold: float | None) -> None:
+    if threshold is not None and not math.isfinite(threshold):
+        _fail(f"--threshold must be a finite grey level, got {threshold}")
+
+
+def _save(figure, path: Path, dpi: int) -> None:
+    """Save a figure, or exit 2 saying why it could not be written (a full disk, ...)."""
+    try:
+        figure.savefig(path, dpi=dpi)
+    except OSError as err:
+        _fail(f"--plot: cannot write {path} ({err.strerror or err})")
 
 
 def register(app: typer.Typer) -> None:
@@ -42,8 +63,7 @@ def st0_command(
     try:
         values = evaluate_file(formula, trace)
     except (FormulaError, TraceError) as err:
-        typer.echo(f"error: {err}", err=True)
-        raise typer.Exit(2)
+        _fail(str(err))
     for i, value in enumerate(values):
         typer.echo(f"{i}\t{'true' if value else 'false'}")
 
@@ -72,13 +92,11 @@ def outline_command(
     bad --scale.
     """
 
+    _threshold(threshold)
     if scale is not None and scales:
-        typer.echo("error: --scale and --scales exclude each other", err=True)
-        raise typer.Exit(2)
+        _fail("--scale and --scales exclude each other")
     if scale is not None and not (math.isfinite(scale) and 0 < scale <= SCALE_MAX):
-        typer.echo(f"error: --scale must be a fraction of the object's perimeter in (0, {SCALE_MAX:g}], "
-                   f"got {scale:g}", err=True)
-        raise typer.Exit(2)
+        _fail(f"--scale must be a fraction of the object's perimeter in (0, {SCALE_MAX:g}], got {scale:g}")
     try:
         if scales:
             hierarchy = outline_scales(image, threshold=threshold, largest=largest)
@@ -86,8 +104,7 @@ def outline_command(
             outline = outline_image(image, scale=DEFAULT_SCALE if scale is None else scale,
                                     threshold=threshold, largest=largest)
     except QualitativeError as err:
-        typer.echo(f"error: {err}", err=True)
-        raise typer.Exit(2)
+        _fail(str(err))
     if scales and as_json:
         typer.echo(json.dumps([{"lo": i.lo, "hi": i.hi, "string": i.string, "corners": i.corners,
                                 "convex": i.convex} for i in hierarchy]))
@@ -121,14 +138,18 @@ def regions_command(
     """
 
     try:
+        _threshold(threshold)
+        number_in(alpha, "--alpha", 0, 100, unit="(fraction of the object's size)")
+        number_in(finger_width, "--finger-width", 1e-3, 1, unit="(fraction of the object's size)")
+        number_in(margin, "--margin", 0, 0.5, unit="(fraction of the object's size)", high_open=True)
+        if plot is not None:
+            output_file(plot, "--plot", suffixes=FIGURE_SUFFIXES, reads=[image])
         outline = outline_image(image, threshold=threshold, largest=largest)
         regions = feasible_regions(outline, alpha, finger_width, margin)
     except (QualitativeError, ValueError) as err:
-        typer.echo(f"error: {err}", err=True)
-        raise typer.Exit(2)
+        _fail(str(err))
     if plot is not None:
-
-        outline_figure(outline, regions, read_image(image)).savefig(plot, dpi=120)
+        _save(outline_figure(outline, regions, read_image(image)), plot, 120)
     if as_json:
         typer.echo(json.dumps(regions_to_dict(outline, regions, alpha, finger_width, margin)))
         return
@@ -163,43 +184,59 @@ def synthesize_command(
 
     Contacts are in pixels of the input image (x = column, y = row) with inward unit normals;
     center is the object's area centroid and length its radius. The file goes straight into
-    'qualgrasp certify'. Prints one line per grasp (id, regions, certified margin and L1 epsilon)
-    and a summary. Exit code 0 (with an empty file) when no grasp exists, 1 when a synthesised grasp
-    fails certification, 2 on unusable input or options.
+    'qualgrasp certify'. Prints one line per grasp (id, regions, certified margin and L1 epsilon,
+    and whether the image resolves it: a grasp whose certified epsilon is below the wrench change a
+    pixel of error can cause is flagged) and a summary. Exit code 0 (with an empty file) when no
+    grasp exists, 1 when a synthesised grasp fails certification, 2 on unusable input or options.
     """
 
 
     if mu is not None and theta_min is not None:
-        typer.echo("error: give --mu or --theta-min, not both", err=True)
-        raise typer.Exit(2)
+        _fail("give --mu or --theta-min, not both")
     if fingers is None and procedure is None:
-        typer.echo(f"error: give --fingers or --procedure ({', '.join(procedures.names())})", err=True)
-        raise typer.Exit(2)
+        _fail(f"give --fingers or --procedure ({', '.join(procedures.names())})")
     try:
+        _threshold(threshold)
+        if mu is not None:
+            number_in(mu, "--mu", 0, MAX_MU, low_open=True, unit="(friction coefficient)")
+        if theta_min is not None:
+            number_in(theta_min, "--theta-min (theta_min, the friction cone's half-angle)", 0, 90,
+                      low_open=True, high_open=True, unit="degrees")
+        number_in(alpha, "--alpha", 0, 100, unit="(fraction of the object's size)")
+        output_file(output, "-o", reads=[image])
+        if plot is not None:
+            output_file(plot, "--plot", suffixes=FIGURE_SUFFIXES, reads=[image, output])
         result = synthesize(image, fingers, mu, None if theta_min is None else math.radians(theta_min),
                             alpha, procedure=procedure, threshold=threshold, largest=largest)
-    except QualitativeError as err:
-        typer.echo(f"error: {err}", err=True)
-        raise typer.Exit(2)
-    write_grasps(output, result.grasps)
+    except (QualitativeError, ValueError) as err:
+        _fail(str(err))
+    try:
+        write_grasps(output, result.grasps)
+    except OSError as err:
+        _fail(f"-o: cannot write {output} ({err.strerror or err})")
     if plot is not None:
-
-        synthesis_figure(result, read_image(image)).savefig(plot, dpi=110)
+        _save(synthesis_figure(result, read_image(image)), plot, 110)
     friction = "frictionless" if result.mu is None else f"mu {result.mu:.4g}"
     if not result.grasps:
         typer.echo(f"no grasp found: {result.procedure.title} ({result.fingers} fingers, {friction}) on "
                    f"{len(result.regions)} "
                    f"feasible region(s) of {result.outline.string}; wrote an empty grasp set to {output}")
         return
-    for grasp, report, ok in zip(result.grasps, result.reports, result.certified):
+    for grasp, report, ok, good in zip(result.grasps, result.reports, result.certified, result.resolved):
         eps = report.epsilons["L1"].hi if report.epsilons else float("nan")
+        verdict = "NOT CERTIFIED" if not ok else "verified" if good else "verified, BELOW IMAGE RESOLUTION"
         typer.echo(f"{grasp.id}\tregions {grasp.meta['regions']}\t{report.force.status}\t"
-                   f"margin {report.force.margin:.4f}\teps {eps:.4f}\t{'verified' if ok else 'NOT CERTIFIED'}")
+                   f"margin {report.force.margin:.4f}\teps {eps:.4f}\t{verdict}")
     s = result.summary()
     typer.echo(f"{s['grasps']} grasp(s) by {result.procedure.title} ({result.fingers} fingers, {friction}) "
                f"-> {output}; "
-               f"{100 * s['certified_fraction']:.0f} % certified; synthesis {s['seconds']:.2f} s, "
-               f"certification {s['certify_seconds']:.2f} s")
+               f"{100 * s['certified_fraction']:.0f} % certified, {s['resolved']} resolved by the image; "
+               f"synthesis {s['seconds']:.2f} s, certification {s['certify_seconds']:.2f} s")
+    if s["resolved"] < s["certified"]:
+        typer.echo(f"note: {s['certified'] - s['resolved']} certified grasp(s) are below the image's "
+                   "resolution: their certified epsilon is smaller than the wrench change that a pixel "
+                   "of error in the contacts and their normals can cause, so the closure may be an "
+                   "artefact of the pixels; do not rely on them")
     if s["certified"] < s["grasps"]:
         typer.echo("error: some synthesised grasps did not certify (a synthesis bug: please report it)", err=True)
         raise typer.Exit(1)

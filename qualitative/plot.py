@@ -37,8 +37,11 @@ STYLE = {
 def draw_frame(ax: Axes, outline: Outline, image: np.ndarray | None) -> None:
     """Draw the image faintly (if given) and the object's contour on ``ax``, in pixels (y down)."""
     if image is not None:
-        ax.imshow(image, cmap="gray", vmin=0, vmax=255 if np.asarray(image).dtype == np.uint8 else None,
-                  alpha=0.35, interpolation="nearest")
+        image = np.asarray(image)
+        # 8-bit images on their own scale; others (float, 16-bit, negative) on their range
+        low, high = (0, 255) if image.dtype == np.uint8 else (float(np.min(image)), float(np.max(image)))
+        ax.imshow(image, cmap="gray", vmin=low, vmax=high if high > low else low + 1, alpha=0.35,
+                  interpolation="nearest")
     ring = np.vstack([outline.contour, outline.contour[:1]])
     ax.plot(ring[:, 0], ring[:, 1], color="0.6", lw=0.8, zorder=1)
     ax.set_aspect("equal")

@@ -61,12 +61,21 @@ from pathlib import Path
 import numpy as np
 
 from .errors import FormulaError, TraceError
-from .rcc8 import RELATIONS
+from .rcc8 import RELATIONS, path_consistency
+
+#: Longest formula accepted, in characters.
+MAX_FORMULA = 10_000
+#: Most nested operators in a formula (brackets, ``!``, temporal operators, chains of ``->``,
+#: ``U``, ``S``): evaluation and printing are recursive.
+MAX_DEPTH = 100
+#: Largest trace file read, in bytes.
+MAX_TRACE_BYTES = 64 << 20
 
 __all__ = [
     "Formula", "Const", "Atom", "Not", "And", "Or", "Implies",
     "Next", "Sometime", "Always", "Until", "Previous", "Once", "Historically", "Since",
     "parse", "read_trace", "write_trace", "evaluate_file", "evaluate_reference",
+    "MAX_FORMULA", "MAX_DEPTH", "MAX_TRACE_BYTES",
 ]
 
 Frame = Mapping[tuple[str, str], str]
@@ -438,10 +447,21 @@ def read_trace(path: str | Path) -> list[dict[tuple[str, str], str]]:
     """
     path = Path(path)
     try:
-        data = json.loads(path.read_text())
+        if not path.is_file():
+            raise TraceError(f"cannot read trace file {path}: " + (
+                "no such file" if not path.exists() else "not a regular file (a folder, device or pipe)"))
+        if path.stat().st_size > MAX_TRACE_BYTES:
+            raise TraceError(f"trace file {path} is larger than {MAX_TRACE_BYTES >> 20} MiB")
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except TraceError:
+        raise
     except OSError as err:
         raise TraceError(f"cannot read trace file {path}: {err.strerror or err}") from None
     except (json.JSONDecodeError, UnicodeDecodeError) as err:
+        raise TraceError(f"trace file {path} is not valid JSON: {err}") from None
+    except RecursionError:
+        raise TraceError(f"trace file {path} is nested deeper than the JSON parser allows") from None
+    except ValueError as err:  # e.g. an integer of more than 4,300 digits
         raise TraceError(f"trace file {path} is not valid JSON: {err}") from None
     if not isinstance(data, list):
         raise TraceError(f"trace file {path}: expected a JSON list of frames, "
@@ -457,12 +477,17 @@ def read_trace(path: str | Path) -> list[dict[tuple[str, str], str]]:
             if len(names) != 2 or not all(names):
                 raise TraceError(f'trace file {path}, frame {t}: key {key!r} is not two region '
                                  f'names joined by a comma, e.g. "F1,O"')
-            if rel not in _CODE:
+            if not isinstance(rel, str) or rel not in _CODE:
+                shown = repr(rel) if isinstance(rel, (str, int, float, bool)) and len(repr(rel)) < 60 else \
+                    f"(a {type(rel).__name__})"
                 raise TraceError(f"trace file {path}, frame {t}, pair {key!r}: unknown relation "
-                                 f"{rel!r}; the base relations are {', '.join(RELATIONS)}")
+                                 f"{shown}; the base relations are {', '.join(RELATIONS)}")
             if frame.get(names, rel) != rel:
                 raise TraceError(f"trace file {path}, frame {t}: pair {names} is given twice")
             frame[names] = rel
+        if path_consistency(frame) is None:
+            raise TraceError(f"trace file {path}, frame {t}: the relations contradict RCC-8's "
+                             "composition table (no arrangement of regions has them all)")
         frames.append(frame)
     return frames
 
@@ -494,13 +519,19 @@ def evaluate_file(formula: str | Formula, path: str | Path) -> np.ndarray:
     Raises
     ------
     FormulaError
-        The formula text does not parse.
+        The formula text does not parse (or exceeds :data:`MAX_FORMULA` characters or
+        :data:`MAX_DEPTH` nested operators).
     TraceError
-        The file is malformed or lacks a pair that the formula needs.
+        The file is missing, not a regular file, larger than :data:`MAX_TRACE_BYTES`,
+        malformed, empty, inconsistent with RCC-8's composition table in some frame, or lacks a
+        pair that the formula needs.
     """
     if isinstance(formula, str):
         formula = parse(formula)
-    return formula.evaluate(read_trace(path))
+    trace = read_trace(path)
+    if not trace:
+        raise TraceError(f"trace file {path} is empty: it holds no frame to evaluate the formula on")
+    return formula.evaluate(trace)
 
 
 # ------------------------------------------------------------------------ reference route
@@ -627,9 +658,19 @@ def _split_unary(word: str) -> tuple[list[str], str] | None:
 
 class _Parser:
     def __init__(self, text: str):
+        if len(text) > MAX_FORMULA:
+            raise FormulaError(f"the formula has {len(text)} characters, more than the limit of {MAX_FORMULA}")
         self.text = text
         self.tokens = _tokenize(text)
         self.pos = 0
+        self.depth = 0
+
+    def deeper(self) -> None:
+        """Count one more nested operator; refuse beyond :data:`MAX_DEPTH`."""
+        self.depth += 1
+        if self.depth > MAX_DEPTH:
+            raise FormulaError(f"the formula nests more than {MAX_DEPTH} operators (brackets, '!', "
+                               "temporal operators, or a chain of '->', U or S)")
 
     def peek(self) -> _Token:
         return self.tokens[self.pos]
@@ -658,6 +699,7 @@ class _Parser:
         left = self.disjunction()
         if self.peek().text == "->":
             self.take()
+            self.deeper()
             return Implies(left, self.implication())
         return left
 
@@ -680,6 +722,7 @@ class _Parser:
         tok = self.peek()
         if tok.kind == "word" and tok.text in _BINARY_OPS:
             self.take()
+            self.deeper()
             return _BINARY_OPS[tok.text](left, self.binary())
         return left
 
@@ -689,9 +732,11 @@ class _Parser:
             tok = self.peek()
             if tok.kind == "op" and tok.text == "!":
                 self.take()
+                self.deeper()
                 return Not(self.unary())
             if tok.kind == "op" and tok.text == "(":
                 self.take()
+                self.deeper()
                 f = self.implication()
                 self.expect(")", "')' closing the '(' at column " + str(tok.column))
                 return f
@@ -707,10 +752,13 @@ class _Parser:
         if word in _CODE:
             return self.atom(word)
         if word in _UNARY_OPS:
+            self.deeper()
             return _UNARY_OPS[word](self.unary())
         split = _split_unary(word)
         if split is not None:
             ops, rest = split
+            for _ in ops:
+                self.deeper()
             inner = self.unary(rest) if rest else self.unary()
             for op in reversed(ops):
                 inner = _UNARY_OPS[op](inner)

@@ -17,19 +17,35 @@ comparable across procedures -- with the id ``<name>-<tag>-0007`` (the procedure
 ``fingers``, ``regions`` (indices into the feasible regions list) and the procedure's own fields
 (``zone_depth`` for FormGrasp, ``cone_margin`` in radians for ForceGrasp). Each is then certified by :func:`qualgrasp.certify.certify_grasp`;
 a synthesised grasp that does not certify is a bug of the synthesis, and is reported, not dropped.
+
+Image resolution
+----------------
+A grasp certified on the contour the image gives may still rest on details the image cannot
+resolve (a FormGrasp grasp on a large disc closes only through the pixel contour's facets, which a
+disc does not have). :func:`resolution` bounds how far each generator wrench of the grasp can move
+under the image's own uncertainty: contact points known to a pixel (:data:`POSITION`), normals to
+``NORMAL / l`` radians where ``l`` is the length they are estimated over (the fitted line of a
+straight element, four smoothing standard deviations on a curve) and :data:`NORMAL` half a pixel
+of the contour's error across it. A contact force ``f`` rotated by
+``dtheta`` and moved by ``e`` changes its wrench by at most ``|f| sqrt(dtheta^2 + ((e + r dtheta) /
+L)^2)`` (``r`` the lever, ``L`` the length dividing torques), and a grasp whose L1 epsilon exceeds
+the largest such change keeps a ball of wrenches after any such change (the hull of the moved
+generators is within that distance of the hull): it is **resolved**. A grasp whose certified
+epsilon is below it is reported as not resolved by the image, not as a good grasp.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..certify import Contact, Grasp, Report, certify_grasp
+from ..certify.quality import epsilon
 from . import procedures as registry
 from .candidates import INSET, PER_REGION, STEP, Candidates, candidates, object_frame
 from .errors import SynthesisError
@@ -40,10 +56,17 @@ from .procedures import Procedure, SearchInput
 from .regions import ALPHA, FINGER_WIDTH, MARGIN as REGION_MARGIN, Region, feasible_regions
 from .vision import ImageSource
 
-__all__ = ["MU", "Synthesis", "synthesize", "to_grasp", "choose"]
+__all__ = ["MU", "POSITION", "NORMAL", "Synthesis", "synthesize", "to_grasp", "choose", "resolution"]
 
 MU = 0.5
 """Default friction coefficient of procedures with friction."""
+
+POSITION = 1.0
+"""Uncertainty of a contact point found in an image, pixels (the image's resolution)."""
+
+NORMAL = 0.5
+"""Error of the contour across the length a normal is estimated over, pixels: a normal estimated
+over ``l`` pixels is known to ``NORMAL / l`` radians."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -101,6 +124,13 @@ class Synthesis:
     certify_seconds: float
 
     @property
+    def resolved(self) -> tuple[bool, ...]:
+        """Per grasp: certified, and its certified L1 epsilon above the wrench change the image's
+        uncertainty can cause (:func:`resolution`; module notes)."""
+        return tuple(c and r.eps_l1 > g.meta["resolution"] for c, r, g in
+                     zip(self.certified, self.reports, self.grasps))
+
+    @property
     def certified(self) -> tuple[bool, ...]:
         """Per grasp: force closure certified (status ``closure`` and both certificates verified)."""
         return tuple(r.certified for r in self.reports)
@@ -123,6 +153,7 @@ class Synthesis:
             "mu": self.mu,
             "grasps": len(self.grasps),
             "certified": len(ok),
+            "resolved": sum(self.resolved),
             "certified_fraction": self.certified_fraction,
             "median_margin": float(np.median([r.force.margin for r in ok])) if ok else None,
             "median_eps_l1": float(np.median(eps)) if eps else None,
@@ -140,6 +171,49 @@ def to_grasp(found: Any, gid: str, center: np.ndarray, length: float, mu: float 
     meta = {"procedure": procedure.title, "fingers": len(contacts), "regions": list(found.regions),
             **procedure.meta(found)}
     return Grasp(contacts, center=tuple(float(v) for v in center), length=float(length), id=gid, meta=meta)
+
+
+def _certified(grasp: Grasp, quality: bool) -> Report:
+    """The grasp's report, with at least its L1 epsilon (needed to tell resolved grasps)."""
+    report = certify_grasp(grasp, quality=quality)
+    if quality:
+        return report
+    return replace(report, epsilons={"L1": epsilon(grasp, "L1", verdict=report.force)})
+
+
+def resolution(grasp: Grasp, spans) -> float:
+    """Largest change of any generator wrench of a planar ``grasp`` under the image's
+    uncertainty (module notes): every contact point within :data:`POSITION` pixels, every normal
+    within ``NORMAL / span`` radians, ``spans`` the length (pixels) each contact's normal is
+    estimated over. Unit-free, like the wrenches (torques divided by the grasp's ``length``).
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import Contact, Grasp
+    >>> g = Grasp((Contact((100, 0), (-1, 0)), Contact((-100, 0), (1, 0))), center=(0, 0), length=100)
+    >>> round(resolution(g, [50, 50]), 4)  # 0.01 rad on a lever of 100 px, and a pixel
+    0.0224
+    """
+    out = 0.0
+    c = np.asarray(grasp.center)
+    for contact, span in zip(grasp.contacts, spans):
+        turn = NORMAL / span
+        lever = float(np.linalg.norm(np.asarray(contact.p) - c))
+        force = math.sqrt(1 + contact.mu ** 2)  # the longest generator: a friction-cone edge
+        out = max(out, force * math.hypot(turn, (POSITION + lever * turn) / grasp.length))
+    return out
+
+
+def _spans(outline: Outline, regions, found) -> list[float]:
+    """Length over which each contact's normal is estimated (pixels): the fitted line of a
+    straight element, four smoothing standard deviations on a curve."""
+    sigma = outline.scale * outline.perimeter
+    out = []
+    for r in found.regions:
+        seg = outline.segments[regions[r].segment]
+        out.append(float(np.linalg.norm(seg.endpoints[1] - seg.endpoints[0])) if seg.symbol == "/"
+                   else 4 * sigma)
+    return out
 
 
 def choose(fingers: int | None = None, procedure: str | None = None) -> Procedure:
@@ -210,7 +284,8 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     certify : bool
         Certify every grasp (:func:`qualgrasp.certify.certify_grasp`).
     quality : bool
-        With ``certify``, compute the epsilon quality too.
+        With ``certify``, compute both epsilons (L1 and L-infinity); otherwise only the L1
+        epsilon, which tells resolved grasps (module notes).
     threshold, largest
         Segmentation (:func:`qualgrasp.qualitative.outline.outline_image`).
     finger_width, region_margin
@@ -261,10 +336,14 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     found = proc.search(SearchInput(cands, outline.contour, center, length, outline.size, theta_min,
                                     error, margin))
     stem = _name(image, name)
-    grasps = tuple(to_grasp(g, f"{stem}-{proc.tag}-{k:04d}", center, length, mu, proc)
-                   for k, g in enumerate(found))
+    grasps = []
+    for k, g in enumerate(found):
+        grasp = to_grasp(g, f"{stem}-{proc.tag}-{k:04d}", center, length, mu, proc)
+        grasp.meta["resolution"] = resolution(grasp, _spans(outline, regions, g))
+        grasps.append(grasp)
+    grasps = tuple(grasps)
     seconds = time.perf_counter() - start
     start = time.perf_counter()
-    reports = tuple(certify_grasp(g, quality=quality) for g in grasps) if certify else ()
+    reports = tuple(_certified(g, quality) for g in grasps) if certify else ()
     return Synthesis(stem, proc.fingers, proc, mu, theta_min, outline, regions, cands,
                      center, length, tuple(found), grasps, reports, seconds, time.perf_counter() - start)

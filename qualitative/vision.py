@@ -35,6 +35,7 @@ from typing import Union
 
 import cv2
 import numpy as np
+from PIL import Image
 from scipy import ndimage
 from skimage.filters import threshold_otsu
 
@@ -42,6 +43,8 @@ from .errors import ContourError, ImageError, SegmentationError
 
 __all__ = [
     "MIN_AREA",
+    "MAX_PIXELS",
+    "MAX_CONTOUR",
     "Segmentation",
     "read_image",
     "segment",
@@ -55,6 +58,41 @@ ImageSource = Union[str, Path, np.ndarray]
 
 MIN_AREA = 400
 """Smallest object, in pixels, that can be described (about 20 x 20 pixels)."""
+
+MAX_PIXELS = 40_000_000
+"""Largest image read, in pixels (about 6,300 x 6,300): a larger one is refused with a message
+saying how to downsample it (memory and time stay bounded)."""
+
+MAX_CONTOUR = 1_000_000
+"""Longest object contour described, in contour pixels: a longer one (a huge or very wiggly
+object) is refused with a message saying by how much to downsample the image."""
+
+
+def _header_size(path: Path) -> tuple[int, int] | None:
+    """``(width, height)`` from the file's header without decoding it (None when the format is
+    not known here; OpenCV's own decoder is then the check)."""
+    with path.open("rb") as fh:
+        head = fh.read(24)
+    if head.startswith(b"\x89PNG\r\n\x1a\n") and len(head) == 24:  # the IHDR chunk comes first
+        return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+    try:
+        with Image.open(path) as im:
+            return im.size
+    except Image.DecompressionBombError:  # Pillow refuses to open it: far beyond our own limit
+        return MAX_PIXELS, MAX_PIXELS
+    except (OSError, ValueError):
+        return None
+
+
+def _check_size(size, what: str) -> None:
+    if size is None:
+        return
+    width, height = int(size[0]), int(size[1])
+    if width * height > MAX_PIXELS:
+        factor = int(np.ceil(np.sqrt(width * height / MAX_PIXELS)))
+        raise ImageError(f"{what} is {width} x {height} pixels, more than the limit of {MAX_PIXELS:,} "
+                         f"(about 6,300 x 6,300): downsample it by {factor} or more, e.g. "
+                         f"`convert in.png -resize {100 // factor}% out.png` (ImageMagick)")
 
 _SPECK = 0.01
 """Connected components smaller than this fraction of the largest one are noise, not objects."""
@@ -119,15 +157,23 @@ def read_image(src: ImageSource) -> np.ndarray:
     if isinstance(src, (str, Path)):
         path = Path(src)
         if not path.is_file():
-            raise ImageError(f"no such image file: {path}")
-        raw = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+            raise ImageError(f"no such image file: {path}" if not path.exists() else
+                             f"{path} is not a regular file (a folder or a device)")
+        _check_size(_header_size(path), str(path))
+        try:
+            raw = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+        except cv2.error as err:
+            raise ImageError(f"cannot read {path} as an image ({str(err).strip().splitlines()[-1]})") from None
         if raw is None:
             raise ImageError(f"cannot read {path} as an image (OpenCV cannot decode it)")
+        _check_size(raw.shape[1::-1], str(path))
         grey = _to_grey(raw, bgr=True)
     else:
         array = np.asarray(src)
         if array.dtype == object or not (np.issubdtype(array.dtype, np.number) or array.dtype == bool):
             raise ImageError(f"expected a numeric image array, got dtype {array.dtype}")
+        if array.ndim >= 2:
+            _check_size(array.shape[1::-1] if array.ndim == 2 else array.shape[1::-1][-2:], "the image array")
         grey = _to_grey(array, bgr=False)
     if grey.size == 0:
         raise ImageError(f"empty image (shape {grey.shape})")
@@ -288,16 +334,20 @@ def refine_contour(contour: np.ndarray, seg: Segmentation, level: float | None =
     contour = contour - (x0, y0)
     outward = -_inward_normals(contour, 2.0)
     offsets = np.arange(-reach, reach + step / 2, step)
-    xy = contour[:, None, :] + offsets[None, :, None] * outward[:, None, :]
-    profile = ndimage.map_coordinates(level, [xy[..., 1].ravel(), xy[..., 0].ravel()], order=1,
-                                      mode="nearest").reshape(xy.shape[:2])
-    g0, g1 = profile[:, :-1], profile[:, 1:]
-    crossing = (g0 > 0) & (g1 <= 0)  # leaving the object, going outward
-    where = offsets[:-1] + step * g0 / np.where(crossing, g0 - g1, 1.0)
-    score = np.where(crossing, np.abs(where - 0.5), np.inf)
-    best = np.argmin(score, axis=1)
-    index = np.arange(len(contour))
-    distance = np.where(np.isfinite(score[index, best]), where[index, best], 0.5)
+    distance = np.empty(len(contour))
+    block = 1 << 15  # points per block: memory stays bounded whatever the contour's length
+    for k in range(0, len(contour), block):
+        c, o = contour[k:k + block], outward[k:k + block]
+        xy = c[:, None, :] + offsets[None, :, None] * o[:, None, :]
+        profile = ndimage.map_coordinates(level, [xy[..., 1].ravel(), xy[..., 0].ravel()], order=1,
+                                          mode="nearest").reshape(xy.shape[:2])
+        g0, g1 = profile[:, :-1], profile[:, 1:]
+        crossing = (g0 > 0) & (g1 <= 0)  # leaving the object, going outward
+        where = offsets[:-1] + step * g0 / np.where(crossing, g0 - g1, 1.0)
+        score = np.where(crossing, np.abs(where - 0.5), np.inf)
+        best = np.argmin(score, axis=1)
+        index = np.arange(len(c))
+        distance[k:k + block] = np.where(np.isfinite(score[index, best]), where[index, best], 0.5)
     return contour + distance[:, None] * outward + (x0, y0)
 
 
@@ -335,6 +385,10 @@ def extract_contour(src: ImageSource, threshold: float | None = None, largest: b
     contour = max(found, key=len)[:, 0, :].astype(np.float64)
     if len(contour) < 8:
         raise ContourError(f"degenerate contour of {len(contour)} points")
+    if len(contour) > MAX_CONTOUR:
+        factor = int(np.ceil(len(contour) / MAX_CONTOUR))
+        raise ContourError(f"the object's contour has {len(contour):,} pixels, more than the limit of "
+                           f"{MAX_CONTOUR:,}: downsample the image by {factor} or more")
     if signed_area(contour) < 0:
         contour = contour[::-1].copy()
     if subpixel:

@@ -1,4 +1,3 @@
-import numpy as np
 from hypothesis import settings
 
 settings.register_profile("ci", deadline=None, max_examples=60, derandomize=True)

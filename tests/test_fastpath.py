@@ -1,9 +1,6 @@
 """The columnar fast path gives, row for row, what the per-grasp path gives."""
 
-import json
 
-import numpy as np
-import pyarrow as pa
 import pytest
 
 from qualgrasp.certify import Contact, Grasp
@@ -12,7 +9,6 @@ from qualgrasp.certify.chunk import Options, certify_values
 from qualgrasp.certify.table import table_values
 from qualgrasp.certify.fastpath import certify_table
 from qualgrasp.certify.grasp import grasp_to_dict
-from qualgrasp.certify.io import write_rows
 from qualgrasp.certify.samples import random_grasp_table, random_grasps, textbook_grasps
 from qualgrasp.certify.table import grasps_table, rows_to_table, table_to_rows
 

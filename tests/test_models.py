@@ -9,7 +9,6 @@ different code path: point generators at shifted positions, not the pad's own la
 import math
 
 import numpy as np
-import pyarrow as pa
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st

@@ -1,6 +1,5 @@
 """Two-finger grasps: the LP and the SOCP against Nguyen's condition (independent geometry)."""
 
-import numpy as np
 import pytest
 
 from qualgrasp.certify import Contact, Grasp, force_closure, verify

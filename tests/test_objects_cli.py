@@ -151,7 +151,7 @@ def test_regions_command(images, tmp_path):
     (["regions", "missing.png"], "no such image file"),
     (["outline", "TEXT"], "cannot read"),
     (["outline", "TWO"], "found 2 objects"),
-    (["regions", "DISC", "--finger-width", "0"], "finger_width"),
+    (["regions", "DISC", "--finger-width", "0"], "--finger-width"),  # the flag, in its units (issue 17)
 ])
 def test_command_errors(images, args, message):
     args = [str(images[a.lower()]) if a.isupper() else a for a in args]

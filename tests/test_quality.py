@@ -13,7 +13,7 @@ from scipy.spatial import ConvexHull
 from qualgrasp.certify import Contact, Grasp, force_closure
 from qualgrasp.certify.quality import epsilon, epsilon_linearised
 from qualgrasp.certify.samples import random_grasp, random_grasps
-from qualgrasp.certify.steinitz import boundary_epsilon, efficiency, steinitz_bound
+from qualgrasp.certify.steinitz import efficiency, steinitz_bound
 from helpers import rotation
 
 
