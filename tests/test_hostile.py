@@ -140,6 +140,27 @@ def test_generated_lines_give_one_row_each(values):
             assert {k: row[k] for k in expected} == expected
 
 
+@settings(max_examples=8, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
+                                                 HealthCheck.function_scoped_fixture], deadline=None)
+@given(st.lists(st.one_of(grasps, json_values), min_size=20, max_size=20),
+       st.sampled_from([b"\n", b"\r\n", b"\r"]))
+def test_generated_files_through_the_command_line(tmp_path, values, end):
+    """The same contract through ``qualgrasp certify`` and ``qualgrasp verify``: one row per line
+    in order, exit 1 exactly when a row is an error, and the untampered results verify."""
+    folder = tmp_path / f"run{len(list(tmp_path.iterdir()))}"
+    folder.mkdir()
+    path, out = folder / "g.jsonl", folder / "r.jsonl"
+    path.write_bytes(end.join(_line(v) for v in values) + end)
+    result = runner.invoke(app, ["certify", str(path), "-o", str(out), "-q", "--no-quality", "--workers", "1"])
+    rows = _rows(out)
+    assert [r["line"] for r in rows] == list(range(1, 21))
+    errors = any(r["status"] == "error" or not r["verified"] for r in rows)
+    assert result.exit_code == (1 if errors else 0), result.output
+    assert result.exception is None or isinstance(result.exception, SystemExit)
+    result = runner.invoke(app, ["verify", str(out), "--grasps", str(path), "--workers", "1"])
+    assert result.exit_code == 0 and result.exception is None, result.output
+
+
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.data())
 def test_generated_arrow_layouts_give_one_row_each(data):
