@@ -27,7 +27,7 @@ from .certificates import Certificate, Tolerances
 from .errors import GraspError, SolverError
 from .grasp import Grasp
 from ._kernels.cones import farkas_direction
-from ._kernels.linalg import null_direction, pivot_basis, world_values
+from ._kernels.linalg import null_direction, pivot_basis
 from .problem import ClosureProblem, block_arrays, grasp_problem, grasp_system, span_problem, span_system
 from .solvers import make_solver
 
@@ -71,7 +71,8 @@ def decide(problem: ClosureProblem, exact_columns, solver,
     """
     C, blocks, layout = problem.system
     d, k = C.shape
-    U, sv, _ = np.linalg.svd(C)
+    # U spans the wrench space (d x d); V (k x k) is never needed, and too big at many contacts
+    U, sv, _ = np.linalg.svd(C, full_matrices=k < d)
     thin = k < d or sv[-1] <= tol.rank * sv[0]
     sol = None
     if k >= d:  # fewer columns than rows: rank-deficient, nothing to solve
@@ -81,7 +82,7 @@ def decide(problem: ClosureProblem, exact_columns, solver,
             if not thin:
                 raise  # solvers may fail on rank-deficient data; there the rank decides below
     if sol is not None and not thin and sol.status == "optimal" and sol.t >= tol.margin:
-        values = world_values(problem.to_values[None], sol.x[None])[0]
+        values = problem.values(sol.x)
         basis = pivot_basis(np.ascontiguousarray(C, dtype=float))
         cert = Certificate("interior", layout, _floats(values), tuple(int(j) for j in basis))
         return Verdict("closure", float(sol.t), cert)
@@ -96,7 +97,7 @@ def decide(problem: ClosureProblem, exact_columns, solver,
                                tight=tuple(range(len(blocks))), null_space=True)
             return Verdict("no_closure", 0.0, cert)
         return Verdict("degenerate", 0.0, Certificate("degenerate", layout, reason="rank"))
-    values = None if sol.x is None else _floats(problem.to_values @ sol.x)
+    values = None if sol.x is None else _floats(problem.values(sol.x))
     y = None if sol.y is None else _floats(sol.y / np.linalg.norm(sol.y))
     return Verdict("degenerate", 0.0,
                    Certificate("degenerate", layout, values, y=y, reason="margin"))

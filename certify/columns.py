@@ -2,7 +2,8 @@
 
 :func:`grasp_columns` reads an Arrow grasp table (Parquet, or an in-memory table), and
 :func:`value_columns` a list of parsed JSON values, into the same :class:`GraspColumns`: one row
-per grasp, contacts padded to the largest count, every rule of
+per grasp, contacts kept flat (padded only for the rows of one contact pattern, so one row with
+many contacts costs its own size, not the chunk's), every rule of
 :mod:`qualgrasp.certify.validation` applied once, vectorised, with its messages. The columnar
 kernels take the valid rows from the arrays; :meth:`GraspColumns.grasps` builds
 :class:`qualgrasp.certify.Grasp` objects of any valid rows for the per-grasp route, and
@@ -36,22 +37,17 @@ __all__ = ["GraspColumns", "grasp_columns", "value_columns", "extra_columns"]
 
 @dataclass
 class GraspColumns:
-    """Checked grasps as padded arrays (``m`` = the most contacts of a row).
+    """Checked grasps as columns; contacts flat, in row order.
 
     Attributes
     ----------
     checked : CheckedGrasps
-        The validation's output (errors, stored values, flattened contacts).
+        The validation's output (errors, stored values, flattened contacts with the rows'
+        ``offsets``).
     ok : (n,) bool
         Valid rows.
     dim, count : (n,) int
         Coordinates (2 or 3) and number of contacts.
-    P, N : (n, m, 3) float
-        Points and stored normals; the third coordinate is 0 for planar rows; padding is 0.
-    params : dict of str to (n, m) float
-        Model parameters (0 where a model does not take one, and in padding).
-    model, variant : (n, m) int
-        Effective model codes and variants, -1 for padding.
     center : (n, 3) float
     length : (n,) float
     ids : list or pyarrow.Array
@@ -64,15 +60,24 @@ class GraspColumns:
     ok: np.ndarray
     dim: np.ndarray
     count: np.ndarray
-    P: np.ndarray
-    N: np.ndarray
-    params: dict
-    model: np.ndarray
-    variant: np.ndarray
     center: np.ndarray
     length: np.ndarray
     ids: Any
     meta: list | None = None
+
+    def contacts(self, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict]:
+        """Points ``P`` and stored normals ``N`` (``(B, m, 3)``, the third coordinate 0 for
+        planar rows) and model parameters (``(B, m)`` each, 0 where a model does not take one)
+        of ``rows``, which must all have ``m`` contacts (one contact pattern)."""
+        rows = np.asarray(rows)
+        m = int(self.count[rows[0]]) if len(rows) else 0
+        if len(rows) and not (self.count[rows] == m).all():
+            raise ValueError("contacts(rows) takes rows with the same number of contacts")
+        index = (self.checked.offsets[rows][:, None] + np.arange(m)).ravel()
+        c = self.checked.contacts
+        B = len(rows)
+        return (c.p[index].reshape(B, m, 3), c.n[index].reshape(B, m, 3),
+                {name: values[index].reshape(B, m) for name, values in c.params.items()})
 
     def message(self, i: int) -> str | None:
         """The error of row ``i`` (None when valid)."""
@@ -101,48 +106,34 @@ class GraspColumns:
         and each contact's model and variant (the key of the columnar kernels); -1 for invalid
         rows."""
         n = len(self.ok)
-        if not self.ok.any():
-            return np.full(n, -1)
-        key = np.concatenate([self.dim[:, None], self.count[:, None], self.model * 8 + self.variant], axis=1)
-        _, label = np.unique(key[self.ok], axis=0, return_inverse=True)
         out = np.full(n, -1)
-        out[self.ok] = label.ravel()
+        c, offsets = self.checked.contacts, self.checked.offsets
+        ok = np.flatnonzero(self.ok)
+        next_label = 0
+        shapes = np.stack([self.dim[ok], self.count[ok]], axis=1)
+        for shape in np.unique(shapes, axis=0):
+            rows = ok[(shapes == shape).all(axis=1)]
+            index = (offsets[rows][:, None] + np.arange(int(shape[1]))).ravel()
+            key = (c.model[index] * 8 + c.variant[index]).reshape(len(rows), int(shape[1]))
+            _, label = np.unique(key, axis=0, return_inverse=True)
+            out[rows] = next_label + label.ravel()
+            next_label += int(label.max()) + 1 if len(label) else 0
         return out
 
     def models_of(self, row: int) -> tuple[str, ...]:
         """Model names of the contacts of ``row``."""
-        return tuple(registry.get(int(c)).name for c in self.model[row, : self.count[row]])
+        a = self.checked.offsets[row]
+        return tuple(registry.get(int(code)).name for code in self.checked.contacts.model[a:a + self.count[row]])
 
     def variants_of(self, row: int) -> tuple[int, ...]:
-        return tuple(int(v) for v in self.variant[row, : self.count[row]])
+        """Model variants of the contacts of ``row``."""
+        a = self.checked.offsets[row]
+        return tuple(int(v) for v in self.checked.contacts.variant[a:a + self.count[row]])
 
 
-def _padded(checked: CheckedGrasps, count: np.ndarray, ids: list, meta) -> GraspColumns:
-    n = len(count)
-    c = checked.contacts
+def _columns(checked: CheckedGrasps, count: np.ndarray, ids: list, meta) -> GraspColumns:
     ok = checked.error == None  # noqa: E711  (elementwise)
-    m = int(count.max()) if n else 0
-    total = int(checked.offsets[-1])
-    row = np.repeat(np.arange(n), count)
-    slot = np.arange(total) - np.repeat(checked.offsets[:-1], count)
-    P = np.zeros((n, m, 3))
-    N = np.zeros((n, m, 3))
-    model = np.full((n, m), -1, dtype=np.int64)
-    variant = np.full((n, m), -1, dtype=np.int64)
-    params = {name: np.zeros((n, m)) for name in c.params}
-    if n and total == n * m:  # the common, uniform case
-        P[:], N[:] = c.p.reshape(n, m, 3), c.n.reshape(n, m, 3)
-        model[:], variant[:] = c.model.reshape(n, m), c.variant.reshape(n, m)
-        for name, values in c.params.items():
-            params[name][:] = values.reshape(n, m)
-    else:
-        P[row, slot], N[row, slot] = c.p, c.n
-        model[row, slot], variant[row, slot] = c.model, c.variant
-        for name, values in c.params.items():
-            params[name][row, slot] = values
-    model[~ok] = -1
-    return GraspColumns(checked, ok, checked.dim, np.asarray(count), P, N, params, model, variant,
-                        checked.center, checked.length, ids, meta)
+    return GraspColumns(checked, ok, checked.dim, np.asarray(count), checked.center, checked.length, ids, meta)
 
 
 def value_columns(values: Sequence[Any]) -> GraspColumns:
@@ -153,7 +144,7 @@ def value_columns(values: Sequence[Any]) -> GraspColumns:
     for i, err in failed.items():
         data.errors[i] = str(err)
     checked = check_grasps(data, contacts)
-    return _padded(checked, data.count, data.ids, data.meta)
+    return _columns(checked, data.count, data.ids, data.meta)
 
 
 # --- Arrow --------------------------------------------------------------------------------------
@@ -324,9 +315,13 @@ def grasp_columns(table: pa.Table) -> GraspColumns:
             offsets, flat, valid = lists
             data.count = np.diff(offsets)
             _type_error(data, ~valid, "contacts: missing (a grasp needs a 'contacts' list)")
-            for i in np.flatnonzero(data.count > MAX_CONTACTS):
+            over = data.count > MAX_CONTACTS
+            for i in np.flatnonzero(over):
                 data.errors[i] = data.errors[i] or (f"contacts: {data.count[i]} contacts, more than the "
                                                     f"limit of {MAX_CONTACTS}")
+            if over.any():  # as the JSON reader does: such a row's contacts are not read
+                flat = flat.filter(pa.array(np.repeat(~over, data.count)))
+                data.count = np.where(over, 0, data.count)
             contacts = _arrow_contacts(flat)
     if contacts is None:
         data.count[:] = 0
@@ -355,7 +350,7 @@ def grasp_columns(table: pa.Table) -> GraspColumns:
         for i in np.flatnonzero(np.asarray(unreadable.is_valid(), dtype=bool)):
             data.errors[i] = unreadable[i].as_py()
     checked = check_grasps(data, contacts)
-    return _padded(checked, data.count, ids, None)
+    return _columns(checked, data.count, ids, None)
 
 
 def extra_columns(table: pa.Table) -> list[str]:

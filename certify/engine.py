@@ -109,7 +109,7 @@ def _finish(results, part: Path) -> tuple[dict[str, int], int]:
     return status_counts([r["status"] for r in results], [r["verified"] for r in results])
 
 
-def _partstatus_counts(part: Path) -> tuple[dict[str, int], int]:
+def _part_counts(part: Path) -> tuple[dict[str, int], int]:
     if part.suffix == ".arrow":
         t = _read_part(part)
         return status_counts(t.column("status"), t.column("verified"))
@@ -339,7 +339,7 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
             n_chunks += 1
             part = parts / _part_name(chunk.index, results)
             if part.exists():
-                summary.add(*_partstatus_counts(part))
+                summary.add(*_part_counts(part))
                 summary.resumed_chunks += 1
             elif pool is None:
                 _, counts, unverified = certify_chunk(chunk, options, str(part))

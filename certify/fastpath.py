@@ -21,7 +21,6 @@ the per-grasp path, so the two agree by construction.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from math import comb
 
 import numpy as np
 import pyarrow as pa
@@ -209,11 +208,15 @@ def planar_screen(P, N, mu, center, length, *, quality: bool = True,
 def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances):
     """Certify the planar grasps ``rows`` (one contact pattern) with :func:`planar_batch`;
     return the settled rows and their result columns."""
-    m = int(cols.count[rows[0]])
+    models, variants = cols.models_of(rows[0]), cols.variants_of(rows[0])
+    sizes = [len(generator_layout(models, variants, 2, frictionless=f)[0]) for f in (False, True)]
+    if not all(FastSolver.enumerates(k, 3) for k in sizes):
+        # the per-grasp fast route solves these by the barrier method: both routes give its rows
+        return np.zeros(len(rows), dtype=bool), {}
+    P, N, params = cols.contacts(rows)
     (code, t, lam, basis, y, code_f, t_f, lam_f, basis_f, y_f, eps) = _planar_kernel(
-        cols.P[rows, :m, :2], cols.N[rows, :m, :2], cols.params["mu"][rows, :m],
-        cols.params["width"][rows, :m], cols.center[rows, :2], cols.length[rows],
-        cols.models_of(rows[0]), cols.variants_of(rows[0]), tol, options.quality)
+        P[:, :, :2], N[:, :, :2], params["mu"], params["width"], cols.center[rows, :2], cols.length[rows],
+        models, variants, tol, options.quality)
     settled = (code > 0) & (code_f > 0)
     out = {"force": (code, t, lam, basis, y), "form": (code_f, t_f, lam_f, basis_f, y_f)}
     if options.quality:
@@ -278,7 +281,7 @@ def _polyhedral(P, N, c, L, options, tol: Tolerances):
     W, _ = generator_columns(P, N, zeros, models, c, L, frictionless=True, variants=(0,) * m)
     W = np.ascontiguousarray(W)  # (B, 6, m): one ray per contact, as barrier_arrays lays it out
     E = force_column_errors(P, N, models, c, L)
-    if comb(m, 2 * d) <= FastSolver.max_bases:
+    if FastSolver.enumerates(m, 2 * d):
         return _polyhedral_rows(P, N, c, L, W, E, options, tol)
     status, t, y, xn, _ = barrier_batch(np.ascontiguousarray(np.swapaxes(W, 1, 2)),
                                         np.zeros((B, m, 1, 2 * d)), np.zeros(m, dtype=np.int64),
@@ -320,16 +323,22 @@ def _block_arrays_of(models, N, mu, params):
     return cone, first, width, np.ascontiguousarray(N), np.ascontiguousarray(mu), g
 
 
+SPATIAL_CONTACTS = 16
+"""Most contacts of a spatial grasp certified on the columnar path."""
+
+
 def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances):
     """Certify the spatial grasps ``rows`` (one contact pattern with friction): force closure
     by the compiled dual barrier method, form closure by the null-space direction (fewer than 6
     contacts) or the enumerated LP, every certificate re-checked in floating point with error
     bounds. Rows these rules do not settle (thin, near the boundary, tight contacts, unproved,
-    or needing the spatial epsilon) are left to the per-grasp path."""
+    or needing the spatial epsilon) are left to the per-grasp path, and so are grasps of more
+    than :data:`SPATIAL_CONTACTS` contacts (the batch arrays grow with their square)."""
     m = int(cols.count[rows[0]])
+    if m > SPATIAL_CONTACTS:
+        return np.zeros(len(rows), dtype=bool), {}
     models = cols.models_of(rows[0])
-    P, N = cols.P[rows, :m, :], cols.N[rows, :m, :]
-    params = {name: values[rows, :m] for name, values in cols.params.items()}
+    P, N, params = cols.contacts(rows)
     mu, c, L = params["mu"], cols.center[rows], cols.length[rows]
     B = len(rows)
     if all(name == "frictionless" for name in models):  # force closure is form closure
@@ -453,10 +462,13 @@ def _tight_shift(C, E, owner, mask, models, P, y) -> float:
     points, ``(e_j, (p_i - c) x e_j / L)``, have rank exactly 5 for any data: the map
     ``(a, b) -> (a + b, (r_1 x a + r_2 x b) / L)`` has kernel ``{(a, -a) : a || r_1 - r_2}``. So
     their span is that of any 5 of them proved independent, which floats can bound. Other tight
-    sets go to the exact checker."""
+    sets go to the exact checker. "Point contact" here is any model whose columns are the three
+    world-axis forces and no moments (:attr:`~qualgrasp.certify.models.ContactModel.forces`,
+    ``extra``)."""
     tight = np.flatnonzero(mask)
     cols = np.flatnonzero(mask[owner])
-    if len(tight) == 2 and all(models[b] == "point" for b in tight) and \
+    spec = [registry.get(models[b]) for b in tight]
+    if len(tight) == 2 and all(m.forces == "axes" and not m.extra for m in spec) and \
             not np.array_equal(P[tight[0]], P[tight[1]]):
         for drop in range(len(cols)):
             keep = np.delete(cols, drop)
@@ -464,7 +476,7 @@ def _tight_shift(C, E, owner, mask, models, P, y) -> float:
             if np.isfinite(bound):
                 return bound
         return np.inf
-    if len(tight) == 1 and models[tight[0]] != "soft":
+    if len(tight) == 1 and not spec[0].extra:
         return projection_bound(np.ascontiguousarray(C[:, cols]), np.ascontiguousarray(E[:, cols]), y)
     return np.inf
 

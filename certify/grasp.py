@@ -25,7 +25,7 @@ read from JSON and columns read from Parquet alike.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 import numpy as np
@@ -236,17 +236,6 @@ class Grasp:
     def frictionless(self) -> bool:
         """True when every contact is frictionless (form and force closure coincide)."""
         return all(c.model == "frictionless" for c in self.contacts)
-
-    def as_frictionless(self) -> "Grasp":
-        """The same grasp with friction ignored at every contact (for form closure): each
-        contact becomes its model's frictionless counterpart (a pad stays a pad with ``mu = 0``)."""
-        contacts = []
-        for c in self.contacts:
-            model, overrides, _ = c.contact_model.frictionless()
-            params = {k: v for k, v in c.params if k in registry.get(model).param_names}
-            params.update(overrides)
-            contacts.append(Contact(c.p, c.n, model, **params))
-        return replace(self, contacts=tuple(contacts))
 
 
 def grasps_from_checked(checked: CheckedGrasps, rows, ids=None, meta=None) -> list[Grasp]:

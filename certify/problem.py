@@ -23,9 +23,11 @@ from fractions import Fraction
 from typing import Any, NamedTuple, Sequence
 
 import numpy as np
+import scipy.sparse as sp
 
 from .grasp import Grasp
 from . import models as registry
+from ._kernels.linalg import world_values
 from .cones import cone_code
 from .wrench import (contact_frame, force_columns, generator_columns, grasp_arrays, tangent,
                      to_exact, variants_of, wrench)
@@ -82,8 +84,10 @@ class ClosureProblem:
     cones : tuple of (start, size, kappa)
         Second-order cone blocks; ``x[start]`` is the normal force, the next ``size - 1`` entries
         the tangential forces (and the scaled torsional moment).
-    to_values : ndarray, shape (ncert, nvar)
-        Linear map from ``x`` to the certificate's values (world-frame forces).
+    to_values : ndarray or scipy.sparse.csr_array, shape (ncert, nvar)
+        Linear map from ``x`` to the certificate's values (world-frame forces): block diagonal,
+        stored sparse for one grasp (its size grows with the square of the contacts); see
+        :meth:`values`.
     system : System
         The float certificate system (for polyhedral problems its columns are ``columns``).
     """
@@ -91,8 +95,17 @@ class ClosureProblem:
     columns: np.ndarray
     rays: tuple[int, ...]
     cones: tuple[tuple[int, int, float], ...]
-    to_values: np.ndarray
+    to_values: Any
     system: System
+
+    def values(self, x: np.ndarray) -> np.ndarray:
+        """The certificate's values ``to_values @ x``, each summed in variable order as
+        :func:`qualgrasp.certify._kernels.linalg.world_values` sums the columnar batch (the
+        zeros a sparse map skips add nothing), so both routes state the same values."""
+        x = np.asarray(x, dtype=float)
+        if sp.issparse(self.to_values):
+            return np.asarray(self.to_values @ x, dtype=float)
+        return world_values(np.ascontiguousarray(self.to_values)[None], x[None])[0]
 
     @property
     def d(self) -> int:
@@ -120,7 +133,7 @@ def span_problem(vectors) -> ClosureProblem:
     """Positive spanning of the rows of ``vectors`` (shape ``(k, d)``): every row is a ray."""
     system = span_system(vectors)
     k = system.columns.shape[1]
-    return ClosureProblem(system.columns, tuple(range(k)), (), np.eye(k), system)
+    return ClosureProblem(system.columns, tuple(range(k)), (), sp.identity(k, format="csr"), system)
 
 
 def is_polyhedral(grasp: Grasp, frictionless: bool = False, socp: bool = False) -> bool:
@@ -153,7 +166,7 @@ def grasp_problem(grasp: Grasp, *, frictionless: bool = False, socp: bool = Fals
     system = grasp_system(grasp, frictionless=frictionless, socp=socp)
     if system.layout == "generators":
         k = system.columns.shape[1]
-        return ClosureProblem(system.columns, tuple(range(k)), (), np.eye(k), system)
+        return ClosureProblem(system.columns, tuple(range(k)), (), sp.identity(k, format="csr"), system)
     P, N, mu, params, c, L = grasp_arrays(grasp)
     models = tuple(contact.model for contact in grasp.contacts)
     columns, rays, cones, to_values = conic_columns(P, N, params, models, c, L)
@@ -179,7 +192,8 @@ def conic_columns(P, N, params, models, center, length):
         and tangential forces of the contact frame ``(n, t1, t2)`` (``(n, t)`` in the plane) and,
         per moment of the model (a soft finger's torsion), the scaled moment ``m / g``.
     to_values : array, shape (..., ncert, nvar)
-        Map from the variables to the certificate's world-frame values (forces, moments).
+        Map from the variables to the certificate's world-frame values (forces, moments):
+        dense for a batch, a sparse block-diagonal ``scipy.sparse.csr_array`` for one grasp.
     rays, cones : tuple
         As :class:`ClosureProblem` (the structure, shared by the batch).
     """
@@ -215,7 +229,7 @@ def conic_columns(P, N, params, models, center, length):
         cones.append((start, len(cols) - start, params["mu"][..., i]))
         blocks.append(frame)
     columns = np.stack(cols, axis=-1)
-    to_values = _block_diag(blocks, batch)
+    to_values = _block_diag(blocks, batch) if batch else sp.block_diag(blocks, format="csr")
     if not batch:
         cones = [(start, size, float(k)) for start, size, k in cones]
     return columns, tuple(rays), tuple(cones), to_values

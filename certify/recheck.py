@@ -71,9 +71,8 @@ def _group_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, tol: Tole
     m = int(cols.count[rows[0]])
     dim = int(cols.dim[rows[0]])
     models, variants = cols.models_of(rows[0]), cols.variants_of(rows[0])
-    P = np.ascontiguousarray(cols.P[rows, :m, :dim])
-    N = np.ascontiguousarray(cols.N[rows, :m, :dim])
-    params = {name: np.ascontiguousarray(values[rows, :m]) for name, values in cols.params.items()}
+    P, N, params = cols.contacts(rows)
+    P, N = np.ascontiguousarray(P[:, :, :dim]), np.ascontiguousarray(N[:, :, :dim])
     mu = params["mu"]
     c, L = np.ascontiguousarray(cols.center[rows, :dim]), np.ascontiguousarray(cols.length[rows])
     cert = res.column("certificate").combine_chunks()

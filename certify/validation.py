@@ -23,9 +23,12 @@ Rules and documented limits
   means nothing). Reductions then apply (``mu = 0``: frictionless; a pad of width 0: point).
 * A grasp has 1 to :data:`MAX_CONTACTS` contacts of one dimension; ``center`` (optional) has
   that many finite coordinates, at most ``MAX_LENGTH`` in absolute value; ``length``
-  (optional) is a finite number in ``[MIN_LENGTH, MAX_LENGTH]``. Defaults: ``center`` the
+  (optional) is a finite number in ``[MIN_LENGTH, MAX_GRASP_LENGTH]``. Defaults: ``center`` the
   centroid of the contact points (their sum in contact order over their count), ``length`` the
-  largest distance from ``center`` to a contact point, or 1 when that is 0.
+  largest distance from ``center`` to a contact point, or 1 when the contacts coincide (up to
+  the rounding of their centroid); a default length
+  outside ``[MIN_LENGTH, MAX_GRASP_LENGTH]`` is an error (the contacts are too close together
+  for the tolerances: give ``length`` or rescale), so a grasp's results always read back.
 * ``id`` (optional) is a string or an integer.
 * Other keys of a contact are ignored; other top-level keys of a grasp are kept (``meta``).
 """
@@ -393,6 +396,21 @@ class CheckedGrasps:
     offsets: np.ndarray
 
 
+MAX_GRASP_LENGTH = 4 * MAX_LENGTH
+"""Largest ``length`` (given or default): about the largest distance between a center and a
+point whose coordinates are within ``MAX_LENGTH`` (``2 sqrt(3) MAX_LENGTH``)."""
+
+
+def _reach(d: np.ndarray) -> np.ndarray:
+    """Euclidean norms of the rows of ``d``, scaled so that neither tiny nor huge coordinates
+    underflow or overflow (0 for rows that are not finite)."""
+    scale = np.abs(d).max(axis=1) if d.size else np.zeros(len(d))
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        safe = np.where(scale > 0, scale, 1.0)
+        norm = scale * np.sqrt(((d / safe[:, None]) ** 2).sum(axis=1))
+    return np.where(np.isfinite(norm), norm, 0.0)
+
+
 def check_grasps(data: GraspData, contacts: ContactData) -> CheckedGrasps:
     """Apply the grasp and contact value rules (module docstring); one message per bad grasp."""
     return grasp_rules(data, check_contacts(contacts))
@@ -437,9 +455,9 @@ def grasp_rules(data: GraspData, checked: Checked) -> CheckedGrasps:
         fail(given & ~finite, lambda i: f"center: NaN or infinite coordinate, or one beyond {MAX_LENGTH:g}: "
                                         f"expected {dim[i]} finite numbers, got {show(data.raw.get((i, 'center')))}")
         L = data.length
-        fail(data.length_given & ~((L >= MIN_LENGTH) & (L <= MAX_LENGTH)),
+        fail(data.length_given & ~((L >= MIN_LENGTH) & (L <= MAX_GRASP_LENGTH)),
              lambda i: f"length: length must be > 0 (at least {MIN_LENGTH:g}), finite and <= "
-                       f"{MAX_LENGTH:g}, got {show(data.raw.get((i, 'length'), L[i]))}")
+                       f"{MAX_GRASP_LENGTH:g}, got {show(data.raw.get((i, 'length'), L[i]))}")
     ok = todo
     center = data.center.copy()
     length = data.length.copy()
@@ -451,13 +469,19 @@ def grasp_rules(data: GraspData, checked: Checked) -> CheckedGrasps:
         center[need_c] = sums[need_c] / np.maximum(data.count[need_c], 1)[:, None]
     need_l = ok & ~data.length_given
     if need_l.any():
-        with np.errstate(invalid="ignore", over="ignore"):
-            reach = np.sqrt(((checked.p - center[owner]) ** 2).sum(axis=1))
-        reach = np.where(np.isfinite(reach), reach, 0.0)
-        far = np.zeros(g)
+        far, size = np.zeros(g), np.zeros(g)
         has = data.count > 0
         if has.any():
-            far[has] = np.maximum.reduceat(reach, offsets[:-1][has])
-        length[need_l] = np.where(far[need_l] > 0, far[need_l], 1.0)
+            far[has] = np.maximum.reduceat(_reach(checked.p - center[owner]), offsets[:-1][has])
+            with np.errstate(invalid="ignore"):
+                size[has] = np.maximum.reduceat(np.nan_to_num(np.abs(checked.p)).max(axis=1), offsets[:-1][has])
+        # contacts that coincide up to the rounding of their centroid: no lever arm to scale
+        apart = far > 8 * 2.0**-53 * size
+        length[need_l] = np.where(apart[need_l], far[need_l], 1.0)
+        with np.errstate(invalid="ignore"):
+            fail(need_l & ~((length >= MIN_LENGTH) & (length <= MAX_GRASP_LENGTH)),
+                 lambda i: f"contacts: the contacts lie within {length[i]:.3g} of the center, outside the "
+                           f"usable range [{MIN_LENGTH:g}, {MAX_GRASP_LENGTH:g}] of the length that divides "
+                           "torques: give 'length' or rescale the coordinates")
     return CheckedGrasps(error, np.where(ok, dim, 0), np.where(ok[:, None], center, 0.0),
                          np.where(ok, length, 1.0), checked, offsets)

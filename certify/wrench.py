@@ -16,12 +16,14 @@ from typing import Sequence
 import numpy as np
 
 from . import models as registry
+from ._kernels.linalg import ETA
 from .grasp import Grasp
 from .validation import param_names
 
 __all__ = [
     "to_exact",
     "tangent",
+    "cross",
     "torque",
     "wrench",
     "contact_frame",
@@ -45,18 +47,25 @@ def tangent(n: np.ndarray) -> np.ndarray:
     return np.stack([-n[..., 1], n[..., 0]], axis=-1)
 
 
-def torque(r: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """Moment ``r x f``: a scalar per row in the plane, a 3-vector per row in space."""
-    if r.shape[-1] == 2:
-        return r[..., 0] * f[..., 1] - r[..., 1] * f[..., 0]
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product of rows: the scalar ``a_x b_y - a_y b_x`` per row in the plane, the 3-vector
+    ``a x b`` per row in space (the one product the torques, face normals and twist axes use)."""
+    if a.shape[-1] == 2:
+        return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
     return np.stack(
         [
-            r[..., 1] * f[..., 2] - r[..., 2] * f[..., 1],
-            r[..., 2] * f[..., 0] - r[..., 0] * f[..., 2],
-            r[..., 0] * f[..., 1] - r[..., 1] * f[..., 0],
+            a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+            a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+            a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0],
         ],
         axis=-1,
     )
+
+
+def torque(r: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """Moment ``r x f`` of force(s) ``f`` at lever(s) ``r``: a scalar per row in the plane, a
+    3-vector per row in space."""
+    return cross(r, f)
 
 
 def wrench(p: np.ndarray, f: np.ndarray, center: np.ndarray, length) -> np.ndarray:
@@ -78,7 +87,7 @@ def contact_frame(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     n = np.asarray(n, dtype=float)
     axis = np.zeros_like(n)
     axis[np.arange(len(n)), np.argmin(np.abs(n), axis=1)] = 1.0
-    t1 = torque(n, axis)
+    t1 = cross(n, axis)
     t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
     return t1, torque(n, t1)
 
@@ -217,8 +226,9 @@ def force_column_errors(P, N, models, center, length) -> np.ndarray:
     """Bounds (B, 6, k) on the distance between the float spatial columns of
     :func:`force_columns` and their exact values on the same data, for a batch (B, m, 3):
     forces are exact (world axes or stored normals); torques ``(r x f) / L`` within
-    ``gamma_8 (|r_a| |f_b| + |r_b| |f_a|) / L`` per component (``gamma_n = n u / (1 - n u)``);
-    a moment column ``n / L`` within ``2u |n| / L``."""
+    ``(gamma_8 (|r_a| |f_b| + |r_b| |f_a|) + 4 eta) / L + eta`` per component
+    (``gamma_n = n u / (1 - n u)``, ``eta`` the smallest subnormal, for products that
+    underflow); a moment column ``n / L`` within ``2u |n| / L + eta``."""
     B = P.shape[0]
     k = sum(registry.get(name).columns(3) for name in models)
     E = np.zeros((B, 6, k))
@@ -231,11 +241,11 @@ def force_column_errors(P, N, models, center, length) -> np.ndarray:
         forces = ([np.abs(N[:, i, :])] if model.forces == "normal"
                   else [np.broadcast_to(np.eye(3)[q], (B, 3)) for q in range(3)])
         for f in forces:
-            E[:, 3, j] = g8 * (r[:, 1] * f[:, 2] + r[:, 2] * f[:, 1]) / L
-            E[:, 4, j] = g8 * (r[:, 2] * f[:, 0] + r[:, 0] * f[:, 2]) / L
-            E[:, 5, j] = g8 * (r[:, 0] * f[:, 1] + r[:, 1] * f[:, 0]) / L
+            E[:, 3, j] = (g8 * (r[:, 1] * f[:, 2] + r[:, 2] * f[:, 1]) + 4 * ETA) / L + ETA
+            E[:, 4, j] = (g8 * (r[:, 2] * f[:, 0] + r[:, 0] * f[:, 2]) + 4 * ETA) / L + ETA
+            E[:, 5, j] = (g8 * (r[:, 0] * f[:, 1] + r[:, 1] * f[:, 0]) + 4 * ETA) / L + ETA
             j += 1
         for _ in model.extra:
-            E[:, 3:, j] = 2 * 2.0**-53 * np.abs(N[:, i, :]) / L[:, None]
+            E[:, 3:, j] = 2 * 2.0**-53 * np.abs(N[:, i, :]) / L[:, None] + ETA
             j += 1
     return E

@@ -317,6 +317,10 @@ def search(points: np.ndarray, normals: np.ndarray, fingers: int, mu: float, cen
     return idx[chosen], eps[chosen], evaluated
 
 
+#: Contact models whose grasps the baseline's compiled search evaluates.
+SEARCHED_MODELS = ("point", "frictionless")
+
+
 def _grasp(points, normals, rows, mu: float, center, length: float, gid: str) -> Grasp:
     contacts = tuple(Contact(tuple(points[i]), tuple(normals[i]), "point", mu) if mu > 0
                      else Contact(tuple(points[i]), tuple(normals[i])) for i in rows)
@@ -353,6 +357,9 @@ def baseline(image: ImageSource | Boundary, procedure: int | str | Procedure, mu
     start = time.perf_counter()
     proc = procedure if isinstance(procedure, Procedure) else choose(
         procedure if isinstance(procedure, int) else None, procedure if isinstance(procedure, str) else None)
+    if proc.model not in SEARCHED_MODELS:
+        raise ValueError(f"the baseline searches {' and '.join(SEARCHED_MODELS)} contacts; procedure "
+                         f"{proc.name!r} uses {proc.model!r} contacts")
     fingers = proc.fingers
     bound = image if isinstance(image, Boundary) else boundary(image, threshold=threshold, largest=largest)
     friction = float(mu) if proc.friction else 0.0
@@ -371,8 +378,9 @@ def baseline(image: ImageSource | Boundary, procedure: int | str | Procedure, mu
 def screen_grasps(grasps: Sequence[Grasp]) -> tuple[np.ndarray, np.ndarray]:
     """Certified force closure and L1 epsilon of many planar grasps.
 
-    Grasps are grouped by contact pattern and screened columnar
-    (:func:`qualgrasp.certify.fastpath.planar_screen`); the rows it does not settle are certified one by one
+    Grasps of point and frictionless contacts are grouped by contact pattern and screened
+    columnar (:func:`qualgrasp.certify.fastpath.planar_screen`); other contact models, and the
+    rows the screen does not settle, are certified one by one
     with :func:`qualgrasp.certify.certify_grasp`. A grasp counts as certified when force closure is proved
     (columnar) or certified and verified (per grasp), as in :func:`qualgrasp.certify.fastpath.certify_table`.
 
@@ -385,8 +393,15 @@ def screen_grasps(grasps: Sequence[Grasp]) -> tuple[np.ndarray, np.ndarray]:
     """
     certified, eps = np.zeros(len(grasps), dtype=bool), np.zeros(len(grasps))
     groups: dict[tuple, list[int]] = {}
+    alone = []
     for i, g in enumerate(grasps):
-        groups.setdefault(tuple(c.mu for c in g.contacts), []).append(i)
+        if all(c.model in SEARCHED_MODELS for c in g.contacts):
+            groups.setdefault(tuple(c.mu for c in g.contacts), []).append(i)
+        else:
+            alone.append(i)
+    for i in alone:
+        report = certify_grasp(grasps[i])
+        certified[i], eps[i] = report.certified, report.eps_l1
     for pattern, rows in groups.items():
         P = np.array([grasps[i].points for i in rows])
         N = np.array([grasps[i].normals for i in rows])

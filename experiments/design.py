@@ -17,7 +17,7 @@ from ..qualitative import procedures
 from ..qualitative.procedures import Procedure
 from .baseline import MU, Budget
 
-__all__ = ["Route", "routes", "route_of", "KINDS", "UNITS", "BUILTINS", "ROUTES", "QUICK", "FULL",
+__all__ = ["Route", "routes", "KINDS", "UNITS", "BUILTINS", "ROUTES", "QUICK", "FULL",
            "SETTINGS", "OBJECT_COLUMNS", "OVERALL_COLUMNS", "ROBUSTNESS_COLUMNS", "GRASP_COLUMNS",
            "DETERMINISTIC", "Settings", "Subject", "RouteSummary", "StudyResult"]
 
@@ -48,14 +48,6 @@ def routes() -> tuple[Route, ...]:
     return tuple(Route("qualitative", p) for p in procs) + tuple(Route("baseline", p) for p in procs)
 
 
-def route_of(name: str) -> Route:
-    """The route named ``name`` (KeyError if there is none)."""
-    for r in routes():
-        if r.name == name:
-            return r
-    raise KeyError(name)
-
-
 KINDS = ("rotation", "translation", "noise", "blur", "threshold")
 UNITS = {"none": "", "rotation": "deg", "translation": "px", "noise": "grey sd", "blur": "px sd",
          "threshold": "grey levels"}
@@ -64,17 +56,17 @@ BUILTINS = ("polygon", "nut", "disc", "figure3")
 ROUTES = tuple((r.name.rsplit(" ", 1)[0], r.fingers) for r in routes())
 """``(method title, fingers)`` of every route, as in the tables' ``route`` column."""
 
-OBJECT_COLUMNS = ("object", "route", "method", "procedure", "fingers", "mu", "grasps", "certified",
+OBJECT_COLUMNS = ("object", "route", "method", "fingers", "mu", "grasps", "certified",
                   "certified_fraction", "eps_median", "eps_best", "ratio_best", "ratio_median",
-                  "seconds", "candidates", "error")
+                  "seconds", "candidates", "error", "procedure")
 """Per object and route: grasps returned, certified, certified fraction, median and best certified
 L1 epsilon (uncertified grasps count 0), the qualitative best and median over the baseline's best
 with the same fingers (empty for the baseline), seconds (image to certified grasps), candidates
 screened (baseline), error message (route failed on the image)."""
 
-OVERALL_COLUMNS = ("route", "method", "procedure", "fingers", "objects", "objects_with_grasps", "grasps",
+OVERALL_COLUMNS = ("route", "method", "fingers", "objects", "objects_with_grasps", "grasps",
                    "certified_fraction", "eps_median", "eps_best", "ratio_best", "ratio_median",
-                   "seconds_median", "seconds_total", "robustness", "robustness_paired")
+                   "seconds_median", "seconds_total", "robustness", "robustness_paired", "procedure")
 """Per route over all objects: objects, objects where the route found a certified grasp, grasps,
 certified fraction (pooled), medians over objects of the per-object median and best epsilon and
 of the ratios (objects where both routes found grasps), median and total seconds, robustness
@@ -82,13 +74,13 @@ pooled over every perturbation (not ``none``), and the same over the trials wher
 planned a certified grasp with the route's finger count (``paired``: the qualitative route finds
 no grasp on some objects, where the baseline's grasps may be the most fragile)."""
 
-ROBUSTNESS_COLUMNS = ("route", "method", "procedure", "fingers", "kind", "size", "unit", "trials", "planned",
-                      "held", "fraction", "misses", "collisions", "eps_planned", "eps_executed")
+ROBUSTNESS_COLUMNS = ("route", "method", "fingers", "kind", "size", "unit", "trials", "planned",
+                      "held", "fraction", "misses", "collisions", "eps_planned", "eps_executed", "procedure")
 """Per route, perturbation kind and size: trials (object x trial), planned grasps that certified on
 the perturbed image, how many hold on the true object, their fraction, fingers that missed or
 collided, median epsilon of the planned and of the executed grasps (0 for those that fail)."""
 
-GRASP_COLUMNS = ("object", "route", "method", "procedure", "fingers", "certified", "eps")
+GRASP_COLUMNS = ("object", "route", "method", "fingers", "certified", "eps", "procedure")
 
 DETERMINISTIC = ("blur", "threshold")
 """Perturbations that get one trial whatever the settings."""

@@ -18,8 +18,8 @@ from .design import (GRASP_COLUMNS, KINDS, OBJECT_COLUMNS, OVERALL_COLUMNS, ROBU
 __all__ = ["robustness_rows", "overall_rows", "summarise", "write_csv", "write_markdown",
            "write_tables"]
 
-_TRIAL_COLUMNS = ("object", "route", "method", "procedure", "fingers", "kind", "size", "trial", "planned",
-                  "held", "misses", "collisions", "eps_planned", "eps_executed", "error")
+_TRIAL_COLUMNS = ("object", "route", "method", "fingers", "kind", "size", "trial", "planned",
+                  "held", "misses", "collisions", "eps_planned", "eps_executed", "error", "procedure")
 
 
 def _median(values: Sequence[float]) -> float | None:

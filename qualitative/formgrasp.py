@@ -46,7 +46,7 @@ from functools import cache
 
 import numpy as np
 
-from ..certify.wrench import torque
+from ..certify.wrench import cross
 
 from .candidates import GAP, Candidates, separated
 from .errors import SynthesisError
@@ -100,9 +100,9 @@ def ray_edges(start: np.ndarray, direction: np.ndarray, contour: np.ndarray):
     """
     e = np.roll(contour, -1, axis=0) - contour
     w = contour - start
-    denom = torque(direction, e)
+    denom = cross(direction, e)
     with np.errstate(divide="ignore", invalid="ignore"):
-        return torque(w, e) / denom, torque(w, direction) / denom, denom
+        return cross(w, e) / denom, cross(w, direction) / denom, denom
 
 
 def line_of_action_exit(point: np.ndarray, direction: np.ndarray, contour: np.ndarray) -> np.ndarray | None:
@@ -182,7 +182,7 @@ def form_grasps(cands: Candidates, contour: np.ndarray, center: np.ndarray, leng
 
 
 def _det(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
-    return np.einsum("...k,...k->...", a, torque(b, c))
+    return np.einsum("...k,...k->...", a, cross(b, c))
 
 
 def closure_depth4(a: np.ndarray) -> np.ndarray:
@@ -205,7 +205,7 @@ def closure_depth4(a: np.ndarray) -> np.ndarray:
     C = np.stack([_det(a1, a2, a3), -_det(a0, a2, a3), _det(a0, a1, a3), -_det(a0, a1, a2)], axis=1)
     inside = (C > 0).all(axis=1) | (C < 0).all(axis=1)
     faces = [(a1, a2, a3), (a0, a2, a3), (a0, a1, a3), (a0, a1, a2)]
-    area = np.stack([np.linalg.norm(torque(q - p, r - p), axis=1) for p, q, r in faces], axis=1)
+    area = np.stack([np.linalg.norm(cross(q - p, r - p), axis=1) for p, q, r in faces], axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
         dist = np.abs(C) / area
     return np.where(inside, -dist.min(axis=1), np.inf)

@@ -148,7 +148,8 @@ class Synthesis:
         eps = [r.epsilons["L1"].hi for r in ok if r.epsilons]
         return {
             "name": self.name,
-            "procedure": self.procedure.name,
+            "procedure": self.procedure.title,
+            "procedure_name": self.procedure.name,
             "fingers": self.fingers,
             "mu": self.mu,
             "grasps": len(self.grasps),

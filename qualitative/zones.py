@@ -76,7 +76,7 @@ import shapely
 from shapely.geometry import MultiPoint
 from shapely.geometry.base import BaseGeometry
 
-from ..certify.wrench import torque, wrench
+from ..certify.wrench import cross, wrench
 
 from .errors import ZoneError
 
@@ -347,13 +347,13 @@ def _depth(a: np.ndarray) -> np.ndarray:
     cands = [a]
     if len(pairs):
         ai, aj = a[:, pairs[:, 0]], a[:, pairs[:, 1]]
-        cands += [_unit(ai + aj), _unit(torque(ai, aj))]
+        cands += [_unit(ai + aj), _unit(cross(ai, aj))]
     if len(triples):
         # equal values on a triple: y normal to the plane through the three points a_i, a_j, a_k
         ai, aj, ak = (a[:, triples[:, m]] for m in range(3))
-        cands.append(_unit(torque(aj - ai, ak - ai)))
+        cands.append(_unit(cross(aj - ai, ak - ai)))
     # vectors orthogonal to a_0 (one of them non-zero): they cover a rank-one set of constraints
-    cands += [_unit(torque(a[:, :1], axis)) for axis in np.eye(3)[[0, 2]]]
+    cands += [_unit(cross(a[:, :1], axis)) for axis in np.eye(3)[[0, 2]]]
     y = np.concatenate(cands, axis=1)
     y = np.concatenate([y, -y], axis=1)
     valid = np.linalg.norm(y, axis=2) > 0.5
@@ -400,7 +400,7 @@ def _extreme_rays(C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     D = C @ Q  # the constraints within the complement, where the cone is pointed
     if rank == 3:
         i, j = np.triu_indices(len(D), 1)
-        cand = torque(D[i], D[j])
+        cand = cross(D[i], D[j])
     elif rank == 2:
         cand = np.column_stack([-D[:, 1], D[:, 0]])
     else:  # rank 1: a half-line on each side

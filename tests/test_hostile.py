@@ -7,6 +7,7 @@ mutated fields, Arrow layouts with nulls, ST0 formulas and traces.
 """
 
 import json
+import math
 import pathlib
 
 import cv2
@@ -20,7 +21,9 @@ from typer.testing import CliRunner
 from qualgrasp.certify import CertifyError, GraspError, Options, certify_arrow, certify_grasp, grasp_from_dict
 from qualgrasp.certify.batch import certify_file, verify_file
 from qualgrasp.certify.chunk import certify_values
+from qualgrasp.certify.columns import grasp_columns
 from qualgrasp.certify.table import table_to_rows
+from qualgrasp.certify.validation import MAX_CONTACTS
 from qualgrasp.cli import app
 from qualgrasp.qualitative.errors import FormulaError, TraceError
 from qualgrasp.qualitative.st0 import parse, read_trace
@@ -95,10 +98,13 @@ def test_output_never_overwrites_the_input_and_options_are_checked(tmp_path):
 
 # --- generated lines ----------------------------------------------------------------------------
 
+def _containers(children):
+    return st.lists(children, max_size=4) | st.dictionaries(st.text(max_size=6), children, max_size=4)
+
+
 json_values = st.recursive(
     st.none() | st.booleans() | st.integers() | st.floats(allow_nan=True, allow_infinity=True) | st.text(max_size=8),
-    lambda children: st.lists(children, max_size=4) | st.dictionaries(st.text(max_size=6), children, max_size=4),
-    max_leaves=12)
+    _containers, max_leaves=12)
 numbers = st.floats(allow_nan=True, allow_infinity=True) | st.integers(-10**30, 10**30)
 vectors = st.lists(numbers, min_size=0, max_size=4) | json_values
 contacts = st.fixed_dictionaries({"p": vectors, "n": vectors}, optional={
@@ -255,3 +261,40 @@ def test_commands_refuse_bad_numbers_in_their_own_units(tmp_path):
         assert result.exit_code == 2, (args, result.output)
         assert flag in result.output, (args, result.output)
         assert result.exception is None or isinstance(result.exception, SystemExit)
+
+
+# --- sizes and scales -------------------------------------------------------------------------------
+
+def test_a_row_over_the_contact_limit_costs_nothing_and_is_an_error_row():
+    """A Parquet row beyond MAX_CONTACTS is an error row whose contacts are not even read; a row
+    with many contacts is padded on its own, not across the chunk."""
+    two = [{"p": [1.0, 0.0], "n": [-1.0, 0.0], "mu": 0.5}, {"p": [-1.0, 0.0], "n": [1.0, 0.0], "mu": 0.5}]
+    rows = [{"id": f"g{i}", "contacts": two} for i in range(300)]
+    rows[3] = {"id": "over", "contacts": two * (MAX_CONTACTS // 2 + 1)}
+    rows[4] = {"id": "many", "contacts": two * 500}
+    table = pa.Table.from_pylist(rows)
+    cols = grasp_columns(table)
+    assert len(cols.checked.contacts.p) == 299 * 2 + 998  # the row over the limit is not read
+    P, N, _ = cols.contacts(np.arange(5, 300))
+    assert P.shape == (295, 2, 3)
+    results = table_to_rows(certify_arrow(table, Options(quality=False)))
+    assert results[3]["status"] == "error" and "10002 contacts" in results[3]["error"]
+    assert results[4]["status"] == "closure" and results[4]["n_contacts"] == 1000
+    assert all(r["status"] == "closure" for i, r in enumerate(results) if i != 3)
+
+
+@pytest.mark.parametrize("scale", [1e-170, 1e-100, 1e-13, 1e-5, 1.0, 1e11])
+def test_tiny_and_huge_grasps_keep_their_verdict_or_say_why(scale):
+    """Closure does not depend on the scale: within the usable lengths a grasp keeps its verdict
+    and what is written reads back; contacts closer together than MIN_LENGTH (whose default
+    length would underflow the tolerances) give an error row that says what to do."""
+    contacts = [{"p": [scale, 0.0], "n": [-1.0, 0.0], "mu": 0.5}, {"p": [-scale, 0.0], "n": [1.0, 0.0], "mu": 0.5}]
+    row = certify_values([{"contacts": contacts}], [1], Options(quality=False))[0]
+    if scale < 1e-12:
+        assert row["status"] == "error" and "give 'length' or rescale" in row["error"]
+        return
+    assert row["status"] == "closure" and math.isclose(row["length"], scale)
+    again = grasp_from_dict({"contacts": contacts, "center": row["center"], "length": row["length"]})
+    assert again.length == row["length"]
+    given = certify_values([{"contacts": contacts, "length": 3 * scale}], [1], Options(quality=False))[0]
+    assert given["status"] == "closure" and given["margin"] == row["margin"]

@@ -22,6 +22,7 @@ from qualgrasp.certify.fastpath import certify_table
 from qualgrasp.certify.grasp import grasp_from_dict, grasp_to_dict
 from qualgrasp.certify.samples import random_grasp_table, random_grasps
 from qualgrasp.certify.table import grasps_table, rows_to_table, table_to_rows, table_values
+from qualgrasp.experiments.baseline import screen_grasps
 
 
 def test_registry_order_codes_and_declarations():
@@ -176,8 +177,12 @@ def _both(table, options):
 
 @pytest.mark.parametrize("quality", [False, True])
 def test_pad_rows_columnar_equal_per_grasp(quality):
+    """Also 3 friction pads (12 generators, 220 bases) and 21 point contacts (42 generators,
+    beyond enumeration): the columnar rows are the per-grasp rows."""
     dicts = [grasp_to_dict(g) for g in random_grasps(5, 300, dim=2, n_contacts=2, model="pad", spread=0.5)]
     dicts += [grasp_to_dict(g) for g in random_grasps(6, 200, dim=2, n_contacts=3, model="pad", mu=(0.0, 0.0))]
+    dicts += [grasp_to_dict(g) for g in random_grasps(7, 60, dim=2, n_contacts=3, model="pad", mu=(0.1, 0.8))]
+    dicts += [grasp_to_dict(g) for g in random_grasps(8, 20, dim=2, n_contacts=21, model="point")]
     dicts += [grasp_to_dict(_pads(0.5)), grasp_to_dict(_pads(0.0))]
     fast, ref = _both(grasps_table(dicts), Options(quality=quality))
     assert len(fast) == len(ref) == len(dicts)
@@ -208,3 +213,13 @@ def test_pad_fast_route_agrees_with_the_reference_on_ten_thousand_grasps():
         assert result.grasps == 10_000 and not result.disagreements
         assert len(result.resolved) <= 10
         assert result.max_margin_diff < 1e-6
+
+
+def test_the_baseline_screen_certifies_pads_as_pads():
+    """screen_grasps compiles point and frictionless contacts only; pads go grasp by grasp (a
+    pad screened as a point contact would get a different epsilon)."""
+    grasps = random_grasps(9, 40, dim=2, n_contacts=2, model="pad", mu=(0.2, 0.6))
+    certified, eps = screen_grasps(grasps)
+    reports = [certify_grasp(g) for g in grasps]
+    assert certified.tolist() == [r.certified for r in reports] and any(certified)
+    assert eps.tolist() == [r.eps_l1 for r in reports]

@@ -12,9 +12,11 @@ from numba import njit
 
 __all__ = ["U", "gamma", "solve_small", "lu_factor", "lu_solve", "lu_solve_t", "cholesky_solve",
            "pivot_basis_into", "pivot_basis", "inverse_norm_bound", "projection_bound", "cross_unit",
-           "null_direction", "thin", "world_values"]
+           "null_direction", "thin", "world_values", "U", "ETA", "gamma"]
 
 U = 2.0**-53
+#: The smallest subnormal: the absolute error a rounding can add when its result underflows.
+ETA = 2.0**-1074
 
 
 @njit(cache=True)

@@ -8,7 +8,7 @@ import numpy as np
 from numba import njit
 
 from .epsilon import planar_epsilon_one
-from .linalg import U, gamma, null_direction, pivot_basis_into, thin
+from .linalg import ETA, U, gamma, null_direction, pivot_basis_into, thin
 from .lp import lp_planar_one
 from .recheck import verify_farkas_general, verify_interior_general, verify_null_general
 
@@ -27,12 +27,15 @@ def planar_generators(P, N, mu, width, c, L, owner, offset, friction, W, E):
 
     Generator ``j`` of contact ``i = owner[j]`` is the force ``f = n + (friction_j mu_i) t``
     at ``q = p + (offset_j width_i) t`` (``t = (-n_y, n_x)``), its wrench
-    ``(f, ((q - c) x f) / L)``. Bounds (``gamma_k = k u / (1 - k u)``, Higham): the force is exact
-    when ``friction_j = 0`` and within ``gamma_2 (|n| + |s t|)`` per component otherwise
-    (``s = friction_j mu_i``); the lever ``r = q - c`` within ``u |r|`` when ``offset_j = 0`` and
-    ``gamma_4 (|p| + |o t| + |c|)`` otherwise (``o = offset_j width_i``); the torque within
-    ``(|r_x| e_fy + (|f_y| + e_fy) e_rx + |r_y| e_fx + (|f_x| + e_fx) e_ry
-    + gamma_4 (|r_x f_y| + |r_y f_x|)) (1 + 2u) / L``."""
+    ``(f, ((q - c) x f) / L)``. Bounds (``gamma_k = k u / (1 - k u)``, Higham; ``eta`` the
+    smallest subnormal, the absolute error of a product that underflows): the force is exact
+    when ``friction_j = 0`` and within ``gamma_2 (|n| + |s t|) + 2 eta`` per component otherwise
+    (``s = friction_j mu_i``); the lever ``r = q - c`` within ``gamma_1 |r|`` (of the computed
+    ``r``) when ``offset_j = 0`` and ``gamma_4 (|p| + |o t| + |c|) + 2 eta`` otherwise
+    (``o = offset_j width_i``); the torque within ``(|r_x| e_fy + (|f_y| + e_fy) e_rx + |r_y| e_fx
+    + (|f_x| + e_fx) e_ry + gamma_4 (|r_x f_y| + |r_y f_x|) + 4 eta) (1 + 2u) / L + eta``. The
+    bounds are computed in floating point; the factor ``1 + 2u`` and the slack of ``gamma_4``
+    over the torque's three roundings cover the rounding of the bound itself."""
     k = owner.shape[0]
     for j in range(k):
         i = owner[j]
@@ -42,8 +45,8 @@ def planar_generators(P, N, mu, width, c, L, owner, offset, friction, W, E):
             sm = friction[j] * mu[i]
             fx = nx + sm * tx
             fy = ny + sm * ty
-            efx = gamma(2) * (abs(nx) + abs(sm * tx))
-            efy = gamma(2) * (abs(ny) + abs(sm * ty))
+            efx = gamma(2) * (abs(nx) + abs(sm * tx)) + 2 * ETA
+            efy = gamma(2) * (abs(ny) + abs(sm * ty)) + 2 * ETA
         else:
             fx, fy = nx, ny
             efx, efy = 0.0, 0.0
@@ -51,19 +54,19 @@ def planar_generators(P, N, mu, width, c, L, owner, offset, friction, W, E):
             so = offset[j] * width[i]
             rx = (P[i, 0] + so * tx) - c[0]
             ry = (P[i, 1] + so * ty) - c[1]
-            erx = gamma(4) * (abs(P[i, 0]) + abs(so * tx) + abs(c[0]))
-            ery = gamma(4) * (abs(P[i, 1]) + abs(so * ty) + abs(c[1]))
+            erx = gamma(4) * (abs(P[i, 0]) + abs(so * tx) + abs(c[0])) + 2 * ETA
+            ery = gamma(4) * (abs(P[i, 1]) + abs(so * ty) + abs(c[1])) + 2 * ETA
         else:
             rx = P[i, 0] - c[0]
             ry = P[i, 1] - c[1]
-            erx, ery = U * abs(rx), U * abs(ry)
+            erx, ery = gamma(1) * abs(rx), gamma(1) * abs(ry)
         W[0, j] = fx
         W[1, j] = fy
         W[2, j] = (rx * fy - ry * fx) / L
         E[0, j] = efx
         E[1, j] = efy
         E[2, j] = (abs(rx) * efy + (abs(fy) + efy) * erx + abs(ry) * efx + (abs(fx) + efx) * ery
-                   + gamma(4) * (abs(rx * fy) + abs(ry * fx))) * (1.0 + 2 * U) / L
+                   + gamma(4) * (abs(rx * fy) + abs(ry * fx)) + 4 * ETA) * (1.0 + 2 * U) / L + ETA
 
 
 @njit(cache=True)

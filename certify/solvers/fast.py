@@ -23,15 +23,25 @@ class FastSolver:
     closed-form squeeze direction of two point contacts proves ``t* = 0``
     (:func:`qualgrasp.certify.solvers.squeeze.squeeze_solution`)."""
 
-    #: Largest number of bases (``k choose d``) enumerated before handing over to clarabel.
+    #: Largest number of bases (``k choose d``) of a spatial programme (``d = 6``) enumerated
+    #: before handing over to the barrier method.
     max_bases = 64
+    #: The same for planar programmes (``d = 3``), whose 3 x 3 bases are cheap: up to 30
+    #: generators (10 friction pads, 15 point contacts) are solved exactly by enumeration.
+    max_planar_bases = 4096
+
+    @classmethod
+    def enumerates(cls, nvar: int, d: int) -> bool:
+        """Whether a polyhedral programme of ``nvar`` generators in ``d`` wrench dimensions is
+        solved by enumerating its bases (the rule the columnar path follows too)."""
+        return comb(nvar, d) <= (cls.max_planar_bases if d == 3 else cls.max_bases)
 
     def __init__(self) -> None:
         self._clarabel = ClarabelSolver()
         self._barrier = BarrierSolver()
 
     def solve(self, problem: ClosureProblem) -> Solution:
-        if problem.cones or comb(problem.nvar, problem.d) > self.max_bases:
+        if problem.cones or not self.enumerates(problem.nvar, problem.d):
             sol = self._barrier.solve(problem)
             if sol is not None and abs(sol.t) >= BARRIER_NEAR_ZERO:
                 return sol
