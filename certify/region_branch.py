@@ -1,0 +1,676 @@
+"""Conservative decision for curved regions and for a tolerance on normals, by branch and bound.
+
+**Over-approximation.** Each region is cut into *arcs*: a straight region is one arc (its
+segment), a curved region one arc per pair of consecutive points. An arc is over-approximated by
+what a finger there could be (:func:`arcs_of`):
+
+* its point lies in a rectangle on the chord ``[P_j, P_j+1]``: ``P_j + s (P_j+1 - P_j) + h' E``
+  with ``0 <= s <= 1`` and ``|h'| <= h`` (``E`` the chord's unit normal): between two points the
+  curve's tangent stays within ``[a_lo, a_hi]`` of the chord (``a_lo <= 0 <= a_hi``, the angles
+  of :mod:`qualgrasp.certify.region_data`'s reading, ``normal_tol`` included), so it moves forward
+  along the chord and stays within ``h = c tan(a_hi) tan(-a_lo) / (tan(a_hi) + tan(-a_lo))`` of
+  it (the parallelogram of the extreme tangent lines through both ends); a straight region's
+  arc is its segment (``h = 0``);
+* its normal lies in an angular interval ``[psi_lo, psi_hi]`` (the end normals, the chord's
+  normal, widened by ``normal_tol``), or is one exact normal (straight regions with
+  ``normal_tol = 0``).
+
+Every constructed number is widened by a margin (``1e-9`` relative, ``1e-12`` radians) that
+absorbs the rounding of the construction (``atan2``, ``cos``, ``sin``, ``tan``, a square root),
+so the sets contain the exact ones. A *piece* of an arc is a sub-box ``[s0, s1] x [t0, t1]`` of its
+chord parameter ``s`` and of its normal's fraction ``t`` of ``[psi_lo, psi_hi]``.
+
+**Covering.** The tuple is not robust iff some ``y != 0`` and some choice have ``y . w_g <= 0``
+for every generator of every contact. Directions ``y`` are covered by cells: the 6 faces of the
+cube ``[-1, 1]^3`` cut into dyadic squares (:data:`FACES`). A cell is **covered** by contact ``i``
+when, on each piece of ``i``'s region, a rigorous lower bound of ``max_g y . w_g`` over the cell
+and the piece is positive: then every choice of contact ``i`` resists every wrench direction of
+the cell. For a unit normal, ``L y . w_g = (R_g n) . (L y_f + y_tau perp(q - c)) - y_tau
+offset_g width`` (``R_g n = n + friction_g mu perp(n)``, ``perp`` a quarter turn), which is affine
+separately in ``y``, in ``q`` and in ``n``; so its minimum over the cell, the piece's rectangle and
+the quadrilateral ``{a n_lo + b n_hi : a, b >= 0, 1 - 1e-9 <= a + b <= 1e-9 + 1 / cos(width / 2)}``
+(which contains the piece's arc of unit normals) is attained at vertices, 4 x 4 x 4 of them. The
+bound is that minimum, for a fixed convex combination of the generators (one of the candidates of
+:func:`candidate_weights`: single generators, pairs, all), evaluated in floating point minus a
+rigorous error bound ``gamma_40 * (the same sum over absolute values)`` (Higham's ``gamma_n``). All
+cells covered: **robust**; the certificate lists each cell with its contact and pieces
+(:func:`check_cells` re-checks it: coverage of the faces and of every arc, and every bound).
+
+**Refinement and witnesses.** An uncovered cell first refines the pieces of contacts that are good
+at the cell's centre direction but whose pieces are too coarse; otherwise it is split in four. At
+its centre direction ``y_c`` each region's exact candidate contacts (its given points with the
+given normals, and those normals turned by ``+-normal_tol``, just inside) are scored by ``max_g
+y_c . w_g``; when every region has one with a score ``<= 0``, that choice is certified with
+:func:`qualgrasp.certify.force_closure`: a verified ``no_closure`` is a **witness** (not robust).
+The **budget** counts work units: one unit is one bound of one piece of one contact on one cell
+(64 vertex evaluations per generator). When it is spent, or cells reach the finest size
+(``2^-40`` of a face) uncovered, the verdict is **undecided**.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+
+from . import models as registry
+from ._kernels.regions import piece_bounds
+from .certificates import Check, verify
+from .closure import force_closure
+from .grasp import Contact, Grasp
+from .region_data import CurvedRegion, RegionTuple, StraightRegion
+from .region_exact import region_variant
+
+__all__ = ["FACES", "Arcs", "arcs_of", "candidate_weights", "bounds", "decide_branch", "check_cells",
+           "exact_candidates", "turned", "BranchResult", "DEFAULT_BUDGET", "MIN_CELL", "MIN_PIECE"]
+
+#: The 6 faces of the direction cube: ``(axis, sign)`` (axis 0 ``y_fx``, 1 ``y_fy``, 2 ``y_tau``).
+FACES = ((0, 1), (0, -1), (1, 1), (1, -1), (2, 1), (2, -1))
+#: Default budget, in work units (module docstring).
+DEFAULT_BUDGET = 400_000
+#: Finest cell width (a face is 2 wide) and finest piece width (fractions of an arc).
+MIN_CELL = 2.0 ** -40
+MIN_PIECE = 2.0 ** -24
+_REL = 1e-9   # relative widening of constructed lengths
+_ANG = 1e-12  # absolute widening of constructed angles (radians)
+_U = 2.0 ** -53
+_GAMMA = 40 * _U / (1 - 40 * _U)
+
+
+# --------------------------------------------------------------------------------------------------
+# Geometry of the arcs
+
+@dataclass(frozen=True)
+class Arcs:
+    """Every arc of every region, as arrays (one row per arc)."""
+
+    region: np.ndarray      # (A,) owner region
+    index: np.ndarray       # (A,) arc number within its region
+    p0: np.ndarray          # (A, 2) chord start
+    p1: np.ndarray          # (A, 2) chord end
+    e: np.ndarray           # (A, 2) unit normal of the chord (zeros when h = 0)
+    h: np.ndarray           # (A,) half height of the rectangle
+    exact: np.ndarray       # (A,) bool: one exact normal
+    normal: np.ndarray      # (A, 2) the exact normal (when exact)
+    psi: np.ndarray         # (A, 2) normal angle interval (when not exact)
+    splittable_s: np.ndarray  # (A,) the chord has positive length
+    first: np.ndarray       # (k + 1,) arcs of region i are first[i]:first[i+1]
+
+
+def _turn(n, angle):
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([c * n[0] - s * n[1], s * n[0] + c * n[1]])
+
+
+def _signed(u, v) -> float:
+    return math.atan2(u[0] * v[1] - u[1] * v[0], u[0] * v[0] + u[1] * v[1])
+
+
+def arcs_of(regions: RegionTuple) -> Arcs:
+    """The arcs of every region, with their rectangles and normal sets (module docstring)."""
+    tol = regions.normal_tol
+    rows: list[tuple] = []
+    first = [0]
+    for i, r in enumerate(regions.regions):
+        if isinstance(r, StraightRegion):
+            a, b, n = np.array(r.a), np.array(r.b), np.array(r.n)
+            psi = math.atan2(n[1], n[0])
+            rows.append((i, 0, a, b, np.zeros(2), 0.0, tol == 0, n,
+                         (psi - tol - _ANG, psi + tol + _ANG), bool((a != b).any())))
+        else:
+            P, N = r.points, r.normals
+            if len(P) == 1:
+                psi = math.atan2(N[0][1], N[0][0])
+                rows.append((i, 0, P[0], P[0], np.zeros(2), 0.0, tol == 0, N[0],
+                             (psi - tol - _ANG, psi + tol + _ANG), False))
+            for j in range(len(P) - 1):
+                rows.append((i, j) + _curved_arc(P[j], P[j + 1], N[j], N[j + 1], tol))
+        first.append(len(rows))
+    cols = list(zip(*rows))
+    return Arcs(np.array(cols[0], dtype=np.int64), np.array(cols[1], dtype=np.int64),
+                np.array(cols[2], dtype=float).reshape(-1, 2), np.array(cols[3], dtype=float).reshape(-1, 2),
+                np.array(cols[4], dtype=float).reshape(-1, 2), np.array(cols[5], dtype=float),
+                np.array(cols[6], dtype=bool), np.array(cols[7], dtype=float).reshape(-1, 2),
+                np.array(cols[8], dtype=float).reshape(-1, 2), np.array(cols[9], dtype=bool),
+                np.array(first, dtype=np.int64))
+
+
+def _curved_arc(p0, p1, n0, n1, tol):
+    """Rectangle and normal interval of one arc of a curved region."""
+    chord = p1 - p0
+    c = math.hypot(chord[0], chord[1])
+    if c == 0:  # a corner: one point, the normal turns from n0 to n1
+        psi = math.atan2(n0[1], n0[0])
+        turn = _signed(n0, n1)
+        return (p0, p1, np.zeros(2), 0.0, False, n0,
+                (psi + min(0.0, turn) - tol - _ANG, psi + max(0.0, turn) + tol + _ANG), False)
+    e = np.array([-chord[1], chord[0]]) / c
+    if e @ (n0 + n1) < 0:
+        e = -e
+    b0, b1 = _signed(e, n0), _signed(e, n1)
+    lo = min(b0, b1, 0.0) - tol - _ANG
+    hi = max(b0, b1, 0.0) + tol + _ANG
+    t1, t2 = math.tan(hi + _ANG), math.tan(-lo + _ANG)
+    h = c * t1 * t2 / (t1 + t2)
+    h = h * (1 + _REL) + c * _REL + 8 * _U * (np.abs(p0).max() + np.abs(p1).max())
+    psi = math.atan2(e[1], e[0])
+    return (p0, p1, e, h, False, e, (psi + lo, psi + hi), True)
+
+
+# --------------------------------------------------------------------------------------------------
+# Generators and their convex combinations
+
+def _generators(region):
+    gens = registry.get(region.model).generators(2, region_variant(region))
+    fm = np.array([g.friction * region.mu for g in gens])
+    ow = np.array([g.offset * region.width for g in gens])
+    return fm, ow
+
+
+def candidate_weights(count: int) -> np.ndarray:
+    """Convex combinations of ``count`` generators tried by the bound: each generator alone, each
+    pair's mean, and (more than two) the mean of all. Shape ``(C, count)``; exact dyadic weights."""
+    rows = [np.eye(count)[g] for g in range(count)]
+    for g in range(count):
+        for h in range(g + 1, count):
+            w = np.zeros(count)
+            w[[g, h]] = 0.5
+            rows.append(w)
+    if count > 2:
+        rows.append(np.full(count, 1.0 / count))
+    return np.array(rows)
+
+
+@dataclass(frozen=True)
+class _Model:
+    """Generator data of every region, padded to ``G`` generators and ``C`` candidates."""
+
+    fm: np.ndarray      # (k, G)
+    ow: np.ndarray      # (k, G)
+    gmask: np.ndarray   # (k, G)
+    weights: np.ndarray  # (k, C, G)
+    cmask: np.ndarray   # (k, C)
+
+
+def _model(regions: RegionTuple) -> _Model:
+    data = [_generators(r) for r in regions.regions]
+    G = max(len(fm) for fm, _ in data)
+    cands = [candidate_weights(len(fm)) for fm, _ in data]
+    C = max(len(c) for c in cands)
+    k = len(data)
+    fm, ow, gm = np.zeros((k, G)), np.zeros((k, G)), np.zeros((k, G), dtype=bool)
+    W, cm = np.zeros((k, C, G)), np.zeros((k, C), dtype=bool)
+    for i, ((f, o), c) in enumerate(zip(data, cands)):
+        fm[i, :len(f)], ow[i, :len(o)], gm[i, :len(f)] = f, o, True
+        W[i, :len(c), :c.shape[1]], cm[i, :len(c)] = c, True
+    return _Model(fm, ow, gm, W, cm)
+
+
+# --------------------------------------------------------------------------------------------------
+# The bound
+
+def cell_vertices(face: np.ndarray, box: np.ndarray) -> np.ndarray:
+    """``(B, 4, 3)`` corner directions of cells: ``face`` (B,) indices into :data:`FACES`,
+    ``box`` (B, 4) ``lo0, hi0, lo1, hi1`` of the two free coordinates (in axis order)."""
+    B = len(face)
+    V = np.zeros((B, 4, 3))
+    axes = np.array([f[0] for f in FACES])[face]
+    signs = np.array([f[1] for f in FACES], dtype=float)[face]
+    corners = np.stack([box[:, [0, 2]], box[:, [0, 3]], box[:, [1, 2]], box[:, [1, 3]]], axis=1)
+    for ax, (f0, f1) in enumerate(((1, 2), (0, 2), (0, 1))):
+        m = axes == ax
+        V[m, :, ax] = signs[m][:, None]
+        V[m, :, f0] = corners[m][:, :, 0]
+        V[m, :, f1] = corners[m][:, :, 1]
+    return V
+
+
+def _piece_vertices(arcs: Arcs, arc: np.ndarray, s0, s1, t0, t1):
+    """Point vertices (B, 4, 2) with their absolute bounds, and normal vertices (B, 4, 2)."""
+    h = arcs.h[arc]
+    ext = np.where(h > 0, _REL, 0.0)
+    s0e = np.where(s0 <= 0, s0 - ext, s0)
+    s1e = np.where(s1 >= 1, s1 + ext, s1)
+    P0, P1, E = arcs.p0[arc], arcs.p1[arc], arcs.e[arc]
+    S = np.stack([s0e, s0e, s1e, s1e], axis=1)[..., None]
+    Hh = np.stack([-h, h, -h, h], axis=1)[..., None]
+    Q = P0[:, None, :] + S * (P1 - P0)[:, None, :] + Hh * E[:, None, :]
+    Qabs = np.abs(P0)[:, None, :] + np.abs(S) * (np.abs(P1) + np.abs(P0))[:, None, :] + np.abs(Hh) * np.abs(E)[:, None, :]
+    lo, hi = arcs.psi[arc, 0], arcs.psi[arc, 1]
+    a = lo + t0 * (hi - lo) - _ANG
+    b = lo + t1 * (hi - lo) + _ANG
+    half = (b - a) / 2
+    scale = (1.0 / np.cos(half)) * (1 + _REL)
+    ua = np.stack([np.cos(a), np.sin(a)], axis=1)
+    ub = np.stack([np.cos(b), np.sin(b)], axis=1)
+    inner = 1 - _REL
+    Nv = np.stack([inner * ua, inner * ub, scale[:, None] * ua, scale[:, None] * ub], axis=1)
+    exact = arcs.exact[arc]
+    Nv[exact] = arcs.normal[arc][exact][:, None, :]
+    return Q, Qabs, Nv
+
+
+def bounds(regions: RegionTuple, arcs: Arcs, model: _Model, contact, arc, face, box, s0, s1, t0, t1,
+           Y: np.ndarray | None = None, cand: np.ndarray | None = None):
+    """Rigorous lower bounds, per item, of ``L max_g y . w_g`` over a cell and a piece.
+
+    Items are ``(contact, arc, cell face, cell box, piece s0 s1 t0 t1)`` arrays of one length
+    ``B``; ``Y`` (B, 4, 3) replaces the cell's corners (the analysis uses the centre direction);
+    ``cand`` (B,) evaluates only that candidate combination. Returns ``(bound, candidate)``:
+    the best bound over the candidates and which one gave it.
+    """
+    if Y is None:
+        Y = cell_vertices(face, box)
+    Q, Qabs, Nv = _piece_vertices(arcs, arc, s0, s1, t0, t1)
+    cx, cy = regions.center
+    L = regions.length
+    B = len(contact)
+    fm, ow = model.fm[contact], model.ow[contact]                                   # (B, G)
+    # rounding: every term of the exact expression is bounded in absolute value by ``scale``
+    # (the same expression over absolute values, bounded above), so each value is within
+    # gamma_40 scale of its float (Higham's gamma_n; the depth of the expression is below 25)
+    ya = np.abs(Y).max(axis=1)                                                        # (B, 3)
+    qa = (np.abs(arcs.p0[arc]) + np.maximum(np.abs(s0), np.abs(s1))[:, None] * 1.0000001 * (np.abs(arcs.p1[arc])
+          + np.abs(arcs.p0[arc])) + (arcs.h[arc] * (1 + 2 * _REL))[:, None] * np.abs(arcs.e[arc]))
+    va = L * ya[:, :2] + ya[:, 2:3] * (qa[:, ::-1] + np.abs([cx, cy])[::-1])
+    na = np.abs(Nv).max(axis=1)                                                       # (B, 2)
+    ra = (na.sum(axis=1)[:, None] * (1 + np.abs(fm)))                                 # (B, G)
+    scale = (ra * va.sum(axis=1)[:, None] + ya[:, 2:3] * np.abs(ow)).max(axis=1)     # (B,)
+    which = np.full(B, -1, dtype=np.int64) if cand is None else np.asarray(cand, dtype=np.int64)
+    lb, best = piece_bounds(np.ascontiguousarray(Y, dtype=float), np.ascontiguousarray(Q), np.ascontiguousarray(Nv),
+                            np.ascontiguousarray(contact, dtype=np.int64), model.fm, model.ow, model.weights,
+                            model.cmask, which, scale, float(cx), float(cy), float(L), _GAMMA)
+    return lb, best
+
+
+def _centre_values(regions, arcs, model, contact, arc, yc, s0, s1, t0, t1):
+    """Float ``L max_g y_c . w_g`` at the piece's centre point and normal (no rigour needed)."""
+    sm = (s0 + s1) / 2
+    q = arcs.p0[arc] + sm[:, None] * (arcs.p1[arc] - arcs.p0[arc])
+    lo, hi = arcs.psi[arc, 0], arcs.psi[arc, 1]
+    ang = lo + (t0 + t1) / 2 * (hi - lo)
+    n = np.stack([np.cos(ang), np.sin(ang)], axis=1)
+    n[arcs.exact[arc]] = arcs.normal[arc][arcs.exact[arc]]
+    cx, cy = regions.center
+    L = regions.length
+    v = np.stack([L * yc[:, 0] - yc[:, 2] * (q[:, 1] - cy), L * yc[:, 1] + yc[:, 2] * (q[:, 0] - cx)], axis=1)
+    fm, ow = model.fm[contact], model.ow[contact]
+    Rx, Ry = n[:, 0:1] - fm * n[:, 1:2], n[:, 1:2] + fm * n[:, 0:1]
+    F = Rx * v[:, 0:1] + Ry * v[:, 1:2] - yc[:, 2:3] * ow
+    F = np.where(model.gmask[contact], F, -np.inf)
+    spread_s = np.abs(yc[:, 2]) * np.hypot(*(arcs.p1[arc] - arcs.p0[arc]).T) * (s1 - s0) + 2 * arcs.h[arc] * np.abs(yc[:, 2])
+    spread_t = (hi - lo) * (t1 - t0) * np.hypot(v[:, 0], v[:, 1])
+    spread_t = np.where(arcs.exact[arc], 0.0, spread_t)
+    return F.max(axis=1), spread_s, spread_t
+
+
+# --------------------------------------------------------------------------------------------------
+# Exact candidate choices (witnesses)
+
+def turned(n, angle: float):
+    """``n`` turned by ``angle`` (radians, counter-clockwise), as a tuple."""
+    return tuple(float(v) for v in _turn(np.asarray(n, dtype=float), angle))
+
+
+def _inside_tol(tol: float) -> float:
+    """The turn used for candidate normals: just inside ``tol`` (see :func:`normal_within`)."""
+    return tol - tol * _REL - 1e-12 if tol > 4e-12 else 0.0
+
+
+def exact_candidates(regions: RegionTuple):
+    """Per region, its exact candidate contacts ``(point, normal, descriptor)``: the given
+    points (a straight region's ends) with the given normal and, with ``normal_tol``, that normal
+    turned by just under ``+-normal_tol``."""
+    turn = _inside_tol(regions.normal_tol)
+    out = []
+    for r in regions.regions:
+        if isinstance(r, StraightRegion):
+            pts = [(r.a, r.n, {"s": 0.0}), (r.b, r.n, {"s": 1.0})] if r.a != r.b else [(r.a, r.n, {"s": 0.0})]
+        else:
+            pts = [(tuple(map(float, p)), tuple(map(float, n)), {"point": j}) for j, (p, n) in enumerate(zip(r.points, r.normals))]
+        cands = []
+        for p, n, desc in pts:
+            cands.append((p, tuple(n), dict(desc, turn=0)))
+            if turn > 0:
+                for sign in (-1, 1):
+                    cands.append((p, turned(n, sign * turn), dict(desc, turn=sign)))
+        out.append(cands)
+    return out
+
+
+def _candidate_wrenches(regions: RegionTuple, cands) -> list[np.ndarray]:
+    """Generator wrenches (n_cand, G, 3) of each region's candidate contacts."""
+    cx, cy = regions.center
+    L = regions.length
+    out = []
+    for r, cs in zip(regions.regions, cands):
+        fm, ow = _generators(r)
+        P = np.array([c[0] for c in cs], dtype=float)
+        N = np.array([c[1] for c in cs], dtype=float)
+        T = np.stack([-N[:, 1], N[:, 0]], axis=1)
+        F = N[:, None, :] + fm[None, :, None] * T[:, None, :]
+        Q = P[:, None, :] + ow[None, :, None] * T[:, None, :]
+        tau = ((Q[..., 0] - cx) * F[..., 1] - (Q[..., 1] - cy) * F[..., 0]) / L
+        out.append(np.concatenate([F, tau[..., None]], axis=-1))
+    return out
+
+
+# --------------------------------------------------------------------------------------------------
+# The search
+
+@dataclass
+class BranchResult:
+    """Outcome of :func:`decide_branch`."""
+
+    status: str                      # robust, not_robust, undecided
+    cells: list = field(default_factory=list)
+    witness: Grasp | None = None
+    verdict: Any = None
+    choice: list | None = None
+    reason: str | None = None
+    work: int = 0
+
+
+def _initial_cells(k_arcs_per_region, first):
+    cells = []
+    for f in range(6):
+        for lo0 in (-1.0, 0.0):
+            for lo1 in (-1.0, 0.0):
+                pieces = [np.column_stack([np.arange(first[i], first[i + 1]), np.zeros(n), np.ones(n),
+                                           np.zeros(n), np.ones(n)])
+                          for i, n in enumerate(k_arcs_per_region)]
+                cells.append((f, np.array([lo0, lo0 + 1.0, lo1, lo1 + 1.0]), pieces))
+    return cells
+
+
+def decide_branch(regions: RegionTuple, budget: int = DEFAULT_BUDGET, batch_items: int = 4096) -> BranchResult:
+    """Branch and bound over direction cells and pieces (module docstring)."""
+    arcs = arcs_of(regions)
+    model = _model(regions)
+    k = len(regions.regions)
+    first = arcs.first
+    cands = exact_candidates(regions)
+    cwrench = _candidate_wrenches(regions, cands)
+    queue = deque(_initial_cells([first[i + 1] - first[i] for i in range(k)], first))
+    covered: list = []
+    stuck = 0
+    work = 0
+    tried: set = set()
+    failures: list[str] = []
+    while queue:
+        batch, n_items = [], 0
+        while queue and (not batch or n_items + sum(len(p) for p in queue[0][2]) <= batch_items):
+            cell = queue.popleft()
+            batch.append(cell)
+            n_items += sum(len(p) for p in cell[2])
+        if work + n_items > budget:
+            return BranchResult("undecided", reason=f"budget of {budget} work units spent with "
+                                f"{len(batch) + len(queue)} direction cells still uncovered ({len(covered)} covered)",
+                                work=work)
+        work += n_items
+        items = _items(batch, k)
+        lb, best = bounds(regions, arcs, model, items["contact"], items["arc"], items["face"], items["box"],
+                          items["s0"], items["s1"], items["t0"], items["t1"])
+        good = lb > 0
+        starts = items["group_start"]
+        group_good = np.logical_and.reduceat(good, starts) if len(good) else np.zeros(0, bool)
+        group_cell = items["group_cell"]
+        covering = {}
+        for g in np.flatnonzero(group_good):
+            covering.setdefault(int(group_cell[g]), int(items["group_contact"][g]))
+        open_cells = [c for c in range(len(batch)) if c not in covering]
+        for c, i in covering.items():
+            f, box, pieces = batch[c]
+            sel = (items["cell"] == c) & (items["contact"] == i)
+            covered.append((f, box, i, np.column_stack([pieces[i], best[sel]])))
+        if not open_cells:
+            continue
+        # analysis of the open cells at their centre directions
+        sel = np.isin(items["cell"], open_cells)
+        idx = np.flatnonzero(sel)
+        work += len(idx)
+        yc_cell = cell_vertices(np.array([batch[c][0] for c in range(len(batch))]),
+                                np.array([batch[c][1] for c in range(len(batch))])).mean(axis=1)
+        Yc = yc_cell[items["cell"][idx]]
+        lbc, _ = bounds(regions, arcs, model, items["contact"][idx], items["arc"][idx], None, None,
+                        items["s0"][idx], items["s1"][idx], items["t0"][idx], items["t1"][idx],
+                        Y=np.repeat(Yc[:, None, :], 4, axis=1))
+        centre, sp_s, sp_t = _centre_values(regions, arcs, model, items["contact"][idx], items["arc"][idx], Yc,
+                                            items["s0"][idx], items["s1"][idx], items["t0"][idx], items["t1"][idx])
+        info = {int(j): (lbc[q], centre[q], sp_s[q], sp_t[q]) for q, j in enumerate(idx)}
+        # witnesses: every region has an exact candidate with max_g y_c . w_g <= 0
+        for c in open_cells:
+            y = yc_cell[c]
+            choice = []
+            for i in range(k):
+                score = (cwrench[i] @ y).max(axis=1)
+                j = int(score.argmin())
+                if score[j] > 1e-12 * (1 + np.abs(cwrench[i]).max()):
+                    break
+                choice.append(j)
+            else:
+                key = tuple(choice)
+                if key not in tried:
+                    tried.add(key)
+                    found = _certify_choice(regions, cands, choice)
+                    if found[0] is not None:
+                        return BranchResult("not_robust", witness=found[0], verdict=found[1],
+                                            choice=[cands[i][j][2] for i, j in enumerate(choice)], work=work)
+                    failures.append(found[1])
+        # refinement
+        item_cell = items["cell"]
+        for c in open_cells:
+            f, box, pieces = batch[c]
+            rows = np.flatnonzero(item_cell == c)
+            new_pieces, split_any = [], False
+            for i in range(k):
+                r_i = rows[items["contact"][rows] == i]
+                stats = [info[int(j)] for j in r_i]
+                bad_centre = any(s[1] <= 0 for s in stats)
+                if bad_centre:
+                    new_pieces.append(pieces[i])
+                    continue
+                out = []
+                for q, j in enumerate(r_i):
+                    lbc_j, _, sps, spt = stats[q]
+                    p = pieces[i][q]
+                    if good[j] or lbc_j > 0:
+                        out.append(p[None, :])
+                        continue
+                    halves = _split_piece(p, arcs, sps, spt)
+                    if halves is None:
+                        out.append(p[None, :])
+                    else:
+                        out.append(halves)
+                        split_any = True
+                new_pieces.append(np.vstack(out))
+            if split_any:
+                queue.append((f, box, new_pieces))
+                continue
+            w = box[1] - box[0]
+            if w / 2 < MIN_CELL:
+                stuck += 1
+                continue
+            h = w / 2
+            for a0 in (box[0], box[0] + h):
+                for a1 in (box[2], box[2] + h):
+                    queue.append((f, np.array([a0, a0 + h, a1, a1 + h]), pieces))
+    if stuck:
+        why = "; ".join(sorted(set(failures))) if failures else "no exact candidate choice separates there"
+        return BranchResult("undecided", reason=f"{stuck} direction cells reached the finest size uncovered "
+                            f"(the worst choice is on the closure boundary, or between the given points; {why})",
+                            work=work)
+    return BranchResult("robust", cells=covered, work=work)
+
+
+def _split_piece(p, arcs: Arcs, spread_s: float, spread_t: float):
+    """Two halves of a piece ``[arc, s0, s1, t0, t1]`` along ``s`` or ``t`` (the larger spread),
+    or None when neither may be split."""
+    arc = int(p[0])
+    can_s = arcs.splittable_s[arc] and p[2] - p[1] > MIN_PIECE
+    can_t = (not arcs.exact[arc]) and p[4] - p[3] > MIN_PIECE
+    if not (can_s or can_t):
+        return None
+    along_s = can_s and (not can_t or spread_s >= spread_t)
+    a, b = (1, 2) if along_s else (3, 4)
+    mid = (p[a] + p[b]) / 2
+    lo, hi = p.copy(), p.copy()
+    lo[b], hi[a] = mid, mid
+    return np.vstack([lo, hi])
+
+
+def _items(batch, k):
+    """Flat item arrays of a batch of cells, grouped by (cell, contact)."""
+    cell, contact, arc, s0, s1, t0, t1, face, box = [], [], [], [], [], [], [], [], []
+    group_start, group_cell, group_contact = [], [], []
+    n = 0
+    for c, (f, bx, pieces) in enumerate(batch):
+        for i in range(k):
+            p = pieces[i]
+            m = len(p)
+            group_start.append(n)
+            group_cell.append(c)
+            group_contact.append(i)
+            cell.append(np.full(m, c))
+            contact.append(np.full(m, i))
+            arc.append(p[:, 0].astype(np.int64))
+            s0.append(p[:, 1]), s1.append(p[:, 2]), t0.append(p[:, 3]), t1.append(p[:, 4])
+            face.append(np.full(m, f))
+            box.append(np.broadcast_to(bx, (m, 4)))
+            n += m
+    cat = np.concatenate
+    return {"cell": cat(cell), "contact": cat(contact), "arc": cat(arc), "s0": cat(s0), "s1": cat(s1),
+            "t0": cat(t0), "t1": cat(t1), "face": cat(face).astype(np.int64), "box": np.vstack(box),
+            "group_start": np.array(group_start, dtype=np.int64), "group_cell": np.array(group_cell),
+            "group_contact": np.array(group_contact)}
+
+
+def _certify_choice(regions: RegionTuple, cands, choice):
+    contacts = []
+    for r, cs, j in zip(regions.regions, cands, choice):
+        p, n, _ = cs[j]
+        contacts.append(Contact(p, n, r.model, **dict(r.params)))
+    grasp = Grasp(tuple(contacts), center=regions.center, length=regions.length)
+    verdict = force_closure(grasp)
+    if verdict.status == "no_closure" and verify(grasp, verdict.certificate, status="no_closure"):
+        return grasp, verdict
+    return None, f"certify: {verdict.status} at the candidate choice"
+
+
+# --------------------------------------------------------------------------------------------------
+# The certificate and its check
+
+def cells_certificate(cells) -> dict[str, Any]:
+    """The JSON certificate of robustness: ``[face, lo0, hi0, lo1, hi1, contact, pieces]`` per
+    covered cell, each piece ``[arc, s0, s1, t0, t1, candidate]`` (``arc`` global over the
+    tuple's arcs, in region order)."""
+    return {"kind": "cells", "faces": [list(f) for f in FACES],
+            "cells": [[int(f), *[float(v) for v in box], int(i),
+                       [[int(p[0]), float(p[1]), float(p[2]), float(p[3]), float(p[4]), int(p[5])] for p in pieces]]
+                      for f, box, i, pieces in cells]}
+
+
+def _dyadic_square(lo0, hi0, lo1, hi1):
+    """``(width, ix, iy)`` of a dyadic square of the face ``[-1, 1]^2``, or None."""
+    a0, b0, a1, b1 = (Fraction(v) for v in (lo0, hi0, lo1, hi1))
+    w = b0 - a0
+    if w <= 0 or w != b1 - a1 or w > 1 or w.numerator != 1 or w.denominator & (w.denominator - 1):
+        return None
+    x, y = (a0 + 1) / w, (a1 + 1) / w
+    if x.denominator != 1 or y.denominator != 1 or x < 0 or y < 0 or (b0 > 1) or (b1 > 1):
+        return None
+    return w, int(x), int(y)
+
+
+def check_cells(regions: RegionTuple, certificate: Any) -> Check:
+    """Re-check a ``cells`` certificate (module docstring): the cells are dyadic squares tiling
+    every face, each cell's pieces tile every arc of its contact's region, and every piece's
+    bound (recomputed with the stated candidate, in floating point with its rigorous error
+    bound) is positive. Not a search: nothing is solved or refined."""
+    if not isinstance(certificate, dict) or certificate.get("kind") != "cells":
+        return Check(False, "expected a certificate of kind 'cells'")
+    cells = certificate.get("cells")
+    if not isinstance(cells, list) or not cells:
+        return Check(False, "a cells certificate lists its cells")
+    arcs = arcs_of(regions)
+    model = _model(regions)
+    k = len(regions.regions)
+    try:
+        seen: dict = {}
+        area = [Fraction(0)] * 6
+        items = {key: [] for key in ("contact", "arc", "face", "box", "s0", "s1", "t0", "t1", "cand")}
+        for c in cells:
+            f, lo0, hi0, lo1, hi1, i, pieces = c
+            f, i = int(f), int(i)
+            if not (0 <= f < 6 and 0 <= i < k):
+                return Check(False, f"cell {c[:6]}: face or contact out of range")
+            sq = _dyadic_square(float(lo0), float(hi0), float(lo1), float(hi1))
+            if sq is None:
+                return Check(False, f"cell {c[:6]}: not a dyadic square of the face")
+            key = (f,) + sq
+            if key in seen:
+                return Check(False, f"cell {c[:6]} is listed twice")
+            seen[key] = True
+            area[f] += sq[0] ** 2
+            P = np.array(pieces, dtype=float).reshape(-1, 6)
+            if not np.isfinite(P).all():
+                return Check(False, f"cell {c[:6]}: non-finite piece")
+            lo_arc, hi_arc = arcs.first[i], arcs.first[i + 1]
+            arc = P[:, 0].astype(np.int64)
+            if (P[:, 0] != arc).any() or (arc < lo_arc).any() or (arc >= hi_arc).any():
+                return Check(False, f"cell {c[:6]}: a piece is not on an arc of region {i}")
+            cand = P[:, 5].astype(np.int64)
+            if (cand < 0).any() or (cand >= model.weights.shape[1]).any() or not model.cmask[i, cand].all():
+                return Check(False, f"cell {c[:6]}: unknown candidate combination")
+            check = _pieces_tile(P, arcs, range(lo_arc, hi_arc))
+            if not check:
+                return Check(False, f"cell {c[:6]}: {check.reason}")
+            m = len(P)
+            items["contact"].append(np.full(m, i))
+            items["arc"].append(arc)
+            items["face"].append(np.full(m, f))
+            items["box"].append(np.tile([float(lo0), float(hi0), float(lo1), float(hi1)], (m, 1)))
+            for q, name in enumerate(("s0", "s1", "t0", "t1"), start=1):
+                items[name].append(P[:, q])
+            items["cand"].append(cand)
+        for (f, w, x, y) in seen:
+            wa, xa, ya = w, x, y
+            while wa < 1:
+                wa, xa, ya = wa * 2, xa // 2, ya // 2
+                if (f, wa, xa, ya) in seen:
+                    return Check(False, f"cells overlap on face {f}")
+        if any(a != 4 for a in area):
+            return Check(False, "the cells do not cover every face of the direction cube")
+        cat = {key: np.concatenate(v) for key, v in items.items()}
+        lb, _ = bounds(regions, arcs, model, cat["contact"], cat["arc"], cat["face"].astype(np.int64),
+                       cat["box"], cat["s0"], cat["s1"], cat["t0"], cat["t1"], cand=cat["cand"])
+        if not (lb > 0).all():
+            j = int(np.argmin(lb))
+            return Check(False, f"a piece's bound is not positive ({lb[j]:.3g} on arc {int(cat['arc'][j])})")
+    except (TypeError, ValueError, IndexError, KeyError, OverflowError) as err:
+        return Check(False, f"malformed cells certificate: {err}")
+    return Check(True)
+
+
+def _pieces_tile(P: np.ndarray, arcs: Arcs, arc_range) -> Check:
+    """Do the pieces ``P`` (rows ``arc, s0, s1, t0, t1, cand``) tile ``[0, 1]^2`` of every arc?"""
+    for a in arc_range:
+        Q = P[P[:, 0] == a]
+        if not len(Q):
+            return Check(False, f"arc {a} has no piece")
+        s0, s1, t0, t1 = Q[:, 1], Q[:, 2], Q[:, 3], Q[:, 4]
+        if (s0 < 0).any() or (s1 > 1).any() or (t0 < 0).any() or (t1 > 1).any() or (s0 >= s1).any() or (t0 >= t1).any():
+            return Check(False, f"arc {a}: a piece leaves [0, 1]^2 or is empty")
+        total = sum((Fraction(b) - Fraction(x)) * (Fraction(d) - Fraction(c)) for x, b, c, d in zip(s0, s1, t0, t1))
+        if total != 1:
+            return Check(False, f"arc {a}: the pieces do not cover it")
+        over = ((s0[:, None] < s1[None, :]) & (s0[None, :] < s1[:, None]) &
+                (t0[:, None] < t1[None, :]) & (t0[None, :] < t1[:, None]))
+        np.fill_diagonal(over, False)
+        if over.any():
+            return Check(False, f"arc {a}: pieces overlap")
+    return Check(True)
