@@ -1,24 +1,28 @@
 """Conservative decision for curved regions and for a tolerance on normals, by branch and bound.
 
-**Over-approximation.** Each region is cut into *arcs*: a straight region is one arc (its
-segment), a curved region one arc per pair of consecutive points. An arc is over-approximated by
-what a finger there could be (:func:`arcs_of`):
+**Over-approximation.** A *stretch* of a region is the part of its curve over consecutive arcs
+``j0 .. j1 - 1`` (an arc joins two consecutive points of a curved region; a straight region, or a
+single point, is one arc). A stretch is over-approximated by what a finger there could be
+(:class:`Geometry`):
 
-* its point lies in a rectangle on the chord ``[P_j, P_j+1]``: ``P_j + s (P_j+1 - P_j) + h' E``
-  with ``0 <= s <= 1`` and ``|h'| <= h`` (``E`` the chord's unit normal): between two points the
-  curve's tangent stays within ``[a_lo, a_hi]`` of the chord (``a_lo <= 0 <= a_hi``, the angles
-  of :mod:`qualgrasp.certify.region_data`'s reading, ``normal_tol`` included), so it moves forward
-  along the chord and stays within ``h = c tan(a_hi) tan(-a_lo) / (tan(a_hi) + tan(-a_lo))`` of
-  it (the parallelogram of the extreme tangent lines through both ends); a straight region's
-  arc is its segment (``h = 0``);
-* its normal lies in an angular interval ``[psi_lo, psi_hi]`` (the end normals, the chord's
-  normal, widened by ``normal_tol``), or is one exact normal (straight regions with
-  ``normal_tol = 0``).
+* its point lies in a rectangle on the chord ``[P_j0, P_j1]``: ``P_j0 + s (P_j1 - P_j0) + h' E``
+  with ``0 <= s <= 1`` and ``|h'| <= h`` (``E`` the chord's unit normal). On every arc the
+  curve's normal stays within the angles of its end normals and its chord's normal
+  (:mod:`qualgrasp.certify.region_data`'s reading), so over the stretch the tangent stays within
+  ``[a_lo, a_hi]`` of the chord (``a_lo <= 0 <= a_hi``, the extreme angles of those normals and
+  of the stretch's chord normal, widened by ``normal_tol``): the curve moves forward along the
+  chord and stays within ``h = c tan(a_hi) tan(-a_lo) / (tan(a_hi) + tan(-a_lo))`` of it (the
+  parallelogram of the extreme tangent lines through both ends, ``c`` the chord's length). A
+  straight region's stretch is its segment (``h = 0``). A stretch of several arcs whose normals
+  sweep more than :data:`MAX_MERGED` is split first;
+* its normal lies in the angular interval ``[psi_lo, psi_hi]`` of those angles, or is one exact
+  normal (straight regions and single points with ``normal_tol = 0``).
 
 Every constructed number is widened by a margin (``1e-9`` relative, ``1e-12`` radians) that
 absorbs the rounding of the construction (``atan2``, ``cos``, ``sin``, ``tan``, a square root),
-so the sets contain the exact ones. A *piece* of an arc is a sub-box ``[s0, s1] x [t0, t1]`` of its
-chord parameter ``s`` and of its normal's fraction ``t`` of ``[psi_lo, psi_hi]``.
+so the sets contain the exact ones. A *piece* is a stretch and, for a single arc, a sub-box
+``[s0, s1] x [t0, t1]`` of its chord parameter ``s`` and of its normal's fraction ``t`` of
+``[psi_lo, psi_hi]``.
 
 **Covering.** The tuple is not robust iff some ``y != 0`` and some choice have ``y . w_g <= 0``
 for every generator of every contact. Directions ``y`` are covered by cells: the 6 faces of the
@@ -32,19 +36,21 @@ the quadrilateral ``{a n_lo + b n_hi : a, b >= 0, 1 - 1e-9 <= a + b <= 1e-9 + 1 
 (which contains the piece's arc of unit normals) is attained at vertices, 4 x 4 x 4 of them. The
 bound is that minimum, for a fixed convex combination of the generators (one of the candidates of
 :func:`candidate_weights`: single generators, pairs, all), evaluated in floating point minus a
-rigorous error bound ``gamma_40 * (the same sum over absolute values)`` (Higham's ``gamma_n``). All
+rigorous error bound ``gamma_40 * scale`` (Higham's ``gamma_n``, ``scale`` an upper bound of the
+same expression over absolute values; compiled: :mod:`qualgrasp.certify._kernels.regions`). All
 cells covered: **robust**; the certificate lists each cell with its contact and pieces
 (:func:`check_cells` re-checks it: coverage of the faces and of every arc, and every bound).
 
-**Refinement and witnesses.** An uncovered cell first refines the pieces of contacts that are good
-at the cell's centre direction but whose pieces are too coarse; otherwise it is split in four. At
-its centre direction ``y_c`` each region's exact candidate contacts (its given points with the
-given normals, and those normals turned by ``+-normal_tol``, just inside) are scored by ``max_g
-y_c . w_g``; when every region has one with a score ``<= 0``, that choice is certified with
-:func:`qualgrasp.certify.force_closure`: a verified ``no_closure`` is a **witness** (not robust).
-The **budget** counts work units: one unit is one bound of one piece of one contact on one cell
-(64 vertex evaluations per generator). When it is spent, or cells reach the finest size
-(``2^-40`` of a face) uncovered, the verdict is **undecided**.
+**Refinement and witnesses.** At an uncovered cell's centre direction ``y_c`` each region's exact
+candidate contacts (its given points -- a straight region's ends -- with the given normals, and
+those normals turned by just under ``+-normal_tol``) are scored by ``max_g y_c . w_g``. When every
+region has one scoring ``<= 0``, that choice is certified with :func:`qualgrasp.certify.force_closure`:
+a verified ``no_closure`` is a **witness** (not robust). Otherwise the pieces of the region scoring
+best are halved where their bound at ``y_c`` is far below its score and halving improves it (a
+stretch at its middle point, a single arc along ``s`` or ``t``); when none is, the cell is split in
+four. The **budget** counts work units: one unit is one bound of one piece of one contact on one
+cell (64 vertex evaluations per generator, about a microsecond compiled). When it is spent, or
+cells reach the finest size (``2^-40`` of a face) uncovered, the verdict is **undecided**.
 """
 
 from __future__ import annotations
@@ -65,16 +71,16 @@ from .grasp import Contact, Grasp
 from .region_data import CurvedRegion, RegionTuple, StraightRegion
 from .region_exact import region_variant
 
-__all__ = ["FACES", "Arcs", "arcs_of", "candidate_weights", "bounds", "decide_branch", "check_cells",
+__all__ = ["FACES", "Geometry", "MAX_MERGED", "candidate_weights", "cells_certificate", "bounds", "decide_branch", "check_cells",
            "exact_candidates", "turned", "BranchResult", "DEFAULT_BUDGET", "MIN_CELL", "MIN_PIECE"]
 
 #: The 6 faces of the direction cube: ``(axis, sign)`` (axis 0 ``y_fx``, 1 ``y_fy``, 2 ``y_tau``).
 FACES = ((0, 1), (0, -1), (1, 1), (1, -1), (2, 1), (2, -1))
 #: Default budget, in work units (module docstring).
-DEFAULT_BUDGET = 400_000
+DEFAULT_BUDGET = 200_000
 #: Finest cell width (a face is 2 wide) and finest piece width (fractions of an arc).
 MIN_CELL = 2.0 ** -40
-MIN_PIECE = 2.0 ** -24
+MIN_PIECE = 2.0 ** -16
 _REL = 1e-9   # relative widening of constructed lengths
 _ANG = 1e-12  # absolute widening of constructed angles (radians)
 _U = 2.0 ** -53
@@ -84,21 +90,9 @@ _GAMMA = 40 * _U / (1 - 40 * _U)
 # --------------------------------------------------------------------------------------------------
 # Geometry of the arcs
 
-@dataclass(frozen=True)
-class Arcs:
-    """Every arc of every region, as arrays (one row per arc)."""
-
-    region: np.ndarray      # (A,) owner region
-    index: np.ndarray       # (A,) arc number within its region
-    p0: np.ndarray          # (A, 2) chord start
-    p1: np.ndarray          # (A, 2) chord end
-    e: np.ndarray           # (A, 2) unit normal of the chord (zeros when h = 0)
-    h: np.ndarray           # (A,) half height of the rectangle
-    exact: np.ndarray       # (A,) bool: one exact normal
-    normal: np.ndarray      # (A, 2) the exact normal (when exact)
-    psi: np.ndarray         # (A, 2) normal angle interval (when not exact)
-    splittable_s: np.ndarray  # (A,) the chord has positive length
-    first: np.ndarray       # (k + 1,) arcs of region i are first[i]:first[i+1]
+#: Widest normal interval (radians, margins and ``normal_tol`` included) of a piece spanning
+#: several arcs; wider ranges are split at a point before they are bounded.
+MAX_MERGED = math.radians(60)
 
 
 def _turn(n, angle):
@@ -110,55 +104,108 @@ def _signed(u, v) -> float:
     return math.atan2(u[0] * v[1] - u[1] * v[0], u[0] * v[0] + u[1] * v[1])
 
 
-def arcs_of(regions: RegionTuple) -> Arcs:
-    """The arcs of every region, with their rectangles and normal sets (module docstring)."""
-    tol = regions.normal_tol
-    rows: list[tuple] = []
-    first = [0]
-    for i, r in enumerate(regions.regions):
-        if isinstance(r, StraightRegion):
-            a, b, n = np.array(r.a), np.array(r.b), np.array(r.n)
-            psi = math.atan2(n[1], n[0])
-            rows.append((i, 0, a, b, np.zeros(2), 0.0, tol == 0, n,
-                         (psi - tol - _ANG, psi + tol + _ANG), bool((a != b).any())))
-        else:
-            P, N = r.points, r.normals
-            if len(P) == 1:
-                psi = math.atan2(N[0][1], N[0][0])
-                rows.append((i, 0, P[0], P[0], np.zeros(2), 0.0, tol == 0, N[0],
-                             (psi - tol - _ANG, psi + tol + _ANG), False))
-            for j in range(len(P) - 1):
-                rows.append((i, j) + _curved_arc(P[j], P[j + 1], N[j], N[j + 1], tol))
-        first.append(len(rows))
-    cols = list(zip(*rows))
-    return Arcs(np.array(cols[0], dtype=np.int64), np.array(cols[1], dtype=np.int64),
-                np.array(cols[2], dtype=float).reshape(-1, 2), np.array(cols[3], dtype=float).reshape(-1, 2),
-                np.array(cols[4], dtype=float).reshape(-1, 2), np.array(cols[5], dtype=float),
-                np.array(cols[6], dtype=bool), np.array(cols[7], dtype=float).reshape(-1, 2),
-                np.array(cols[8], dtype=float).reshape(-1, 2), np.array(cols[9], dtype=bool),
-                np.array(first, dtype=np.int64))
+class Geometry:
+    """Over-approximations of the stretches ``[j0, j1]`` of the regions' polylines (module
+    docstring), as arrays indexed by a stretch id (:meth:`id`), grown on demand.
+
+    Array attributes (one row per stretch): ``region``, ``j0``, ``j1``; ``p0``, ``p1`` the chord;
+    ``e`` its unit normal; ``h`` the rectangle's half height; ``exact`` (one exact normal,
+    ``normal``) or the normal interval ``psi``; ``splittable_s`` (a single arc of positive
+    length, which may be cut along its chord).
+    """
+
+    _FIELDS = ("region", "j0", "j1", "p0", "p1", "e", "h", "exact", "normal", "psi", "splittable_s")
+
+    def __init__(self, regions: RegionTuple) -> None:
+        self.regions = regions
+        self._rows: list[tuple] = []
+        self._ids: dict[tuple[int, int, int], int | None] = {}
+        self._arrays: dict[str, np.ndarray] | None = None
+
+    def arcs(self, i: int) -> int:
+        """Number of arcs of region ``i`` (1 for a straight region or a single point)."""
+        r = self.regions.regions[i]
+        return 1 if isinstance(r, StraightRegion) or len(r.points) == 1 else len(r.points) - 1
+
+    def id(self, i: int, j0: int, j1: int) -> int | None:
+        """Id of the stretch of region ``i`` over arcs ``j0 .. j1 - 1``, or None when it spans
+        several arcs and its normal interval is wider than :data:`MAX_MERGED` (split it)."""
+        key = (i, j0, j1)
+        if key not in self._ids:
+            row = _stretch(self.regions.regions[i], j0, j1, self.regions.normal_tol)
+            if row is None:
+                self._ids[key] = None
+            else:
+                self._ids[key] = len(self._rows)
+                self._rows.append((i, j0, j1) + row)
+                self._arrays = None
+        return self._ids[key]
+
+    def ranges(self, i: int) -> list[int]:
+        """Ids of a partition of region ``i`` into the fewest halvings that can be bounded."""
+        out: list[int] = []
+        todo = [(0, self.arcs(i))]
+        while todo:
+            j0, j1 = todo.pop()
+            g = self.id(i, j0, j1)
+            if g is None:
+                mid = (j0 + j1) // 2
+                todo += [(mid, j1), (j0, mid)]
+            else:
+                out.append(g)
+        return out
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        if name not in Geometry._FIELDS:
+            raise AttributeError(name)
+        if self._arrays is None:
+            cols = list(zip(*self._rows))
+            shapes = {"p0": 2, "p1": 2, "e": 2, "normal": 2, "psi": 2}
+            dtypes = {"region": np.int64, "j0": np.int64, "j1": np.int64, "exact": bool, "splittable_s": bool}
+            self._arrays = {f: np.array(c, dtype=dtypes.get(f, float)).reshape((-1, shapes[f]) if f in shapes else (-1,))
+                            for f, c in zip(Geometry._FIELDS, cols)}
+        return self._arrays[name]
 
 
-def _curved_arc(p0, p1, n0, n1, tol):
-    """Rectangle and normal interval of one arc of a curved region."""
+def _stretch(r, j0: int, j1: int, tol: float):
+    """``(p0, p1, e, h, exact, normal, psi, splittable_s)`` of arcs ``j0 .. j1 - 1`` of region
+    ``r``, or None (several arcs, too wide a normal interval)."""
+    if isinstance(r, StraightRegion):
+        a, b, n = np.array(r.a), np.array(r.b), np.array(r.n)
+        psi = math.atan2(n[1], n[0])
+        return (a, b, np.zeros(2), 0.0, tol == 0, n, (psi - tol - _ANG, psi + tol + _ANG), bool((a != b).any()))
+    P, N = r.points, r.normals
+    if len(P) == 1:
+        psi = math.atan2(N[0][1], N[0][0])
+        return (P[0], P[0], np.zeros(2), 0.0, tol == 0, N[0], (psi - tol - _ANG, psi + tol + _ANG), False)
+    p0, p1 = P[j0], P[j1]
     chord = p1 - p0
     c = math.hypot(chord[0], chord[1])
-    if c == 0:  # a corner: one point, the normal turns from n0 to n1
-        psi = math.atan2(n0[1], n0[0])
-        turn = _signed(n0, n1)
-        return (p0, p1, np.zeros(2), 0.0, False, n0,
+    if c == 0:
+        if j1 - j0 > 1:
+            return None
+        psi = math.atan2(N[j0][1], N[j0][0])  # a corner: one point, the normal turns from N_j0 to N_j1
+        turn = _signed(N[j0], N[j1])
+        return (p0, p1, np.zeros(2), 0.0, False, N[j0],
                 (psi + min(0.0, turn) - tol - _ANG, psi + max(0.0, turn) + tol + _ANG), False)
     e = np.array([-chord[1], chord[0]]) / c
-    if e @ (n0 + n1) < 0:
+    if e @ N[j0:j1 + 1].sum(axis=0) < 0:
         e = -e
-    b0, b1 = _signed(e, n0), _signed(e, n1)
-    lo = min(b0, b1, 0.0) - tol - _ANG
-    hi = max(b0, b1, 0.0) + tol + _ANG
+    angles = [0.0] + [_signed(e, N[j]) for j in range(j0, j1 + 1)]
+    for j in range(j0, j1):  # every arc's chord normal is attained on it
+        d = P[j + 1] - P[j]
+        if d[0] or d[1]:
+            ej = np.array([-d[1], d[0]])
+            angles.append(_signed(e, ej if ej @ (N[j] + N[j + 1]) >= 0 else -ej))
+    lo = min(angles) - tol - _ANG
+    hi = max(angles) + tol + _ANG
+    if j1 - j0 > 1 and hi - lo > MAX_MERGED:
+        return None
     t1, t2 = math.tan(hi + _ANG), math.tan(-lo + _ANG)
     h = c * t1 * t2 / (t1 + t2)
     h = h * (1 + _REL) + c * _REL + 8 * _U * (np.abs(p0).max() + np.abs(p1).max())
     psi = math.atan2(e[1], e[0])
-    return (p0, p1, e, h, False, e, (psi + lo, psi + hi), True)
+    return (p0, p1, e, h, False, e, (psi + lo, psi + hi), j1 - j0 == 1)
 
 
 # --------------------------------------------------------------------------------------------------
@@ -229,7 +276,7 @@ def cell_vertices(face: np.ndarray, box: np.ndarray) -> np.ndarray:
     return V
 
 
-def _piece_vertices(arcs: Arcs, arc: np.ndarray, s0, s1, t0, t1):
+def _piece_vertices(arcs: Geometry, arc: np.ndarray, s0, s1, t0, t1):
     """Point vertices (B, 4, 2) with their absolute bounds, and normal vertices (B, 4, 2)."""
     h = arcs.h[arc]
     ext = np.where(h > 0, _REL, 0.0)
@@ -254,7 +301,7 @@ def _piece_vertices(arcs: Arcs, arc: np.ndarray, s0, s1, t0, t1):
     return Q, Qabs, Nv
 
 
-def bounds(regions: RegionTuple, arcs: Arcs, model: _Model, contact, arc, face, box, s0, s1, t0, t1,
+def bounds(regions: RegionTuple, arcs: Geometry, model: _Model, contact, arc, face, box, s0, s1, t0, t1,
            Y: np.ndarray | None = None, cand: np.ndarray | None = None):
     """Rigorous lower bounds, per item, of ``L max_g y . w_g`` over a cell and a piece.
 
@@ -373,29 +420,32 @@ class BranchResult:
     choice: list | None = None
     reason: str | None = None
     work: int = 0
+    geometry: Any = None
+    pending: list = field(default_factory=list)
 
 
-def _initial_cells(k_arcs_per_region, first):
+def _initial_cells(geo: Geometry, k: int):
+    pieces = []
+    for i in range(k):
+        ids = geo.ranges(i)
+        n = len(ids)
+        pieces.append(np.column_stack([np.array(ids, dtype=float), np.zeros(n), np.ones(n), np.zeros(n), np.ones(n)]))
     cells = []
     for f in range(6):
         for lo0 in (-1.0, 0.0):
             for lo1 in (-1.0, 0.0):
-                pieces = [np.column_stack([np.arange(first[i], first[i + 1]), np.zeros(n), np.ones(n),
-                                           np.zeros(n), np.ones(n)])
-                          for i, n in enumerate(k_arcs_per_region)]
                 cells.append((f, np.array([lo0, lo0 + 1.0, lo1, lo1 + 1.0]), pieces))
     return cells
 
 
 def decide_branch(regions: RegionTuple, budget: int = DEFAULT_BUDGET, batch_items: int = 4096) -> BranchResult:
     """Branch and bound over direction cells and pieces (module docstring)."""
-    arcs = arcs_of(regions)
+    arcs = Geometry(regions)
     model = _model(regions)
     k = len(regions.regions)
-    first = arcs.first
     cands = exact_candidates(regions)
     cwrench = _candidate_wrenches(regions, cands)
-    queue = deque(_initial_cells([first[i + 1] - first[i] for i in range(k)], first))
+    queue = deque(_initial_cells(arcs, k))
     covered: list = []
     stuck = 0
     work = 0
@@ -410,7 +460,7 @@ def decide_branch(regions: RegionTuple, budget: int = DEFAULT_BUDGET, batch_item
         if work + n_items > budget:
             return BranchResult("undecided", reason=f"budget of {budget} work units spent with "
                                 f"{len(batch) + len(queue)} direction cells still uncovered ({len(covered)} covered)",
-                                work=work)
+                                work=work, cells=covered, pending=list(batch) + list(queue))
         work += n_items
         items = _items(batch, k)
         lb, best = bounds(regions, arcs, model, items["contact"], items["arc"], items["face"], items["box"],
@@ -443,8 +493,11 @@ def decide_branch(regions: RegionTuple, budget: int = DEFAULT_BUDGET, batch_item
                                             items["s0"][idx], items["s1"][idx], items["t0"][idx], items["t1"][idx])
         info = {int(j): (lbc[q], centre[q], sp_s[q], sp_t[q]) for q, j in enumerate(idx)}
         # witnesses: every region has an exact candidate with max_g y_c . w_g <= 0
+        real = {}
         for c in open_cells:
             y = yc_cell[c]
+            scores = [float((cwrench[i] @ y).max(axis=1).min()) for i in range(k)]
+            real[c] = scores
             choice = []
             for i in range(k):
                 score = (cwrench[i] @ y).max(axis=1)
@@ -461,34 +514,44 @@ def decide_branch(regions: RegionTuple, budget: int = DEFAULT_BUDGET, batch_item
                         return BranchResult("not_robust", witness=found[0], verdict=found[1],
                                             choice=[cands[i][j][2] for i, j in enumerate(choice)], work=work)
                     failures.append(found[1])
-        # refinement
+        # refinement: the pieces of the contact that is best at the centre direction (among its
+        # exact candidate contacts) whose bound there is far below what its real candidates give,
+        # when halving them improves that bound; otherwise the cell is split
         item_cell = items["cell"]
+        proposals = []
+        for c in open_cells:
+            i = int(np.argmax(real[c]))
+            if real[c][i] <= 0:
+                continue
+            target = regions.length * real[c][i]
+            rows = np.flatnonzero((item_cell == c) & (items["contact"] == i))
+            for q, j in enumerate(rows):
+                lbc_j, _, sps, spt = info[int(j)]
+                if good[j] or lbc_j > 0.5 * target:
+                    continue
+                halves = _split_piece(batch[c][2][i][q], arcs, sps, spt)
+                if halves is not None:
+                    proposals.append((c, i, q, halves, lbc_j, target))
+        accepted: dict = {}
+        if proposals:
+            H = np.vstack([p[3] for p in proposals])
+            cells_of = np.repeat([p[0] for p in proposals], 2)
+            work += len(H)
+            lbh, _ = bounds(regions, arcs, model, np.repeat([p[1] for p in proposals], 2), H[:, 0].astype(np.int64),
+                            None, None, H[:, 1], H[:, 2], H[:, 3], H[:, 4],
+                            Y=np.repeat(yc_cell[cells_of][:, None, :], 4, axis=1))
+            for n_, (c, i, q, halves, lbc_j, target) in enumerate(proposals):
+                child = min(lbh[2 * n_], lbh[2 * n_ + 1])
+                if child > lbc_j + 0.05 * (target - lbc_j):
+                    accepted.setdefault((c, i), {})[q] = halves
         for c in open_cells:
             f, box, pieces = batch[c]
-            rows = np.flatnonzero(item_cell == c)
-            new_pieces, split_any = [], False
-            for i in range(k):
-                r_i = rows[items["contact"][rows] == i]
-                stats = [info[int(j)] for j in r_i]
-                bad_centre = any(s[1] <= 0 for s in stats)
-                if bad_centre:
-                    new_pieces.append(pieces[i])
-                    continue
-                out = []
-                for q, j in enumerate(r_i):
-                    lbc_j, _, sps, spt = stats[q]
-                    p = pieces[i][q]
-                    if good[j] or lbc_j > 0:
-                        out.append(p[None, :])
-                        continue
-                    halves = _split_piece(p, arcs, sps, spt)
-                    if halves is None:
-                        out.append(p[None, :])
-                    else:
-                        out.append(halves)
-                        split_any = True
-                new_pieces.append(np.vstack(out))
-            if split_any:
+            split = [key for key in accepted if key[0] == c]
+            if split:
+                new_pieces = list(pieces)
+                for _, i in split:
+                    parts = accepted[(c, i)]
+                    new_pieces[i] = np.vstack([parts.get(q, p[None, :]) for q, p in enumerate(pieces[i])])
                 queue.append((f, box, new_pieces))
                 continue
             w = box[1] - box[0]
@@ -504,15 +567,23 @@ def decide_branch(regions: RegionTuple, budget: int = DEFAULT_BUDGET, batch_item
         return BranchResult("undecided", reason=f"{stuck} direction cells reached the finest size uncovered "
                             f"(the worst choice is on the closure boundary, or between the given points; {why})",
                             work=work)
-    return BranchResult("robust", cells=covered, work=work)
+    return BranchResult("robust", cells=covered, work=work, geometry=arcs)
 
 
-def _split_piece(p, arcs: Arcs, spread_s: float, spread_t: float):
-    """Two halves of a piece ``[arc, s0, s1, t0, t1]`` along ``s`` or ``t`` (the larger spread),
-    or None when neither may be split."""
-    arc = int(p[0])
-    can_s = arcs.splittable_s[arc] and p[2] - p[1] > MIN_PIECE
-    can_t = (not arcs.exact[arc]) and p[4] - p[3] > MIN_PIECE
+def _split_piece(p, arcs: Geometry, spread_s: float, spread_t: float):
+    """Two pieces covering the piece ``[stretch, s0, s1, t0, t1]``: a stretch of several arcs is
+    cut at its middle point; a single arc along ``s`` or ``t`` (the larger spread). None when it
+    may not be split."""
+    g = int(p[0])
+    i, j0, j1 = int(arcs.region[g]), int(arcs.j0[g]), int(arcs.j1[g])
+    if j1 - j0 > 1:
+        mid = (j0 + j1) // 2
+        ids = [arcs.id(i, j0, mid), arcs.id(i, mid, j1)]
+        if None in ids:  # pragma: no cover  (a part of a boundable stretch is boundable)
+            return None
+        return np.array([[ids[0], 0.0, 1.0, 0.0, 1.0], [ids[1], 0.0, 1.0, 0.0, 1.0]])
+    can_s = arcs.splittable_s[g] and p[2] - p[1] > MIN_PIECE
+    can_t = (not arcs.exact[g]) and p[4] - p[3] > MIN_PIECE
     if not (can_s or can_t):
         return None
     along_s = can_s and (not can_t or spread_s >= spread_t)
@@ -564,14 +635,20 @@ def _certify_choice(regions: RegionTuple, cands, choice):
 # --------------------------------------------------------------------------------------------------
 # The certificate and its check
 
-def cells_certificate(cells) -> dict[str, Any]:
+def cells_certificate(cells, geo: Geometry) -> dict[str, Any]:
     """The JSON certificate of robustness: ``[face, lo0, hi0, lo1, hi1, contact, pieces]`` per
-    covered cell, each piece ``[arc, s0, s1, t0, t1, candidate]`` (``arc`` global over the
-    tuple's arcs, in region order)."""
-    return {"kind": "cells", "faces": [list(f) for f in FACES],
-            "cells": [[int(f), *[float(v) for v in box], int(i),
-                       [[int(p[0]), float(p[1]), float(p[2]), float(p[3]), float(p[4]), int(p[5])] for p in pieces]]
-                      for f, box, i, pieces in cells]}
+    covered cell (face index into :data:`FACES`, the cell's box on it), each piece
+    ``[j0, j1, s0, s1, t0, t1, candidate]``: arcs ``j0 .. j1 - 1`` of the contact's region,
+    the sub-box of a single arc's chord parameter and normal fraction, and the combination of
+    generators (:func:`candidate_weights`) whose bound is positive."""
+    out = []
+    for f, box, i, pieces in cells:
+        rows = []
+        for p in pieces:
+            g = int(p[0])
+            rows.append([int(geo.j0[g]), int(geo.j1[g]), float(p[1]), float(p[2]), float(p[3]), float(p[4]), int(p[5])])
+        out.append([int(f), *[float(v) for v in box], int(i), rows])
+    return {"kind": "cells", "faces": [list(f) for f in FACES], "cells": out}
 
 
 def _dyadic_square(lo0, hi0, lo1, hi1):
@@ -596,7 +673,7 @@ def check_cells(regions: RegionTuple, certificate: Any) -> Check:
     cells = certificate.get("cells")
     if not isinstance(cells, list) or not cells:
         return Check(False, "a cells certificate lists its cells")
-    arcs = arcs_of(regions)
+    arcs = Geometry(regions)
     model = _model(regions)
     k = len(regions.regions)
     try:
@@ -616,25 +693,24 @@ def check_cells(regions: RegionTuple, certificate: Any) -> Check:
                 return Check(False, f"cell {c[:6]} is listed twice")
             seen[key] = True
             area[f] += sq[0] ** 2
-            P = np.array(pieces, dtype=float).reshape(-1, 6)
-            if not np.isfinite(P).all():
-                return Check(False, f"cell {c[:6]}: non-finite piece")
-            lo_arc, hi_arc = arcs.first[i], arcs.first[i + 1]
-            arc = P[:, 0].astype(np.int64)
-            if (P[:, 0] != arc).any() or (arc < lo_arc).any() or (arc >= hi_arc).any():
-                return Check(False, f"cell {c[:6]}: a piece is not on an arc of region {i}")
-            cand = P[:, 5].astype(np.int64)
-            if (cand < 0).any() or (cand >= model.weights.shape[1]).any() or not model.cmask[i, cand].all():
-                return Check(False, f"cell {c[:6]}: unknown candidate combination")
-            check = _pieces_tile(P, arcs, range(lo_arc, hi_arc))
+            P = np.array(pieces, dtype=float).reshape(-1, 7)
+            if not np.isfinite(P).all() or (P[:, :2] != np.round(P[:, :2])).any() or (P[:, 6] != np.round(P[:, 6])).any():
+                return Check(False, f"cell {c[:6]}: malformed piece")
+            check = _pieces_tile(P, arcs.arcs(i))
             if not check:
                 return Check(False, f"cell {c[:6]}: {check.reason}")
+            ids = [arcs.id(i, int(j0), int(j1)) for j0, j1 in P[:, :2]]
+            if None in ids:
+                return Check(False, f"cell {c[:6]}: a piece spans arcs whose normals turn too much to be bounded")
+            cand = P[:, 6].astype(np.int64)
+            if (cand < 0).any() or (cand >= model.weights.shape[1]).any() or not model.cmask[i, cand].all():
+                return Check(False, f"cell {c[:6]}: unknown candidate combination")
             m = len(P)
             items["contact"].append(np.full(m, i))
-            items["arc"].append(arc)
+            items["arc"].append(np.array(ids, dtype=np.int64))
             items["face"].append(np.full(m, f))
             items["box"].append(np.tile([float(lo0), float(hi0), float(lo1), float(hi1)], (m, 1)))
-            for q, name in enumerate(("s0", "s1", "t0", "t1"), start=1):
+            for q, name in enumerate(("s0", "s1", "t0", "t1"), start=2):
                 items[name].append(P[:, q])
             items["cand"].append(cand)
         for (f, w, x, y) in seen:
@@ -656,20 +732,38 @@ def check_cells(regions: RegionTuple, certificate: Any) -> Check:
     return Check(True)
 
 
-def _pieces_tile(P: np.ndarray, arcs: Arcs, arc_range) -> Check:
-    """Do the pieces ``P`` (rows ``arc, s0, s1, t0, t1, cand``) tile ``[0, 1]^2`` of every arc?"""
-    for a in arc_range:
-        Q = P[P[:, 0] == a]
-        if not len(Q):
+def _pieces_tile(P: np.ndarray, count: int) -> Check:
+    """Do the pieces ``P`` (rows ``j0, j1, s0, s1, t0, t1, cand``) tile the ``count`` arcs of a
+    region? Stretches of several arcs take whole arcs (``s`` and ``t`` over ``[0, 1]``); the
+    pieces of a single arc tile its ``[0, 1]^2``."""
+    j0, j1 = P[:, 0].astype(np.int64), P[:, 1].astype(np.int64)
+    s0, s1, t0, t1 = P[:, 2], P[:, 3], P[:, 4], P[:, 5]
+    if (j0 < 0).any() or (j1 > count).any() or (j1 <= j0).any():
+        return Check(False, "a piece is not a stretch of the region's arcs")
+    if (s0 < 0).any() or (s1 > 1).any() or (t0 < 0).any() or (t1 > 1).any() or (s0 >= s1).any() or (t0 >= t1).any():
+        return Check(False, "a piece leaves [0, 1]^2 or is empty")
+    whole = (j1 - j0 > 1) | ((s0 == 0) & (s1 == 1) & (t0 == 0) & (t1 == 1))
+    if ((j1 - j0 > 1) & ~whole).any():
+        return Check(False, "a piece of several arcs must take them whole")
+    cover = np.zeros(count, dtype=np.int64)
+    for a, b in zip(j0[whole], j1[whole]):
+        cover[a:b] += 1
+    if (cover > 1).any():
+        return Check(False, "pieces overlap")
+    for a in range(count):
+        part = ~whole & (j0 == a)
+        if cover[a]:
+            if part.any():
+                return Check(False, f"arc {a}: pieces overlap")
+            continue
+        if not part.any():
             return Check(False, f"arc {a} has no piece")
-        s0, s1, t0, t1 = Q[:, 1], Q[:, 2], Q[:, 3], Q[:, 4]
-        if (s0 < 0).any() or (s1 > 1).any() or (t0 < 0).any() or (t1 > 1).any() or (s0 >= s1).any() or (t0 >= t1).any():
-            return Check(False, f"arc {a}: a piece leaves [0, 1]^2 or is empty")
-        total = sum((Fraction(b) - Fraction(x)) * (Fraction(d) - Fraction(c)) for x, b, c, d in zip(s0, s1, t0, t1))
+        a0, a1, b0, b1 = s0[part], s1[part], t0[part], t1[part]
+        total = sum((Fraction(x1) - Fraction(x0)) * (Fraction(y1) - Fraction(y0)) for x0, x1, y0, y1 in zip(a0, a1, b0, b1))
         if total != 1:
             return Check(False, f"arc {a}: the pieces do not cover it")
-        over = ((s0[:, None] < s1[None, :]) & (s0[None, :] < s1[:, None]) &
-                (t0[:, None] < t1[None, :]) & (t0[None, :] < t1[:, None]))
+        over = ((a0[:, None] < a1[None, :]) & (a0[None, :] < a1[:, None]) &
+                (b0[:, None] < b1[None, :]) & (b0[None, :] < b1[:, None]))
         np.fill_diagonal(over, False)
         if over.any():
             return Check(False, f"arc {a}: pieces overlap")

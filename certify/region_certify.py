@@ -215,7 +215,7 @@ def _exact_route(regions: RegionTuple, tol: float) -> RegionVerdict:
 def _branch_route(regions: RegionTuple, budget: int) -> RegionVerdict:
     res = decide_branch(regions, budget)
     if res.status == "robust":
-        return RegionVerdict("robust", cells_certificate(res.cells), route="branch", work=res.work)
+        return RegionVerdict("robust", cells_certificate(res.cells, res.geometry), route="branch", work=res.work)
     if res.status == "not_robust":
         return RegionVerdict("not_robust", _witness_certificate(res.choice, res.verdict), res.witness,
                              res.verdict, route="branch", work=res.work)
