@@ -35,12 +35,16 @@ import numpy as np
 from .closure import Verdict, force_closure
 from .errors import GraspError
 from .grasp import Contact, Grasp
-from .region_certify import DEFAULT_BUDGET, RegionVerdict, certify_regions
+from .region_certify import RegionVerdict, certify_regions
 from .region_data import CurvedRegion, RegionTuple, StraightRegion
 
-__all__ = ["Boundary", "IndependentRegions", "independent_regions", "enclosing_diameter"]
+__all__ = ["Boundary", "IndependentRegions", "independent_regions", "enclosing_diameter", "SEARCH_BUDGET"]
 
 _NORMAL_EQ = 1e-9
+#: Default branch-and-bound budget of each region tuple tried by the bisection (work units):
+#: smaller than :func:`certify_regions`' default, since a tuple left undecided only makes the
+#: certified ``delta`` a little smaller.
+SEARCH_BUDGET = 50_000
 
 
 def enclosing_diameter(points) -> float:
@@ -344,7 +348,7 @@ def _contacts(boundary: Boundary, contacts, models) -> list[Contact]:
 
 
 def independent_regions(boundary, normals, contacts, *, limits=None, models=None, tol: float | None = None,
-                        symmetric: bool = True, normal_tol: float = 0.0, budget: int = DEFAULT_BUDGET,
+                        symmetric: bool = True, normal_tol: float = 0.0, budget: int = SEARCH_BUDGET,
                         center=None, length=None, on_boundary: float = 1e-6) -> IndependentRegions:
     """The largest independent contact regions of a grasp on a closed boundary (module docstring).
 
@@ -372,7 +376,8 @@ def independent_regions(boundary, normals, contacts, *, limits=None, models=None
     normal_tol : float
         Passed to the region tuples (radians).
     budget : int
-        Branch-and-bound budget per region tuple (curved stretches, ``normal_tol > 0``).
+        Branch-and-bound budget per region tuple tried (curved stretches, ``normal_tol > 0``;
+        default :data:`SEARCH_BUDGET`).
     center, length : optional
         Torque scaling of the tuples (default the grasp's, as certify defaults it).
     on_boundary : float
