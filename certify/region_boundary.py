@@ -446,7 +446,7 @@ def independent_regions(boundary, normals, contacts, *, limits=None, models=None
                 regions.append(StraightRegion(*data, c.model, **params))
             else:
                 regions.append(CurvedRegion(*data, c.model, **params))
-        return RegionTuple(regions, normal_tol, center=grasp.center, length=grasp.length)
+        return RegionTuple(regions, normal_tol, center=grasp.center, length=grasp.length, id=grasp.id)
 
     def certified(deltas) -> RegionVerdict | None:
         key = tuple(round(d, 12) for d in deltas)
