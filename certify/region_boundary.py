@@ -246,7 +246,7 @@ class Boundary:
         """Unwrapped edge index containing ``s``; at a shared point, the edge after (``up``) or
         before it."""
         per, n = self.perimeter, len(self.points)
-        k = math.floor(s / per)
+        k = math.floor(s / per) if up else math.ceil(s / per) - 1  # r in [0, per) or (0, per]
         r = s - k * per
         e = int(np.searchsorted(self.cum, r, side="right" if up else "left")) - 1
         e = min(max(e, 0), n - 1)
@@ -379,7 +379,8 @@ def independent_regions(boundary, normals, contacts, *, limits=None, models=None
         Branch-and-bound budget per region tuple tried (curved stretches, ``normal_tol > 0``;
         default :data:`SEARCH_BUDGET`).
     center, length : optional
-        Torque scaling of the tuples (default the grasp's, as certify defaults it).
+        Torque scaling of the tuples (default: those of ``contacts`` when it is a Grasp, else
+        certify's defaults). The tuples carry the grasp's id.
     on_boundary : float
         Largest distance of a contact from the boundary, fraction of the object's size.
 
@@ -411,7 +412,10 @@ def independent_regions(boundary, normals, contacts, *, limits=None, models=None
     t0 = time.perf_counter()
     B = Boundary.of(boundary, normals)
     cs = _contacts(B, contacts, models)
-    grasp = Grasp(tuple(cs), center=center, length=length)
+    if isinstance(contacts, Grasp):  # its torque scaling and id, unless given
+        center = contacts.center if center is None else center
+        length = contacts.length if length is None else length
+    grasp = Grasp(tuple(cs), center=center, length=length, id=contacts.id if isinstance(contacts, Grasp) else None)
     k = len(cs)
     tol = 1e-3 * B.size if tol is None else float(tol)
     if not tol > 0:

@@ -100,14 +100,19 @@ def contact_limits(outline: Outline, regions: list[Region], points: np.ndarray, 
     n = len(points)
     D = np.roll(points, -1, axis=0) - points
     cum = np.concatenate([[0.0], np.cumsum(np.hypot(D[:, 0], D[:, 1]))])
-    j = int(np.argmin(np.hypot(*(points - np.asarray(p, float)).T)))
+    dist = np.hypot(*(points - np.asarray(p, float)).T)
+    j = int(np.argmin(dist))
+    if dist[j] > ON_OUTLINE * outline.size + 2 * outline.spacing:
+        raise GraspError(f"the contact at {[round(float(v), 2) for v in p]} is {dist[j]:.3g} px from the outline "
+                         f"(more than {ON_OUTLINE:g} of the object's size {outline.size:.3g} px)")
     for r in regions:
         if any((j - r.start) % n == q for q in range(r.stop - r.start)):
             return _arc_limits(cum, r.start, r.stop, n)
     for seg in outline.segments:
         if (j - seg.start) % n < seg.stop - seg.start:
             if seg.is_point:
-                raise GraspError(f"the contact at {[round(float(v), 2) for v in p]} lies on a {seg.name}: "
+                article = "an" if seg.name[0] in "aeiou" else "a"
+                raise GraspError(f"the contact at {[round(float(v), 2) for v in p]} lies on {article} {seg.name}: "
                                  "no finger goes there")
             return _arc_limits(cum, seg.start, seg.stop, n)
     raise GraspError(f"the contact at {list(p)} is on no outline element")  # pragma: no cover
