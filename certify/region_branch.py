@@ -425,11 +425,11 @@ class BranchResult:
 
 
 def _initial_cells(geo: Geometry, k: int):
-    pieces = []
-    for i in range(k):
-        ids = geo.ranges(i)
-        n = len(ids)
-        pieces.append(np.column_stack([np.array(ids, dtype=float), np.zeros(n), np.ones(n), np.zeros(n), np.ones(n)]))
+    """24 cells (each face in 2 x 2), every region in its fewest boundable stretches. A cell is
+    ``(face, box, pieces)``, ``pieces`` rows ``contact, stretch id, s0, s1, t0, t1`` sorted by
+    contact (never modified in place: children share them)."""
+    rows = [[i, g, 0.0, 1.0, 0.0, 1.0] for i in range(k) for g in geo.ranges(i)]
+    pieces = np.array(rows, dtype=float)
     cells = []
     for f in range(6):
         for lo0 in (-1.0, 0.0):
@@ -438,13 +438,19 @@ def _initial_cells(geo: Geometry, k: int):
     return cells
 
 
+#: Work units charged for certifying a candidate witness with force_closure.
+CERTIFY_COST = 500
+
+
 def decide_branch(regions: RegionTuple, budget: int = DEFAULT_BUDGET, batch_items: int = 4096) -> BranchResult:
     """Branch and bound over direction cells and pieces (module docstring)."""
     arcs = Geometry(regions)
     model = _model(regions)
     k = len(regions.regions)
+    L = regions.length
     cands = exact_candidates(regions)
     cwrench = _candidate_wrenches(regions, cands)
+    cscale = [1e-12 * (1 + np.abs(w).max()) for w in cwrench]
     queue = deque(_initial_cells(arcs, k))
     covered: list = []
     stuck = 0
@@ -453,106 +459,96 @@ def decide_branch(regions: RegionTuple, budget: int = DEFAULT_BUDGET, batch_item
     failures: list[str] = []
     while queue:
         batch, n_items = [], 0
-        while queue and (not batch or n_items + sum(len(p) for p in queue[0][2]) <= batch_items):
+        while queue and (not batch or n_items + len(queue[0][2]) <= batch_items):
             cell = queue.popleft()
             batch.append(cell)
-            n_items += sum(len(p) for p in cell[2])
+            n_items += len(cell[2])
         if work + n_items > budget:
             return BranchResult("undecided", reason=f"budget of {budget} work units spent with "
                                 f"{len(batch) + len(queue)} direction cells still uncovered ({len(covered)} covered)",
                                 work=work, cells=covered, pending=list(batch) + list(queue))
         work += n_items
-        items = _items(batch, k)
-        lb, best = bounds(regions, arcs, model, items["contact"], items["arc"], items["face"], items["box"],
-                          items["s0"], items["s1"], items["t0"], items["t1"])
+        it = _items(batch, k)
+        lb, best = bounds(regions, arcs, model, it["contact"], it["arc"], it["face"], it["box"],
+                          it["s0"], it["s1"], it["t0"], it["t1"])
         good = lb > 0
-        starts = items["group_start"]
-        group_good = np.logical_and.reduceat(good, starts) if len(good) else np.zeros(0, bool)
-        group_cell = items["group_cell"]
+        group_good = np.logical_and.reduceat(good, it["group_start"])
         covering = {}
         for g in np.flatnonzero(group_good):
-            covering.setdefault(int(group_cell[g]), int(items["group_contact"][g]))
-        open_cells = [c for c in range(len(batch)) if c not in covering]
+            covering.setdefault(int(it["group_cell"][g]), int(it["group_contact"][g]))
         for c, i in covering.items():
             f, box, pieces = batch[c]
-            sel = (items["cell"] == c) & (items["contact"] == i)
-            covered.append((f, box, i, np.column_stack([pieces[i], best[sel]])))
-        if not open_cells:
+            sel = (it["cell"] == c) & (it["contact"] == i)
+            covered.append((f, box, i, np.column_stack([pieces[pieces[:, 0] == i][:, 1:], best[sel]])))
+        open_cells = np.array([c for c in range(len(batch)) if c not in covering], dtype=np.int64)
+        if not len(open_cells):
             continue
-        # analysis of the open cells at their centre directions
-        sel = np.isin(items["cell"], open_cells)
-        idx = np.flatnonzero(sel)
-        work += len(idx)
-        yc_cell = cell_vertices(np.array([batch[c][0] for c in range(len(batch))]),
-                                np.array([batch[c][1] for c in range(len(batch))])).mean(axis=1)
-        Yc = yc_cell[items["cell"][idx]]
-        lbc, _ = bounds(regions, arcs, model, items["contact"][idx], items["arc"][idx], None, None,
-                        items["s0"][idx], items["s1"][idx], items["t0"][idx], items["t1"][idx],
-                        Y=np.repeat(Yc[:, None, :], 4, axis=1))
-        centre, sp_s, sp_t = _centre_values(regions, arcs, model, items["contact"][idx], items["arc"][idx], Yc,
-                                            items["s0"][idx], items["s1"][idx], items["t0"][idx], items["t1"][idx])
-        info = {int(j): (lbc[q], centre[q], sp_s[q], sp_t[q]) for q, j in enumerate(idx)}
+        # the centre directions of the open cells, and every region's best exact candidate there
+        yc_all = cell_vertices(np.array([b[0] for b in batch]), np.array([b[1] for b in batch])).mean(axis=1)
+        Yc = yc_all[open_cells]
+        real = np.empty((k, len(open_cells)))
+        pick = np.empty((k, len(open_cells)), dtype=np.int64)
+        for i in range(k):
+            scores = np.einsum("cgd,nd->cgn", cwrench[i], Yc).max(axis=1)  # (candidates, cells)
+            pick[i] = scores.argmin(axis=0)
+            real[i] = scores.min(axis=0)
         # witnesses: every region has an exact candidate with max_g y_c . w_g <= 0
-        real = {}
-        for c in open_cells:
-            y = yc_cell[c]
-            scores = [float((cwrench[i] @ y).max(axis=1).min()) for i in range(k)]
-            real[c] = scores
-            choice = []
-            for i in range(k):
-                score = (cwrench[i] @ y).max(axis=1)
-                j = int(score.argmin())
-                if score[j] > 1e-12 * (1 + np.abs(cwrench[i]).max()):
-                    break
-                choice.append(j)
-            else:
-                key = tuple(choice)
-                if key not in tried:
-                    tried.add(key)
-                    found = _certify_choice(regions, cands, choice)
-                    if found[0] is not None:
-                        return BranchResult("not_robust", witness=found[0], verdict=found[1],
-                                            choice=[cands[i][j][2] for i, j in enumerate(choice)], work=work)
-                    failures.append(found[1])
-        # refinement: the pieces of the contact that is best at the centre direction (among its
-        # exact candidate contacts) whose bound there is far below what its real candidates give,
-        # when halving them improves that bound; otherwise the cell is split
-        item_cell = items["cell"]
-        proposals = []
-        for c in open_cells:
-            i = int(np.argmax(real[c]))
-            if real[c][i] <= 0:
+        for q in np.flatnonzero((real <= np.array(cscale)[:, None]).all(axis=0)):
+            key = tuple(int(v) for v in pick[:, q])
+            if key in tried:
                 continue
-            target = regions.length * real[c][i]
-            rows = np.flatnonzero((item_cell == c) & (items["contact"] == i))
-            for q, j in enumerate(rows):
-                lbc_j, _, sps, spt = info[int(j)]
-                if good[j] or lbc_j > 0.5 * target:
-                    continue
-                halves = _split_piece(batch[c][2][i][q], arcs, sps, spt)
-                if halves is not None:
-                    proposals.append((c, i, q, halves, lbc_j, target))
-        accepted: dict = {}
-        if proposals:
-            H = np.vstack([p[3] for p in proposals])
-            cells_of = np.repeat([p[0] for p in proposals], 2)
-            work += len(H)
-            lbh, _ = bounds(regions, arcs, model, np.repeat([p[1] for p in proposals], 2), H[:, 0].astype(np.int64),
-                            None, None, H[:, 1], H[:, 2], H[:, 3], H[:, 4],
-                            Y=np.repeat(yc_cell[cells_of][:, None, :], 4, axis=1))
-            for n_, (c, i, q, halves, lbc_j, target) in enumerate(proposals):
-                child = min(lbh[2 * n_], lbh[2 * n_ + 1])
-                if child > lbc_j + 0.05 * (target - lbc_j):
-                    accepted.setdefault((c, i), {})[q] = halves
+            tried.add(key)
+            work += CERTIFY_COST
+            found = _certify_choice(regions, cands, key)
+            if found[0] is not None:
+                return BranchResult("not_robust", witness=found[0], verdict=found[1],
+                                    choice=[cands[i][j][2] for i, j in enumerate(key)], work=work)
+            failures.append(found[1])
+        # refinement: the pieces of the region best at the centre direction (among its exact
+        # candidates) whose bound there is far below that region's score, when halving them
+        # improves that bound; otherwise the cell is split in four
+        slot = np.full(len(batch), -1, dtype=np.int64)
+        slot[open_cells] = np.arange(len(open_cells))
+        best_i = real.argmax(axis=0)
+        target = L * real[best_i, np.arange(len(open_cells))]
+        item_slot = slot[it["cell"]]
+        cand_items = np.flatnonzero((item_slot >= 0) & ~good)
+        cand_items = cand_items[(it["contact"][cand_items] == best_i[item_slot[cand_items]])
+                                & (target[item_slot[cand_items]] > 0)]
+        accepted: dict[int, dict[int, np.ndarray]] = {}
+        if len(cand_items):
+            work += len(cand_items)
+            Ycand = np.repeat(Yc[item_slot[cand_items]][:, None, :], 4, axis=1)
+            lbc, _ = bounds(regions, arcs, model, it["contact"][cand_items], it["arc"][cand_items], None, None,
+                            it["s0"][cand_items], it["s1"][cand_items], it["t0"][cand_items], it["t1"][cand_items], Y=Ycand)
+            far = lbc <= 0.5 * target[item_slot[cand_items]]
+            sel = cand_items[far]
+            if len(sel):
+                _, sp_s, sp_t = _centre_values(regions, arcs, model, it["contact"][sel], it["arc"][sel],
+                                               Yc[item_slot[sel]], it["s0"][sel], it["s1"][sel], it["t0"][sel], it["t1"][sel])
+                proposals = []
+                for q, j in enumerate(sel):
+                    c = int(it["cell"][j])
+                    row = batch[c][2][it["row"][j]]
+                    halves = _split_piece(row[1:], arcs, sp_s[q], sp_t[q])
+                    if halves is not None:
+                        proposals.append((c, int(it["row"][j]), np.column_stack([np.full(2, row[0]), halves]),
+                                          float(lbc[far][q]), float(target[item_slot[j]])))
+                if proposals:
+                    H = np.vstack([p[2] for p in proposals])
+                    work += len(H)
+                    cells_of = np.repeat([p[0] for p in proposals], 2)
+                    lbh, _ = bounds(regions, arcs, model, H[:, 0].astype(np.int64), H[:, 1].astype(np.int64), None, None,
+                                    H[:, 2], H[:, 3], H[:, 4], H[:, 5],
+                                    Y=np.repeat(yc_all[cells_of][:, None, :], 4, axis=1))
+                    for n_, (c, r, halves, lbc_j, tg) in enumerate(proposals):
+                        if min(lbh[2 * n_], lbh[2 * n_ + 1]) > lbc_j + 0.05 * (tg - lbc_j):
+                            accepted.setdefault(c, {})[r] = halves
         for c in open_cells:
             f, box, pieces = batch[c]
-            split = [key for key in accepted if key[0] == c]
-            if split:
-                new_pieces = list(pieces)
-                for _, i in split:
-                    parts = accepted[(c, i)]
-                    new_pieces[i] = np.vstack([parts.get(q, p[None, :]) for q, p in enumerate(pieces[i])])
-                queue.append((f, box, new_pieces))
+            if c in accepted:
+                parts = accepted[c]
+                queue.append((f, box, np.vstack([parts.get(r, pieces[r:r + 1]) for r in range(len(pieces))])))
                 continue
             w = box[1] - box[0]
             if w / 2 < MIN_CELL:
@@ -595,29 +591,18 @@ def _split_piece(p, arcs: Geometry, spread_s: float, spread_t: float):
 
 
 def _items(batch, k):
-    """Flat item arrays of a batch of cells, grouped by (cell, contact)."""
-    cell, contact, arc, s0, s1, t0, t1, face, box = [], [], [], [], [], [], [], [], []
-    group_start, group_cell, group_contact = [], [], []
-    n = 0
-    for c, (f, bx, pieces) in enumerate(batch):
-        for i in range(k):
-            p = pieces[i]
-            m = len(p)
-            group_start.append(n)
-            group_cell.append(c)
-            group_contact.append(i)
-            cell.append(np.full(m, c))
-            contact.append(np.full(m, i))
-            arc.append(p[:, 0].astype(np.int64))
-            s0.append(p[:, 1]), s1.append(p[:, 2]), t0.append(p[:, 3]), t1.append(p[:, 4])
-            face.append(np.full(m, f))
-            box.append(np.broadcast_to(bx, (m, 4)))
-            n += m
-    cat = np.concatenate
-    return {"cell": cat(cell), "contact": cat(contact), "arc": cat(arc), "s0": cat(s0), "s1": cat(s1),
-            "t0": cat(t0), "t1": cat(t1), "face": cat(face).astype(np.int64), "box": np.vstack(box),
-            "group_start": np.array(group_start, dtype=np.int64), "group_cell": np.array(group_cell),
-            "group_contact": np.array(group_contact)}
+    """Flat item arrays of a batch of cells (one item per piece), grouped by (cell, contact)."""
+    counts = np.array([len(p) for _, _, p in batch])
+    P = np.vstack([p for _, _, p in batch])
+    cell = np.repeat(np.arange(len(batch)), counts)
+    contact = P[:, 0].astype(np.int64)
+    key = cell * k + contact
+    start = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    offsets = np.r_[0, np.cumsum(counts)[:-1]]
+    return {"cell": cell, "contact": contact, "arc": P[:, 1].astype(np.int64), "s0": P[:, 2], "s1": P[:, 3],
+            "t0": P[:, 4], "t1": P[:, 5], "face": np.repeat([b[0] for b in batch], counts).astype(np.int64),
+            "box": np.repeat(np.array([b[1] for b in batch]), counts, axis=0), "row": np.arange(len(P)) - offsets[cell],
+            "group_start": start, "group_cell": cell[start], "group_contact": contact[start]}
 
 
 def _certify_choice(regions: RegionTuple, cands, choice):
