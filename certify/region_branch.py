@@ -49,7 +49,8 @@ a verified ``no_closure`` is a **witness** (not robust). Otherwise the pieces of
 best are halved where their bound at ``y_c`` is far below its score and halving improves it (a
 stretch at its middle point, a single arc along ``s`` or ``t``); when none is, the cell is split in
 four. The **budget** counts work units: one unit is one bound of one piece of one contact on one
-cell (64 vertex evaluations per generator, about a microsecond compiled). When it is spent, or
+cell (64 vertex evaluations per generator; about 10 microseconds with the search around it), and a
+candidate witness certified costs :data:`CERTIFY_COST` units. When the budget is spent, or
 cells reach the finest size (``2^-40`` of a face) uncovered, the verdict is **undecided**.
 """
 

@@ -126,8 +126,8 @@ def certify_regions(regions, *, budget: int = DEFAULT_BUDGET, tol: float = DEFAU
     budget : int
         Work units of the branch and bound (curved regions, ``normal_tol > 0``): one unit is one
         bound of one piece of one region on one cell of wrench directions (64 vertex evaluations
-        per generator, about a microsecond). Straight regions with ``normal_tol = 0`` are decided
-        exactly, with no budget.
+        per generator; about 10 microseconds, so the default takes at most about 2 s).
+        Straight regions with ``normal_tol = 0`` are decided exactly, with no budget.
     tol : float
         Exact route: an LP slack within ``tol`` of 0 is on the closure boundary; the verdict is
         then robust only when the exact check accepts the certificate anyway, not robust only
