@@ -319,6 +319,11 @@ class IndependentRegions:
     evaluations: int = 0
     seconds: float = 0.0
 
+    @property
+    def certificate(self) -> dict | None:
+        """The certificate of the certified regions (None when none is certified)."""
+        return None if self.verdict is None else self.verdict.certificate
+
 
 def _contacts(boundary: Boundary, contacts, models) -> list[Contact]:
     if isinstance(contacts, Grasp):
