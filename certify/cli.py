@@ -1,7 +1,9 @@
-"""Command-line layer of :mod:`qualgrasp.certify`: ``qualgrasp certify``, ``verify`` and ``bench``.
+"""Command-line layer of :mod:`qualgrasp.certify`: ``qualgrasp certify``, ``verify``,
+``certify-regions``, ``bench`` and ``sample``.
 
 Each command is a thin wrapper over a public function (:func:`qualgrasp.certify.batch.certify_file`,
-:func:`qualgrasp.certify.batch.verify_file`, :func:`qualgrasp.certify.bench.run_bench`).
+:func:`qualgrasp.certify.batch.verify_file`, :func:`qualgrasp.certify.regions.certify_region_file`,
+:func:`qualgrasp.certify.regions.verify_region_file`, :func:`qualgrasp.certify.bench.run_bench`).
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from . import models
 from .batch import certify_file, verify_file
 from .bench import print_bench, print_quality_bench, run_bench, run_quality_bench
 from .errors import CertifyError
+from .regions import DEFAULT_BUDGET, certify_region_file, verify_region_file
 from .samples import write_random_grasp_file
 from .table import count_grasps
 from .validation import MAX_CONTACTS
@@ -95,15 +98,26 @@ def certify_command(
 
 
 def verify_command(
-    results: Path = typer.Argument(..., help="Results file written by 'qualgrasp certify'."),
-    grasps: Path = typer.Option(..., "--grasps", help="The grasp set the results came from."),
-    workers: int = typer.Option(0, help="Worker processes (0: all cores)."),
+    results: Path = typer.Argument(..., help="Results file written by 'qualgrasp certify' or 'certify-regions'."),
+    grasps: Path | None = typer.Option(None, "--grasps", help="The grasp set the results came from."),
+    regions: Path | None = typer.Option(None, "--regions", help="The region set the results came from "
+                                        "(results of 'qualgrasp certify-regions')."),
+    workers: int = typer.Option(0, help="Worker processes (0: all cores; grasp sets only)."),
 ) -> None:
-    """Re-check every certificate without a solver; print the id of each one that fails."""
+    """Re-check every certificate without a solver; print the id of each one that fails.
+
+    Give exactly one of --grasps (results of 'qualgrasp certify') and --regions (results of
+    'qualgrasp certify-regions'). Exit code 1 when a row fails, 2 when the run cannot start.
+    """
+    if (grasps is None) == (regions is None):
+        _fail("give exactly one of --grasps and --regions")
     if workers < 0:
         _fail(f"--workers must be 0 (all cores) or a number of processes, got {workers}")
     try:
-        summary = verify_file(results, grasps, workers=workers or None)
+        if regions is not None:
+            summary = verify_region_file(results, regions)
+        else:
+            summary = verify_file(results, grasps, workers=workers or None)
     except CertifyError as err:
         _fail(str(err))
     for gid, reason in summary.failures:
@@ -112,6 +126,43 @@ def verify_command(
     console.print(f"{checked} certified rows re-checked, {summary.errors} error rows skipped, "
                   f"{len(summary.failures)} failed")
     if summary.failures:
+        raise typer.Exit(1)
+
+
+def certify_regions_command(
+    regions: Path = typer.Argument(..., help="Region set: JSON Lines, one region tuple per line."),
+    output: Path = typer.Option(..., "-o", "--output", help="Results file (JSON Lines); never the input."),
+    budget: int = typer.Option(DEFAULT_BUDGET, help="Branch-and-bound work units per tuple (curved regions, "
+                               "normal_tol > 0); straight regions with normal_tol 0 are decided exactly."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar or summary."),
+) -> None:
+    """Certify region tuples: is every choice of one contact per region in force closure?
+
+    One results row per tuple line: status robust, not_robust (with a witness grasp and its
+    Farkas certificate), undecided or error, the certificate, and whether it re-checked. Exit
+    code 1 when some rows are errors or failed their own re-check, 2 when the run cannot start.
+    """
+    try:  # for the progress bar only: the reader reports what is wrong with the file
+        total = sum(1 for line in regions.open("rb") if line.strip()) if regions.is_file() else None
+    except OSError:
+        total = None
+    with Progress(TextColumn("regions"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
+                  console=console, disable=quiet) as bar:
+        task = bar.add_task("regions", total=total)
+        try:
+            summary = certify_region_file(regions, output, budget=budget, progress=lambda n: bar.advance(task, n))
+        except CertifyError as err:
+            _fail(str(err))
+    if not quiet:
+        table = Table(title=f"{summary.rows} region tuples -> {output}")
+        table.add_column("status")
+        table.add_column("rows", justify="right")
+        for status, count in sorted(summary.statuses.items()):
+            table.add_row(status, str(count))
+        table.add_row("unverified", str(summary.unverified))
+        console.print(table)
+        console.print(f"{summary.seconds:.1f} s")
+    if summary.errors or summary.unverified:
         raise typer.Exit(1)
 
 
@@ -172,5 +223,6 @@ def register(app: typer.Typer) -> None:
     """Add the certify commands to the ``qualgrasp`` application."""
     app.command("certify")(certify_command)
     app.command("verify")(verify_command)
+    app.command("certify-regions")(certify_regions_command)
     app.command("bench")(bench_command)
     app.command("sample")(sample_command)

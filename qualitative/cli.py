@@ -9,11 +9,14 @@ from pathlib import Path
 import typer
 
 from ..certify.checks import FIGURE_SUFFIXES, number_in, output_file
+from ..certify.errors import CertifyError
 from ..certify.io import write_grasps
 from ..certify.models import MAX_MU
+from ..certify.region_boundary import SEARCH_BUDGET
 from . import procedures
 from .errors import FormulaError, QualitativeError, TraceError
 from .grasp_plot import synthesis_figure
+from .independent import independent_file
 from .outline import DEFAULT_SCALE, SCALE_MAX, outline_image, outline_scales, outline_to_dict
 from .plot import outline_figure
 from .regions import feasible_regions, regions_to_dict
@@ -49,6 +52,7 @@ def register(app: typer.Typer) -> None:
     app.command("outline")(outline_command)
     app.command("regions")(regions_command)
     app.command("synthesize")(synthesize_command)
+    app.command("independent-regions")(independent_regions_command)
 
 
 def st0_command(
@@ -239,4 +243,53 @@ def synthesize_command(
                    "artefact of the pixels; do not rely on them")
     if s["certified"] < s["grasps"]:
         typer.echo("error: some synthesised grasps did not certify (a synthesis bug: please report it)", err=True)
+        raise typer.Exit(1)
+
+
+def independent_regions_command(
+    image: Path = typer.Argument(..., help="Image file (PNG, JPEG, anything OpenCV reads)."),
+    grasps: Path = typer.Argument(..., help="Grasp set (JSON Lines, certify's format), contacts on the object."),
+    output: Path = typer.Option(..., "-o", "--output", help="Results file (JSON Lines); never the grasp set."),
+    asymmetric: bool = typer.Option(False, "--asymmetric", help="After the common delta, grow each finger's "
+                                    "delta in turn (per-finger deltas)."),
+    tol: float | None = typer.Option(None, "--tol", help="Bisection tolerance on delta, pixels "
+                                     "(default 1e-3 of the object's size)."),
+    normal_tol: float = typer.Option(0.0, "--normal-tol", help="Tolerance on the normals, degrees."),
+    budget: int = typer.Option(SEARCH_BUDGET, help="Branch-and-bound work units per region tuple tried "
+                               "(curved stretches)."),
+    alpha: float = typer.Option(0.5, "--alpha", help="Feasible regions: bounding-circle diameter threshold "
+                                "of curves, fraction of the object's size."),
+    largest: bool = typer.Option(False, "--largest", help="With several objects, use the largest whole one."),
+    threshold: float | None = typer.Option(None, "--threshold", help="Grey level separating object and "
+                                           "background, in the image's units (default: Otsu's)."),
+) -> None:
+    """How far may each finger of every grasp slide along the object's outline, the grasp
+    certified in force closure wherever on its stretch each finger lands?
+
+    One row per grasp line: id, status (robust, not_robust, undecided, error), delta (pixels),
+    delta_fraction (of the object's size), deltas, the certified regions (region-set format) and
+    their certificate. A finger stays in the feasible region it lies on. Prints one line per
+    grasp. Exit code 1 when some rows are errors, 2 when the run cannot start.
+    """
+
+    if not (math.isfinite(normal_tol) and 0 <= normal_tol <= math.degrees(0.5)):
+        typer.echo(f"error: --normal-tol must be in [0, {math.degrees(0.5):.1f}] degrees", err=True)
+        raise typer.Exit(2)
+    try:
+        summary = independent_file(image, grasps, output, symmetric=not asymmetric, tol=tol, budget=budget,
+                                   normal_tol=math.radians(normal_tol), alpha=alpha, threshold=threshold,
+                                   largest=largest)
+    except (QualitativeError, CertifyError, ValueError) as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(2)
+    for line in output.read_text(encoding="utf-8").splitlines():
+        row = json.loads(line)
+        if row["status"] == "error":
+            typer.echo(f"{row['id']}\terror\t{row['error']}")
+        else:
+            typer.echo(f"{row['id']}\t{row['status']}\tdelta {row['delta']:.2f} px\t"
+                       f"{100 * row['delta_fraction']:.2f} % of the size")
+    typer.echo(f"{summary.rows} grasp(s) -> {output}: " + ", ".join(f"{n} {s}" for s, n in sorted(summary.statuses.items()))
+               + f"; {summary.seconds:.1f} s")
+    if summary.errors:
         raise typer.Exit(1)

@@ -1,0 +1,267 @@
+"""Region certificates: certified robustness of a grasp to where exactly each finger lands.
+
+A **contact region** is a set of possible contacts for one finger, with the finger's contact
+model (``frictionless``, ``point`` with ``mu``, ``pad`` with ``mu`` and ``width``; planar only): a
+:class:`StraightRegion` (the finger anywhere on a segment ``[a, b]`` of a straight edge, inward
+normal ``n``) or a :class:`CurvedRegion` (anywhere on a curve given as a polyline of boundary points
+with their inward normals). A :class:`RegionTuple` holds one region per finger and an optional
+``normal_tol`` (radians: every true normal may differ from the stated one by up to that angle).
+
+The tuple is **robust** when every choice of one contact per region is in force closure under the
+declared models; **not robust** when some choice is not, witnessed by that choice (a grasp in
+certify's format) and its Farkas certificate; **undecided** when the question could not be
+settled. :func:`certify_regions` decides (straight regions with ``normal_tol = 0`` exactly, by 10
+small linear programmes; curved regions and ``normal_tol > 0`` by a conservative branch and
+bound within a budget) and :func:`verify_regions` re-checks the evidence without a solver.
+:func:`independent_regions` finds how far each finger of a grasp may slide along the object's
+boundary. The modules: :mod:`qualgrasp.certify.region_data` (the regions, their JSON and the
+reading of curved stretches), :mod:`~qualgrasp.certify.region_exact`,
+:mod:`~qualgrasp.certify.region_branch`, :mod:`~qualgrasp.certify.region_certify`,
+:mod:`~qualgrasp.certify.region_boundary`.
+
+Region sets (JSON Lines, one tuple per line)::
+
+    {"id": "r1", "regions": [{"a": [x, y], "b": [x, y], "n": [nx, ny], "model": "point", "mu": 0.5},
+                             {"points": [[x, y], ...], "normals": [[nx, ny], ...], "model": "frictionless"}],
+     "normal_tol": 0.0, "center": [cx, cy], "length": 1.0}
+
+:func:`certify_region_file` writes one results row per tuple line, in order: ``id``, ``line``,
+``status`` (``robust``, ``not_robust``, ``undecided``, ``error``), ``route``, ``certificate``,
+``witness`` (null, or ``{"grasp": <certify's grasp format>, "certificate": <its Farkas
+certificate>}``), ``reason``, ``work``, ``margin``, ``verified`` and ``error`` (null, or a message
+naming the line and the field). A bad line becomes an error row and the run goes on.
+:func:`verify_region_file` re-checks a results file against its region set.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Iterator
+
+from .errors import CertifyError, GraspError, GraspFileError
+from .region_boundary import Boundary, IndependentRegions, enclosing_diameter, independent_regions
+from .region_branch import DEFAULT_BUDGET
+from .region_certify import DEFAULT_TOL, STATUSES, RegionVerdict, certify_regions, in_region, verify_regions
+from .region_data import (CurvedRegion, RegionTuple, StraightRegion, region_from_dict, region_to_dict,
+                          tuple_from_dict, tuple_to_dict)
+from .validation import show
+
+__all__ = [
+    "StraightRegion", "CurvedRegion", "RegionTuple", "region_from_dict", "region_to_dict",
+    "tuple_from_dict", "tuple_to_dict",
+    "RegionVerdict", "certify_regions", "verify_regions", "in_region", "STATUSES", "DEFAULT_BUDGET", "DEFAULT_TOL",
+    "Boundary", "IndependentRegions", "independent_regions", "enclosing_diameter",
+    "RegionSummary", "certify_region_file", "verify_region_file", "read_region_lines", "error_row",
+]
+
+
+def error_row(message: str, *, id: Any = None, line: int | None = None) -> dict[str, Any]:
+    """The results row of a region tuple that could not be read or certified."""
+    return {"id": id, "line": line, "status": "error", "route": None, "certificate": None, "witness": None,
+            "reason": None, "work": 0, "margin": None, "verified": False, "error": message}
+
+
+def read_region_lines(path: str | Path) -> Iterator[tuple[int, Any]]:
+    """``(line number, tuple or message)`` for every non-blank line of a region set (line numbers
+    count from 1 and include blank lines); a line that cannot be read gives its error message,
+    naming the line and the field, instead of a tuple."""
+    path = Path(path)
+    try:
+        fh = path.open("r", encoding="utf-8")
+    except OSError as err:
+        raise GraspFileError(f"cannot read {path}: {err.strerror or err}") from None
+    with fh:
+        for number, text in enumerate(fh, start=1):
+            if not text.strip():
+                continue
+            try:
+                value = json.loads(text)
+            except json.JSONDecodeError as err:
+                yield number, (None, f"line {number}: malformed JSON: {err.msg} (column {err.colno})")
+                continue
+            gid = value.get("id") if isinstance(value, dict) else None
+            gid = gid if isinstance(gid, (str, int)) and not isinstance(gid, bool) else None
+            try:
+                yield number, tuple_from_dict(value)
+            except GraspError as err:
+                yield number, (gid, f"line {number}: {err}")
+
+
+@dataclass
+class RegionSummary:
+    """Counts of a region-set run: ``rows``, ``statuses`` (rows per status), ``unverified``
+    (rows whose evidence failed its own re-check), ``failures`` (``(id, reason)`` of a
+    verification run) and ``seconds``."""
+
+    rows: int = 0
+    statuses: dict[str, int] = field(default_factory=dict)
+    unverified: int = 0
+    failures: list[tuple[Any, str]] = field(default_factory=list)
+    seconds: float = 0.0
+
+    @property
+    def errors(self) -> int:
+        """Error rows."""
+        return self.statuses.get("error", 0)
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return a.resolve() == b.resolve() or (b.exists() and os.path.samefile(a, b))
+    except OSError:
+        return False
+
+
+def certify_region_file(in_path: str | Path, out_path: str | Path, *, budget: int = DEFAULT_BUDGET,
+                        tol: float = DEFAULT_TOL, progress: Callable[[int], None] | None = None) -> RegionSummary:
+    """Certify every region tuple of a region set into a results file (module docstring).
+
+    Parameters
+    ----------
+    in_path : path
+        Region set, JSON Lines.
+    out_path : path
+        Results file (JSON Lines), written whole at the end (through a temporary file); never
+        the input.
+    budget, tol
+        As for :func:`certify_regions`.
+    progress : callable, optional
+        Called with 1 after each line.
+
+    Returns
+    -------
+    RegionSummary
+
+    Raises
+    ------
+    GraspFileError
+        The input cannot be read, or the output is the input.
+
+    Examples
+    --------
+    >>> import json, pathlib, tempfile
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> lines = [{"id": "r1", "regions": [{"a": [1, -0.3], "b": [1, 0.3], "n": [-1, 0], "mu": 0.5},
+    ...                                   {"a": [-1, -0.3], "b": [-1, 0.3], "n": [1, 0], "mu": 0.5}]},
+    ...          {"id": "bad", "regions": [{"a": [1, "x"], "b": [1, 0], "n": [-1, 0]}]}]
+    >>> _ = (folder / "r.jsonl").write_text("\\n".join(json.dumps(d) for d in lines) + "\\n")
+    >>> s = certify_region_file(folder / "r.jsonl", folder / "out.jsonl")
+    >>> s.statuses, s.unverified
+    ({'robust': 1, 'error': 1}, 0)
+    >>> json.loads((folder / "out.jsonl").read_text().splitlines()[1])["error"]
+    'line 2: regions[0].a: expected 2 finite numbers, got [1, "x"]'
+    """
+    in_path, out_path = Path(in_path), Path(out_path)
+    if _same_file(in_path, out_path):
+        raise GraspFileError(f"the output {out_path} is the input: choose another file")
+    t0 = time.perf_counter()
+    summary = RegionSummary()
+    rows = []
+    for number, item in read_region_lines(in_path):
+        if isinstance(item, tuple):
+            row = error_row(item[1], id=item[0], line=number)
+        else:
+            try:
+                verdict = certify_regions(item, budget=budget, tol=tol)
+            except CertifyError as err:  # a solver failure: recorded, the run goes on
+                row = error_row(f"line {number}: {err}", id=item.id, line=number)
+            else:
+                ok = bool(verify_regions(item, verdict))
+                row = verdict.row(verified=ok, line=number, id=item.id)
+                summary.unverified += not ok
+        summary.rows += 1
+        summary.statuses[row["status"]] = summary.statuses.get(row["status"], 0) + 1
+        rows.append(row)
+        if progress is not None:
+            progress(1)
+    tmp = out_path.with_name(out_path.name + ".tmp")
+    with tmp.open("w", encoding="utf-8") as fh:
+        for row in rows:
+            fh.write(json.dumps(row, allow_nan=False) + "\n")
+    os.replace(tmp, out_path)
+    summary.seconds = time.perf_counter() - t0
+    return summary
+
+
+def verify_region_file(results: str | Path, regions: str | Path) -> RegionSummary:
+    """Re-check every row of a results file against its region set, without a solver.
+
+    Rows and tuples are matched in order (a row's ``line`` and ``id`` must agree with its
+    tuple's); an error row's line must indeed be unreadable. ``failures`` lists ``(id, reason)``
+    of the rows that fail.
+
+    Parameters
+    ----------
+    results : path
+        Results written by :func:`certify_region_file`.
+    regions : path
+        The region set they came from.
+
+    Returns
+    -------
+    RegionSummary
+
+    Raises
+    ------
+    GraspFileError
+        A file cannot be read.
+
+    Examples
+    --------
+    >>> import json, pathlib, tempfile
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> line = {"id": "r1", "regions": [{"a": [1, -0.7], "b": [1, 0.7], "n": [-1, 0], "mu": 0.5},
+    ...                                 {"a": [-1, -0.7], "b": [-1, 0.7], "n": [1, 0], "mu": 0.5}]}
+    >>> _ = (folder / "r.jsonl").write_text(json.dumps(line) + "\\n")
+    >>> certify_region_file(folder / "r.jsonl", folder / "out.jsonl").statuses
+    {'not_robust': 1}
+    >>> verify_region_file(folder / "out.jsonl", folder / "r.jsonl").failures
+    []
+    """
+    results, regions = Path(results), Path(regions)
+    summary = RegionSummary()
+    try:
+        text = results.read_text(encoding="utf-8")
+    except OSError as err:
+        raise GraspFileError(f"cannot read {results}: {err.strerror or err}") from None
+    rows = []
+    for number, line in enumerate(text.splitlines(), start=1):
+        if not line.strip():
+            continue
+        try:
+            rows.append(json.loads(line))
+        except json.JSONDecodeError as err:
+            rows.append({"status": None, "_bad": f"results line {number}: malformed JSON: {err.msg}"})
+    tuples = list(read_region_lines(regions))
+    if len(rows) != len(tuples):
+        summary.failures.append((None, f"{len(rows)} results rows for {len(tuples)} region tuples"))
+    for (number, item), row in zip(tuples, rows):
+        summary.rows += 1
+        status = row.get("status") if isinstance(row, dict) else None
+        summary.statuses[str(status)] = summary.statuses.get(str(status), 0) + 1
+        if not isinstance(row, dict) or "_bad" in row:
+            summary.failures.append((None, row.get("_bad", "not a JSON object") if isinstance(row, dict)
+                                     else f"results row for line {number}: not a JSON object"))
+            continue
+        if row.get("line") != number:
+            summary.failures.append((row.get("id"), f"results row is for line {row.get('line')}, tuple is line {number}"))
+            continue
+        if isinstance(item, tuple):
+            if status != "error":
+                summary.failures.append((row.get("id"), f"line {number} is not a valid tuple ({item[1]}) but its "
+                                                        f"row says {status!r}"))
+            continue
+        if row.get("id") != item.id:
+            summary.failures.append((row.get("id"), f"id does not match tuple line {number} ({show(item.id)})"))
+            continue
+        if status == "error":
+            summary.failures.append((item.id, f"line {number} is a valid tuple but its row is an error"))
+            continue
+        check = verify_regions(item, row)
+        if not check:
+            summary.failures.append((item.id, check.reason))
+    return summary

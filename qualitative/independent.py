@@ -1,0 +1,270 @@
+"""Independent contact regions of grasps on an object seen by a camera.
+
+For each grasp (certify's format, contacts on the object's outline, e.g. from ``qualgrasp
+synthesize``), how far may every finger slide along the outline, and the grasp stay in force
+closure whichever point of its stretch each finger touches? :func:`independent_grasp` answers with
+:func:`qualgrasp.certify.regions.independent_regions` on the outline's boundary
+(:func:`outline_boundary`) and limits from the feasible regions; :func:`independent_file` runs it
+on a grasp set, one results row per grasp line.
+
+Readings (pixels of the input image, x = column, y = row):
+
+* **Boundary.** The outline's contour, with every straight element (``/``) projected onto its
+  total-least-squares line and given that line's inward normal (as feasible regions are), and
+  every other sample taken from the contour smoothed at the outline's scale, with its normal
+  (so points and normals describe one curve; the raw contour differs from it by pixel noise).
+* **Limits.** A finger must stay in the feasible region it lies on (a region's points are where
+  the centre of a finger pad may go), or, off every region, on its outline element; a contact on a
+  corner or a cusp is an error.
+* **Contacts.** Each is placed at the nearest boundary point (within 1 % of the object's size);
+  the grasp itself, as given, decides ``not_robust``.
+
+Results rows: ``id``, ``line``, ``status`` (``robust``, ``not_robust``, ``undecided``, ``error``),
+``delta`` (pixels), ``delta_fraction`` (of the object's size, the diameter of its minimum enclosing
+circle), ``deltas`` (per finger), ``regions`` (the certified tuple, in the region-set format of
+:mod:`qualgrasp.certify.regions`), ``certificate`` (of those regions; for ``not_robust`` the grasp's
+Farkas certificate), ``evaluations``, ``seconds`` and ``error``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from ..certify.errors import CertifyError, GraspError, GraspFileError
+from ..certify.grasp import Grasp, grasp_from_dict
+from ..certify.region_boundary import SEARCH_BUDGET, IndependentRegions, independent_regions
+from ..certify.region_data import tuple_to_dict
+from .outline import Outline, outline_image
+from .regions import ALPHA, FINGER_WIDTH, MARGIN, Region, feasible_regions
+from .vision import ImageSource
+
+__all__ = ["ON_OUTLINE", "outline_boundary", "contact_limits", "independent_grasp", "independent_file",
+           "IndependentSummary"]
+
+#: Largest distance of a contact from the outline, fraction of the object's size.
+ON_OUTLINE = 0.01
+
+
+def outline_boundary(outline: Outline) -> tuple[np.ndarray, np.ndarray]:
+    """Boundary points and inward normals of an outline (module docstring).
+
+    Parameters
+    ----------
+    outline : Outline
+
+    Returns
+    -------
+    points, normals : numpy.ndarray
+        ``(n, 2)`` each, one per contour sample, positively oriented.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from qualgrasp.qualitative.outline import outline_contour
+    >>> square = np.array([[0, 0], [100, 0], [100, 100], [0, 100]], float)
+    >>> P, N = outline_boundary(outline_contour(square))
+    >>> P.shape, bool(np.allclose(np.hypot(*N.T), 1))
+    ((1024, 2), True)
+    """
+    n = len(outline.contour)
+    points = np.array(outline.smoothed, dtype=float)
+    normals = np.array(outline.normals(), dtype=float)
+    for seg in outline.segments:
+        if seg.symbol != "/":
+            continue
+        a, b = seg.endpoints
+        t = (b - a) / np.linalg.norm(b - a)
+        idx = np.arange(seg.start, seg.stop) % n
+        points[idx] = a + np.outer((outline.contour[idx] - a) @ t, t)
+        normals[idx] = [-t[1], t[0]]
+    return points, normals
+
+
+def _arc_limits(cum: np.ndarray, start: int, stop: int, n: int) -> tuple[float, float]:
+    """Arc lengths of samples ``start`` and ``stop - 1`` (indices past ``n`` wrap), unwrapped."""
+    per = cum[-1]
+    last = stop - 1
+    return float(cum[start % n] + (start // n) * per), float(cum[last % n] + (last // n) * per)
+
+
+def contact_limits(outline: Outline, regions: list[Region], points: np.ndarray, p) -> tuple[float, float]:
+    """Arc-length limits (along the polygon ``points``) of a contact at ``p``: the feasible region
+    it lies on, else the graspable element; raises GraspError on a corner or a cusp."""
+    n = len(points)
+    D = np.roll(points, -1, axis=0) - points
+    cum = np.concatenate([[0.0], np.cumsum(np.hypot(D[:, 0], D[:, 1]))])
+    dist = np.hypot(*(points - np.asarray(p, float)).T)
+    j = int(np.argmin(dist))
+    if dist[j] > ON_OUTLINE * outline.size + 2 * outline.spacing:
+        raise GraspError(f"the contact at {[round(float(v), 2) for v in p]} is {dist[j]:.3g} px from the outline "
+                         f"(more than {ON_OUTLINE:g} of the object's size {outline.size:.3g} px)")
+    for r in regions:
+        if any((j - r.start) % n == q for q in range(r.stop - r.start)):
+            return _arc_limits(cum, r.start, r.stop, n)
+    for seg in outline.segments:
+        if (j - seg.start) % n < seg.stop - seg.start:
+            if seg.is_point:
+                article = "an" if seg.name[0] in "aeiou" else "a"
+                raise GraspError(f"the contact at {[round(float(v), 2) for v in p]} lies on {article} {seg.name}: "
+                                 "no finger goes there")
+            return _arc_limits(cum, seg.start, seg.stop, n)
+    raise GraspError(f"the contact at {list(p)} is on no outline element")  # pragma: no cover
+
+
+def independent_grasp(outline: Outline, grasp: Grasp, *, regions: list[Region] | None = None,
+                      symmetric: bool = True, tol: float | None = None, budget: int = SEARCH_BUDGET,
+                      normal_tol: float = 0.0) -> IndependentRegions:
+    """Independent contact regions of one grasp on an outline (module docstring).
+
+    Parameters
+    ----------
+    outline : Outline
+    grasp : Grasp
+        Planar, contacts on the outline (within :data:`ON_OUTLINE` of its size).
+    regions : list of Region, optional
+        Feasible regions (default :func:`~qualgrasp.qualitative.regions.feasible_regions` with
+        its defaults).
+    symmetric, tol, budget, normal_tol
+        As for :func:`qualgrasp.certify.regions.independent_regions` (``tol`` in pixels,
+        default ``1e-3`` of the object's size).
+
+    Returns
+    -------
+    IndependentRegions
+
+    Raises
+    ------
+    GraspError
+        A contact off the outline or on a corner, a spatial grasp.
+
+    Examples
+    --------
+    >>> from qualgrasp.qualitative.objects import render
+    >>> from qualgrasp.qualitative.outline import outline_image
+    >>> from qualgrasp.qualitative.synthesis import synthesize
+    >>> image = render("square")
+    >>> g = synthesize(image, fingers=2).grasps[0]
+    >>> r = independent_grasp(outline_image(image), g)
+    >>> r.status, r.delta > 0
+    ('robust', True)
+    """
+    if grasp.dim != 2:
+        raise GraspError("independent regions are planar: the grasp is spatial")
+    regions = feasible_regions(outline) if regions is None else regions
+    points, normals = outline_boundary(outline)
+    limits = [contact_limits(outline, regions, points, c.p) for c in grasp.contacts]
+    return independent_regions(points, normals, grasp, limits=limits, tol=tol, symmetric=symmetric,
+                               budget=budget, normal_tol=normal_tol, on_boundary=ON_OUTLINE)
+
+
+@dataclass
+class IndependentSummary:
+    """Counts of an :func:`independent_file` run: ``rows``, ``statuses``, ``seconds``."""
+
+    rows: int = 0
+    statuses: dict[str, int] = field(default_factory=dict)
+    seconds: float = 0.0
+
+    @property
+    def errors(self) -> int:
+        """Error rows."""
+        return self.statuses.get("error", 0)
+
+
+def _row(gid, line, result: IndependentRegions | None = None, error: str | None = None) -> dict[str, Any]:
+    if result is None:
+        return {"id": gid, "line": line, "status": "error", "delta": None, "delta_fraction": None, "deltas": None,
+                "regions": None, "certificate": None, "evaluations": 0, "seconds": 0.0, "error": error}
+    if result.status == "robust":
+        regions, cert = tuple_to_dict(result.regions), result.verdict.certificate
+    else:
+        regions, cert = None, {"kind": "grasp", "force": result.grasp_verdict.certificate.to_json()}
+    return {"id": gid, "line": line, "status": result.status, "delta": result.delta,
+            "delta_fraction": result.delta_fraction, "deltas": list(result.deltas), "regions": regions,
+            "certificate": cert, "evaluations": result.evaluations, "seconds": result.seconds, "error": None}
+
+
+def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str | Path, *, symmetric: bool = True,
+                     tol: float | None = None, budget: int = SEARCH_BUDGET, normal_tol: float = 0.0,
+                     alpha: float = ALPHA, finger_width: float = FINGER_WIDTH, margin: float = MARGIN,
+                     threshold: float | None = None, largest: bool = False,
+                     progress: Callable[[int], None] | None = None) -> IndependentSummary:
+    """Independent contact regions of every grasp of a grasp set (JSON Lines) on an image's object.
+
+    Parameters
+    ----------
+    image : str, pathlib.Path or numpy.ndarray
+        The object's image (:func:`qualgrasp.qualitative.vision.read_image`).
+    grasps_path : path
+        Grasp set in certify's format (JSON Lines).
+    out_path : path
+        Results (JSON Lines, module docstring); never the grasp set.
+    symmetric, tol, budget, normal_tol
+        As for :func:`independent_grasp`.
+    alpha, finger_width, margin
+        Feasible regions' parameters (:func:`~qualgrasp.qualitative.regions.feasible_regions`).
+    threshold, largest
+        As for :func:`~qualgrasp.qualitative.outline.outline_image`.
+    progress : callable, optional
+        Called with 1 after each grasp line.
+
+    Returns
+    -------
+    IndependentSummary
+
+    Raises
+    ------
+    QualitativeError
+        The image cannot be read or holds no single object.
+    GraspFileError
+        The grasp set cannot be read, or the output is the grasp set.
+    """
+    grasps_path, out_path = Path(grasps_path), Path(out_path)
+    try:
+        same = grasps_path.resolve() == out_path.resolve() or (out_path.exists() and os.path.samefile(grasps_path, out_path))
+    except OSError:
+        same = False
+    if same:
+        raise GraspFileError(f"the output {out_path} is the grasp set: choose another file")
+    try:
+        text = grasps_path.read_text(encoding="utf-8")
+    except OSError as err:
+        raise GraspFileError(f"cannot read {grasps_path}: {err.strerror or err}") from None
+    outline = outline_image(image, threshold=threshold, largest=largest)
+    regions = feasible_regions(outline, alpha, finger_width, margin)
+    summary = IndependentSummary()
+    rows = []
+    for number, line in enumerate(text.splitlines(), start=1):
+        if not line.strip():
+            continue
+        gid = None
+        try:
+            value = json.loads(line)
+            if isinstance(value, dict) and isinstance(value.get("id"), (str, int)) and not isinstance(value["id"], bool):
+                gid = value["id"]
+            grasp = grasp_from_dict(value)
+            result = independent_grasp(outline, grasp, regions=regions, symmetric=symmetric, tol=tol,
+                                       budget=budget, normal_tol=normal_tol)
+            row = _row(gid, number, result)
+        except json.JSONDecodeError as err:
+            row = _row(None, number, error=f"line {number}: malformed JSON: {err.msg} (column {err.colno})")
+        except CertifyError as err:
+            row = _row(gid, number, error=f"line {number}: {err}")
+        rows.append(row)
+        summary.rows += 1
+        summary.statuses[row["status"]] = summary.statuses.get(row["status"], 0) + 1
+        summary.seconds += row["seconds"]
+        if progress is not None:
+            progress(1)
+    tmp = out_path.with_name(out_path.name + ".tmp")
+    with tmp.open("w", encoding="utf-8") as fh:
+        for row in rows:
+            fh.write(json.dumps(row, allow_nan=False) + "\n")
+    os.replace(tmp, out_path)
+    return summary
