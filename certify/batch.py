@@ -26,11 +26,15 @@ __all__ = ["Summary", "certify_file", "verify_file"]
 def certify_file(grasps_path: str | Path, results_path: str | Path, *, method: str = "fast",
                  progress: Callable[[int], None] | None = None, workers: int | None = 1,
                  dask: str | None = None, resume: bool = False, chunk_size: int = 4096,
-                 quality: bool = True, eps_gap: float = 0.01, eps_budget: int = 200_000) -> RunSummary:
+                 quality: bool = True, eps_gap: float = 0.01, eps_budget: int = 200_000,
+                 eps_time: float | None = 10.0) -> RunSummary:
     """Certify every grasp of ``grasps_path`` into ``results_path``: one results row per grasp,
     in input order. See :func:`qualgrasp.certify.engine.run` for ``workers``, ``dask``, ``resume`` and
-    ``chunk_size`` (``workers=None`` uses every core)."""
-    options = Options(method=method, quality=quality, eps_gap=eps_gap, eps_budget=eps_budget)
+    ``chunk_size`` (``workers=None`` uses every core); ``quality``, ``eps_gap``, ``eps_budget``
+    and ``eps_time`` are :class:`qualgrasp.certify.chunk.Options`' (``eps_time`` in seconds per
+    grasp, None for no limit)."""
+    options = Options(method=method, quality=quality, eps_gap=eps_gap, eps_budget=eps_budget,
+                      eps_time=eps_time)
     return run(grasps_path, results_path, options=options, workers=workers, dask=dask,
                resume=resume, chunk_size=chunk_size, progress=progress)
 

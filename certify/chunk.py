@@ -38,13 +38,15 @@ __all__ = ["Options", "certify_rows", "certify_values", "certify_chunk_results",
 @dataclass(frozen=True)
 class Options:
     """What is computed for every grasp (recorded in a run's manifest; part of a chunk's
-    identity): the solver ``method``, whether to compute epsilon (``quality``) and the spatial
-    epsilon's relative gap and budget."""
+    identity): the solver ``method``, whether to compute epsilon (``quality``), the spatial
+    epsilon's relative gap and budget, and the per-grasp time limit of quality in seconds
+    (``eps_time``, None for none; see :func:`qualgrasp.certify.certify_grasp`)."""
 
     method: str = "fast"
     quality: bool = True
     eps_gap: float = 0.01
     eps_budget: int = 200_000
+    eps_time: float | None = 10.0
 
 
 def certify_rows(cols: GraspColumns, rows: Sequence[int], lines: Sequence[int],
@@ -60,7 +62,8 @@ def certify_rows(cols: GraspColumns, rows: Sequence[int], lines: Sequence[int],
             try:
                 grasp = cols.grasps([i])[0]
                 report = certify_grasp(grasp, solver=solver, tol=tol, quality=options.quality,
-                                       eps_gap=options.eps_gap, eps_budget=options.eps_budget)
+                                       eps_gap=options.eps_gap, eps_budget=options.eps_budget,
+                                       eps_time=options.eps_time)
                 out.append(report.row(line=line))
                 continue
             except CertifyError as err:

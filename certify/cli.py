@@ -32,7 +32,10 @@ def certify_command(
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar or summary."),
     quality: bool = typer.Option(True, help="Compute the epsilon columns (eps_l1_lo ... eps_linf_hi)."),
     eps_gap: float = typer.Option(0.01, help="Spatial epsilon: stop when hi - lo <= gap * hi."),
-    eps_budget: int = typer.Option(200_000, help="Spatial epsilon: most work per grasp and norm, in direction cells examined."),
+    eps_budget: int = typer.Option(200_000, help="Spatial epsilon: most work per grasp and norm, in directions examined."),
+    eps_time: float = typer.Option(10.0, help="Time limit of quality per grasp, in seconds (0: none); when hit, "
+                                              "the row keeps its closure verdict, states the epsilon bounds reached "
+                                              "and eps_limited (results then depend on the machine)."),
     workers: int = typer.Option(0, help="Local worker processes (0: all cores)."),
     dask: str = typer.Option(None, "--dask", help="'local' for a dask LocalCluster, or a scheduler address."),
     resume: bool = typer.Option(False, "--resume", help="Continue an interrupted run, keeping its complete chunks."),
@@ -51,7 +54,8 @@ def certify_command(
         try:
             summary = certify_file(grasps, output, method=method,
                                    progress=lambda n: bar.advance(task, n), quality=quality,
-                                   eps_gap=eps_gap, eps_budget=eps_budget, workers=workers or None,
+                                   eps_gap=eps_gap, eps_budget=eps_budget,
+                                   eps_time=eps_time if eps_time > 0 else None, workers=workers or None,
                                    dask=dask, resume=resume, chunk_size=chunk_size)
         except CertifyError as err:
             console.print(f"[red]error:[/red] {err}")

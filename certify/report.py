@@ -3,8 +3,11 @@
 :func:`certify_grasp` returns a :class:`Report`; :meth:`Report.row` is the results-file row
 (:data:`qualgrasp.certify.results.COLUMNS`): the force and form closure verdicts, margins and
 certificates, whether both certificates re-checked, the ``center`` and ``length`` used, and the
-Ferrari-Canny epsilon bounds (equal in the plane; 0 when not in force closure; null when quality
-was not asked for). ``status`` refers to force closure under the declared contact models.
+Ferrari-Canny epsilon bounds with their evidence (:mod:`qualgrasp.certify.evidence`; 0 and no
+evidence when not in force closure; null when quality was not asked for). ``status`` refers to
+force closure under the declared contact models.
+
+:func:`verify_row` re-checks every number a row states against its grasp, without a solver.
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ from .certificates import Certificate, Check, Tolerances, verify
 from .errors import CertificateError
 from .closure import Verdict, form_closure, force_closure
 from .grasp import Grasp
-from .quality import Epsilon, epsilon
+from .quality import Epsilon, epsilons
 from .results import result_row
 
 __all__ = ["Report", "certify_grasp", "verify_row"]
@@ -50,6 +53,12 @@ class Report:
             e = self.epsilons.get(norm) if self.epsilons else None
             eps[f"eps_{key}_lo"] = None if e is None else e.lo
             eps[f"eps_{key}_hi"] = None if e is None else e.hi
+        eps["eps_limited"] = eps["eps_evidence"] = None
+        if self.epsilons:
+            eps["eps_limited"] = any(e.limited for e in self.epsilons.values())
+            if all(e.evidence is not None for e in self.epsilons.values()):
+                eps["eps_evidence"] = {key: self.epsilons[norm].evidence.to_json()
+                                       for norm, key in (("L1", "l1"), ("Linf", "linf"))}
         return result_row(
             id=g.id, line=line, dim=g.dim, status=self.force.status,
             form_closure=self.form.closure, force_closure=self.force.closure,
@@ -62,7 +71,7 @@ class Report:
 
 def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
                   tol: Tolerances = Tolerances(), quality: bool = True, eps_gap: float = 0.01,
-                  eps_budget: int = 200_000) -> Report:
+                  eps_budget: int = 200_000, eps_time: float | None = None) -> Report:
     """Certify one grasp end to end: force and form closure, the re-check of both certificates
     and, with ``quality``, the L1 and L-infinity Ferrari-Canny epsilon.
 
@@ -76,6 +85,10 @@ def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
     eps_gap, eps_budget
         Spatial epsilon: relative gap to reach and most work (see
         :func:`qualgrasp.certify.quality.epsilon`).
+    eps_time : float, optional
+        Time limit of the quality computation for this grasp, in seconds (both norms
+        together); when it is hit the epsilons are the bounds reached, flagged ``limited``
+        (results then depend on the machine). None: no limit.
 
     Returns
     -------
@@ -100,8 +113,7 @@ def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
     )
     eps = None
     if quality:
-        eps = {norm: epsilon(grasp, norm, rel_gap=eps_gap, budget=eps_budget, verdict=force)
-               for norm in ("L1", "Linf")}
+        eps = epsilons(grasp, rel_gap=eps_gap, budget=eps_budget, time_limit=eps_time, verdict=force)
     return Report(grasp, force, form, ok, eps)
 
 
