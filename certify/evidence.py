@@ -31,6 +31,12 @@ Vertices, by the evidence ``kind``:
 ``sums`` (planar L-infinity)
     ``ref`` holds ``m`` entries per vertex: for contact ``i`` the index of one of its generators,
     or -1 for the origin; the vertex is their sum, a point of the Minkowski sum.
+``support`` (planar L-infinity)
+    ``points`` holds one direction ``v`` (3 floats) per vertex; the vertex is the support point
+    of the GWS along ``v``: for each contact its generator with the largest ``v . g`` (the first
+    such, by :func:`planar_support_choice`), or the origin when none is positive, summed.
+    The faces are not stored: the checker triangulates the vertices with qhull and then checks
+    that triangulation (see below).
 ``support`` (spatial)
     ``points`` holds one direction ``v`` (6 floats) per vertex; the vertex is the support point
     of the GWS along ``v`` computed by :meth:`ConicSupport.forces`, the contact forces (and
@@ -73,12 +79,13 @@ from .wrench import force_column_errors, generator_layout, grasp_arrays, to_exac
 
 __all__ = ["EPS_TOL", "SHRINK", "KINDS", "Evidence", "ConicSupport", "surface_faces",
            "exact_face", "surface_minimum", "stated_lo", "planar_generator_arrays",
-           "planar_vertex_arrays", "spatial_vertex_arrays", "vertex_scale", "verify_bounds", "check_hi", "verify_epsilon", "EPS_COLUMNS"]
+           "planar_vertex_arrays", "planar_support_choice", "planar_support_vertices",
+           "spatial_vertex_arrays", "vertex_scale", "verify_bounds", "check_hi", "verify_epsilon", "EPS_COLUMNS"]
 
 #: Relative tolerance between a stated epsilon bound and the value its evidence proves.
 EPS_TOL = 1e-9
 #: Support forces are pulled this far inside their cones (tangential part times ``SHRINK``).
-SHRINK = 1.0 - 2.0**-40
+SHRINK = 1.0 - 2.0**-30
 #: Evidence kinds (module docstring).
 KINDS = ("generators", "sums", "support", "l1", "none")
 #: The epsilon columns of a results row, in order.
@@ -155,17 +162,20 @@ class Evidence:
 
 def surface_faces(points: np.ndarray) -> np.ndarray | None:
     """Faces of the hull of ``points`` (n, d) from qhull, each ordered so that its float
-    determinant is positive (outward about an interior origin); None when qhull fails."""
+    determinant ``det(v_1, ..., v_d)`` is positive (outward about an interior origin); None when
+    qhull fails."""
     try:
         hull = ConvexHull(points)
     except (QhullError, ValueError):
         return None
-    faces = np.array(hull.simplices, dtype=np.int64)
-    normals = hull.equations[:, :-1]
-    # orient each simplex along qhull's outward normal: det(v_1, ..., v_d) has the sign of
-    # n . v_1 where n is the generalised cross product of the edges
-    n = generalised_cross(points[faces])
-    flip = np.einsum("fd,fd->f", n, normals) < 0
+    return orient_faces(points, hull.simplices)
+
+
+def orient_faces(points: np.ndarray, simplices: np.ndarray) -> np.ndarray:
+    """``simplices`` with the first two vertices swapped where the float determinant of the
+    vertices is negative."""
+    faces = np.array(simplices, dtype=np.int64)
+    flip = np.linalg.det(points[faces]) < 0
     faces[flip, 0], faces[flip, 1] = faces[flip, 1], faces[flip, 0].copy()
     return faces
 
@@ -364,6 +374,34 @@ def sum_errors(E: np.ndarray, mag: np.ndarray, terms: int) -> np.ndarray:
     return E + 2 * (terms + 1) * 2.0**-53 * mag
 
 
+def planar_support_choice(W: np.ndarray, owner: np.ndarray, m: int, v: np.ndarray) -> np.ndarray:
+    """The vertex of planar ``support`` evidence along ``v``: for each contact the first of its
+    generators (columns of ``W``, ``owner`` sorted) with the largest ``v . g``, or -1 (the
+    origin) when that is not positive."""
+    vals = v @ W
+    start = np.searchsorted(owner, np.arange(m))
+    best = np.maximum.reduceat(vals, start)
+    k = len(vals)
+    first = np.minimum.reduceat(np.where(vals == best[owner], np.arange(k), k), start)
+    return np.where(best > 0, first, -1)
+
+
+def planar_support_vertices(W, E, owner, m, dirs: np.ndarray):
+    """Float vertices, error bounds and generator choices (rows, -1 for the origin) of planar
+    ``support`` evidence along the rows of ``dirs``."""
+    R = np.array([planar_support_choice(W, owner, m, v) for v in dirs], dtype=np.int64).reshape(-1, m)
+    return _sum_rows(W, E, R) + (R,)
+
+
+def _sum_rows(W, E, R):
+    used = R >= 0
+    idx = np.where(used, R, 0)
+    V = np.einsum("vi,vir->vr", used.astype(float), W.T[idx]) if R.size else np.zeros((len(R), 3))
+    EV = np.einsum("vi,vir->vr", used.astype(float), E.T[idx]) if R.size else np.zeros((len(R), 3))
+    mag = np.einsum("vi,vir->vr", used.astype(float), np.abs(W.T[idx])) if R.size else np.zeros((len(R), 3))
+    return V, sum_errors(EV, mag, R.shape[1])
+
+
 def planar_vertex_arrays(W, E, owner: np.ndarray, m: int, ev: Evidence):
     """Float vertices, their error bounds and, per vertex, the generators it sums, of planar
     evidence (``generators`` or ``sums``); or a reason string."""
@@ -372,6 +410,11 @@ def planar_vertex_arrays(W, E, owner: np.ndarray, m: int, ev: Evidence):
         if ev.ref:
             return "generators evidence has no ref"
         return W.T, E.T, [(j,) for j in range(k)]
+    if ev.kind == "support":
+        if ev.ref or ev.faces or not ev.points or len(ev.points) % 3 or len(ev.points) < 12:
+            return "planar support evidence needs 3 numbers per direction (4 or more) and nothing else"
+        V, EV, R = planar_support_vertices(W, E, owner, m, np.array(ev.points, dtype=float).reshape(-1, 3))
+        return V, EV, [tuple(int(j) for j in r if j >= 0) for r in R]
     if not ev.ref or len(ev.ref) % m:
         return f"sums evidence needs {m} entries per vertex"
     R = np.array(ev.ref, dtype=np.int64).reshape(-1, m)
@@ -380,15 +423,8 @@ def planar_vertex_arrays(W, E, owner: np.ndarray, m: int, ev: Evidence):
     used = R >= 0
     if (owner[np.where(used, R, 0)][used] != np.nonzero(used)[1]).any():
         return "sums evidence: an entry is not a generator of its contact"
-    V = np.zeros((len(R), 3))
-    EV = np.zeros((len(R), 3))
-    mag = np.zeros((len(R), 3))
-    for i in range(m):
-        sel = used[:, i]
-        V[sel] += W.T[R[sel, i]]
-        EV[sel] += E.T[R[sel, i]]
-        mag[sel] += np.abs(W.T[R[sel, i]])
-    return V, sum_errors(EV, mag, m), [tuple(int(j) for j in r if j >= 0) for r in R]
+    V, EV = _sum_rows(W, E, R)
+    return V, EV, [tuple(int(j) for j in r if j >= 0) for r in R]
 
 
 # --- spatial support points ---------------------------------------------------------------------
@@ -413,20 +449,36 @@ class ConicSupport:
         system = grasp_system(grasp, socp=True)
         self.grasp = grasp
         self.C = np.asarray(system.columns, dtype=float)
+        self.absC = np.abs(self.C)
         self.blocks = system.blocks
         self._Cx = None
         P, N, mu, params, c, L = grasp_arrays(grasp)
         models = tuple(ct.model for ct in grasp.contacts)
         self.errors = force_column_errors(P[None], N[None], models, c[None], np.array([L]))[0]
         self.data = []
-        for b in self.blocks:
+        ray, lor = [], []
+        for i, b in enumerate(self.blocks):
             cols = np.array(b.cols)
             if b.cone == "ray":
                 self.data.append((cols, None, None, 0.0, 0.0, 0.0))
+                ray.append(i)
                 continue
             n = np.asarray(b.n, dtype=float)
             rn = math.sqrt(float(n @ n))
             self.data.append((cols, n, n / rn, float(b.mu), float(b.g), rn))
+            lor.append(i)
+        self.ray = np.array(ray, dtype=np.int64)
+        self.ray_col = np.array([self.data[i][0][0] for i in ray], dtype=np.int64)
+        self.lor = np.array(lor, dtype=np.int64)
+        self.f_col = np.array([self.data[i][0][:3] for i in lor], dtype=np.int64).reshape(-1, 3)
+        self.m_col = np.array([self.data[i][0][3] if len(self.data[i][0]) > 3 else -1 for i in lor],
+                              dtype=np.int64)
+        self.n = np.array([self.data[i][1] for i in lor]).reshape(-1, 3)
+        self.nh = np.array([self.data[i][2] for i in lor]).reshape(-1, 3)
+        self.mu = np.array([self.data[i][3] for i in lor])
+        self.g = np.array([self.data[i][4] for i in lor])
+        self.gr = np.array([self.data[i][4] / self.data[i][5] for i in lor])
+        self.nn = np.einsum("bi,bi->b", self.n, self.n)
 
     @property
     def Cx(self):
@@ -435,88 +487,88 @@ class ConicSupport:
             self._Cx = grasp_system(self.grasp, socp=True, exact=True).columns
         return self._Cx
 
-    def forces(self, v: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
+    def forces(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Each block's support value ``c_b(v)`` (the largest ``v . w`` over its wrenches with
-        unit normal force) and the block values (forces, moments) reaching it, pulled inside by
-        :data:`SHRINK`: ``f = n/|n| + SHRINK mu z_t / |z|``, ``m = (g / |n|) SHRINK mu z_m / |z|``
-        with ``z = (a_t, a_m g / |n|)``, ``a`` the functional ``C_b' v``. A fixed float
-        formula, so producer and checker compute the same forces."""
+        unit normal force) and the values on every column (forces, moments) reaching them,
+        pulled inside by :data:`SHRINK`: ``f = n/|n| + SHRINK mu z_t / |z|``, ``m = (g / |n|)
+        SHRINK mu z_m / |z|`` with ``z = (a_t, a_m g / |n|)``, ``a`` the functional ``C_b' v``; a
+        ray's value is 1. A fixed float formula, so producer and checker compute the same."""
         a = self.C.T @ v
         c = np.empty(len(self.blocks))
-        X = []
-        for i, (cols, n, nh, mu, g, rn) in enumerate(self.data):
-            if n is None:
-                c[i] = a[cols[0]]
-                X.append(np.ones(1))
-                continue
-            dim = len(n)
-            af = a[cols[:dim]]
-            an = float(af @ nh)
-            z = np.concatenate([af - an * nh, a[cols[dim:]] * (g / rn)])
-            nz = float(np.sqrt(z @ z))
-            c[i] = an + mu * nz
-            if nz > 0:
-                step = (SHRINK * mu / nz) * z
-                X.append(np.concatenate([nh + step[:dim], step[dim:] * (g / rn)]))
-            else:
-                X.append(np.concatenate([nh, np.zeros(len(cols) - dim)]))
+        X = np.zeros(self.C.shape[1])
+        c[self.ray] = a[self.ray_col]
+        X[self.ray_col] = 1.0
+        if len(self.lor):
+            af = a[self.f_col]
+            an = np.einsum("bi,bi->b", af, self.nh)
+            at = af - an[:, None] * self.nh
+            am = np.where(self.m_col >= 0, a[self.m_col] * self.gr, 0.0)
+            nz = np.sqrt(np.einsum("bi,bi->b", at, at) + am * am)
+            c[self.lor] = an + self.mu * nz
+            k = np.divide(SHRINK * self.mu, nz, out=np.zeros_like(nz), where=nz > 0)
+            X[self.f_col] = self.nh + k[:, None] * at
+            has_m = self.m_col >= 0
+            X[self.m_col[has_m]] = (k * am * self.gr)[has_m]
         return c, X
 
     def inside(self, b: int, x: np.ndarray) -> bool:
-        """Is the block value ``x`` strictly inside block ``b``'s cone? A float test with a
-        rigorous margin, then the exact one (:func:`qualgrasp.certify.cones.inside`)."""
+        """Is the block value ``x`` strictly inside block ``b``'s cone? Exact
+        (:func:`qualgrasp.certify.cones.inside`)."""
         cols, n, nh, mu, g, rn = self.data[b]
         if n is None:
             return bool(x[0] > 0)
-        dim = len(n)
-        f = x[:dim]
-        fn, nn, ff = float(f @ n), float(n @ n), float(f @ f)
-        extra = sum((m_ * nn / g) ** 2 for m_ in x[dim:]) if len(x) > dim else 0.0
-        tang = nn * ff - fn * fn + extra
-        err = 1e-13 * (nn * ff + fn * fn + extra + mu * mu * fn * fn)
-        if fn > 0 and tang + err < mu * mu * fn * fn - err:
-            return True
         blk = self.blocks[b]
         return cones.inside(blk.cone, list(to_exact(x)), list(to_exact(n)), Fraction(mu), Fraction(g))
 
+    def _inside_all(self, X: np.ndarray, use: np.ndarray) -> bool:
+        """Every used block's values strictly inside its cone: a float test with a rigorous
+        margin (the rounding of ``|n|^2 |f|^2 - (f . n)^2 + (m |n|^2 / g)^2`` is far below
+        ``1e-14`` of its terms), then the exact test for the blocks it leaves open."""
+        sel = np.zeros(len(self.blocks), dtype=bool)
+        sel[use] = True
+        if not (X[self.ray_col[sel[self.ray]]] > 0).all():
+            return False
+        on = sel[self.lor]
+        f = X[self.f_col[on]]
+        fn = np.einsum("bi,bi->b", f, self.n[on])
+        ff = np.einsum("bi,bi->b", f, f)
+        nn = self.nn[on]
+        mcol = self.m_col[on]
+        extra = np.where(mcol >= 0, (X[mcol] * nn / np.where(self.g[on] > 0, self.g[on], 1.0)) ** 2, 0.0)
+        tang = nn * ff - fn * fn + extra
+        mu2 = self.mu[on] ** 2 * fn * fn
+        err = 1e-14 * (nn * ff + fn * fn + extra + mu2)
+        good = (fn > 0) & (tang + err < mu2 - err)
+        for b in self.lor[on][~good]:
+            if not self.inside(int(b), X[self.data[b][0]]):
+                return False
+        return True
+
     def vertex(self, v: np.ndarray, norm: str, index: int, ref: int | None = None):
         """Vertex ``index`` of ``support`` evidence: the support point along ``v`` scaled by
-        :func:`vertex_scale`, as ``(w, err, use, X)``: float wrench, bound on its distance to
-        the exact one, the blocks it sums and their values; None when a value could not be
-        proved inside its cone. ``ref`` (L1): the contact to use (default: the one with the
-        largest term)."""
+        :func:`vertex_scale`, as ``(w, err, x)``: float wrench, bound on its distance to the
+        exact one, and the values on every column (0 off the blocks it sums); None when a value
+        could not be proved inside its cone. ``ref`` (L1): the contact to use (default: the one
+        with the largest term)."""
         c, X = self.forces(v)
-        scale = vertex_scale(index)
         if norm == "L1":
-            use = [int(np.argmax(c)) if ref is None else ref]
+            use = np.array([int(np.argmax(c)) if ref is None else ref])
         else:
-            use = [int(b) for b in np.flatnonzero(c > 0)]
-        d = self.C.shape[0]
-        w, err, mag = np.zeros(d), np.zeros(d), np.zeros(d)
-        Xs, count = [], 0
+            use = np.flatnonzero(c > 0)
+        keep = np.zeros(self.C.shape[1], dtype=bool)
         for b in use:
-            x = X[b] * scale
-            if not self.inside(b, x):
-                return None
-            cols = self.data[b][0]
-            w += self.C[:, cols] @ x
-            err += self.errors[:, cols] @ np.abs(x)
-            mag += np.abs(self.C[:, cols]) @ np.abs(x)
-            count += len(cols)
-            Xs.append(x)
-        return w, sum_errors(err, mag, count), use, Xs
+            keep[self.data[b][0]] = True
+        x = np.where(keep, X * vertex_scale(index), 0.0)
+        if not self._inside_all(x, use):
+            return None
+        ax = np.abs(x)
+        return self.C @ x, sum_errors(self.errors @ ax, self.absC @ ax, int(keep.sum())), x
 
-    def exact_vertex(self, use, X) -> list[Fraction]:
-        """The exact wrench of the block values ``X`` on the blocks ``use``."""
+    def exact_vertex(self, x: np.ndarray) -> list[Fraction]:
+        """The exact wrench of the column values ``x``."""
         Cx = self.Cx
-        d = Cx.shape[0]
-        w = [Fraction(0)] * d
-        for b, x in zip(use, X):
-            cols = self.data[b][0]
-            xs = [Fraction(float(t)) for t in x]
-            for r in range(d):
-                w[r] += sum(Cx[r, j] * t for j, t in zip(cols, xs))
-        return w
+        nz = [(j, Fraction(float(x[j]))) for j in np.flatnonzero(x)]
+        return [sum((Cx[r, j] * t for j, t in nz), Fraction(0)) for r in range(Cx.shape[0])]
 
     def h_bounds(self, u: Sequence[float], norm: str) -> tuple[Fraction, Fraction]:
         """Rigorous bounds ``(lo, hi)`` of ``h(u) / |u|`` (exact columns, integer square roots;
@@ -557,8 +609,8 @@ class ConicSupport:
 
 
 def spatial_vertex_arrays(sup: ConicSupport, ev: Evidence, norm: str):
-    """Float vertices, error bounds and ``(use, X)`` per vertex of ``support`` evidence, or a
-    reason string."""
+    """Float vertices, error bounds and the column values of each vertex of ``support``
+    evidence, or a reason string."""
     d = sup.C.shape[0]
     if not ev.points or len(ev.points) % d:
         return f"points must hold {d} numbers per vertex"
@@ -580,8 +632,8 @@ def spatial_vertex_arrays(sup: ConicSupport, ev: Evidence, norm: str):
         out = sup.vertex(P[i], norm, i, ref)
         if out is None:
             return f"vertex {i}: a support force is not inside its cone"
-        V[i], EV[i], use, X = out
-        parts.append((use, X))
+        V[i], EV[i], x = out
+        parts.append(x)
     return V, EV, parts
 
 
@@ -759,10 +811,10 @@ def verify_bounds(grasp: Grasp, vals: dict, evs: dict, arrays=None) -> Check:
                 return Check(False, f"{col} must equal eps_l1_lo (evidence kind l1)")
             continue
         if planar:
-            if ev.kind not in ("generators", "sums") or (ev.kind == "generators") != (norm == "L1"):
+            if ev.kind not in ("generators", "sums", "support") or (ev.kind == "generators") != (norm == "L1"):
                 return Check(False, f"eps_evidence.{key}: kind {ev.kind} does not fit a planar {norm} GWS")
-            if ev.points:
-                return Check(False, f"eps_evidence.{key}.points must be empty in the plane")
+            if ev.points and ev.kind != "support":
+                return Check(False, f"eps_evidence.{key}.points must be empty for {ev.kind} evidence")
             built = planar_vertex_arrays(W, E, owner, m, ev)
             if isinstance(built, str):
                 return Check(False, f"eps_evidence.{key}: {built}")
@@ -772,9 +824,14 @@ def verify_bounds(grasp: Grasp, vals: dict, evs: dict, arrays=None) -> Check:
                 C = Cx()
                 return [sum((C[r, j] for j in parts[i]), Fraction(0)) for r in range(3)]
 
-            if len(ev.faces) % 3 or not ev.faces:
-                return Check(False, f"eps_evidence.{key}.faces must hold 3 indices per face")
-            faces = np.array(ev.faces, dtype=np.int64).reshape(-1, 3)
+            if ev.kind == "support":
+                faces = surface_faces(V)
+                if faces is None:
+                    return Check(False, f"eps_evidence.{key}: the vertices span no full-dimensional hull")
+            else:
+                if len(ev.faces) % 3 or not ev.faces:
+                    return Check(False, f"eps_evidence.{key}.faces must hold 3 indices per face")
+                faces = np.array(ev.faces, dtype=np.int64).reshape(-1, 3)
         else:
             if ev.kind != "support":
                 return Check(False, f"eps_evidence.{key}: kind {ev.kind} does not fit a spatial GWS")
@@ -786,7 +843,7 @@ def verify_bounds(grasp: Grasp, vals: dict, evs: dict, arrays=None) -> Check:
             V, EV, parts = built
 
             def exact_vertex(i, parts=parts):
-                return sup.exact_vertex(*parts[i])
+                return sup.exact_vertex(parts[i])
 
             faces = surface_faces(V)
             if faces is None:

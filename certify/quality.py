@@ -33,8 +33,12 @@ Planar grasps: every contact model is polyhedral in the plane, so epsilon is exa
   a sweep around the great circle orthogonal to each edge (``O(k^2 log k)``,
   :func:`qualgrasp.certify._kernels.epsilon.linf_sweep`). The evidence for ``lo`` is the hull of
   all sums of one vertex per summand when there are at most ``SUMS_MAX`` of them (then
-  ``lo = hi``); beyond that the L1 GWS, which lies inside the L-infinity one, and ``lo`` is the L1
-  epsilon (``lo < hi``, honestly reported).
+  ``lo = hi``); beyond that the hull of support points of the GWS (each the sum of every contact's
+  generator furthest along a direction), refined along the normals of its faces nearest the
+  origin until it proves ``hi`` (each cut adds a vertex of the GWS beyond the face, so this
+  ends), stored as its directions. If that does not succeed within ``4 MAX_VERTICES`` vertices
+  or the time limit, the L1 GWS, which lies inside the L-infinity one, proves the L1 epsilon
+  (``lo < hi``, honestly reported).
 
 Spatial grasps with exact cones: an inner and an outer approximation refined together. ``hi`` is
 the least ``h(u)`` found over directions ``u`` (the best of a fixed set of starting directions,
@@ -69,8 +73,8 @@ from scipy.spatial import ConvexHull, QhullError
 
 from ._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .closure import Verdict, force_closure
-from .evidence import (EPS_TOL, ConicSupport, Evidence, face_distances, generalised_cross,
-                       planar_generator_arrays, stated_lo, sum_errors, surface_faces,
+from .evidence import (EPS_TOL, ConicSupport, Evidence, planar_generator_arrays,
+                       planar_support_vertices, stated_lo, sum_errors, surface_faces,
                        surface_minimum)
 from .grasp import Grasp
 from .problem import System, grasp_system
@@ -318,11 +322,64 @@ def planar_epsilons(W, E, owner, m: int, *, deadline: float | None = None, exact
                 if lo is not None and lo >= l1_lo:
                     ev = Evidence("sums", direction, ref=tuple(int(i) for i in choice[used].ravel()),
                                   faces=tuple(int(i) for i in faces.ravel()))
+        else:
+            found = _planar_support(W, E, owner, m, eps, np.asarray(u, dtype=float), deadline, gens)
+            if found is not None and found[0] >= l1_lo:
+                lo, dirs = found
+                ev = Evidence("support", direction, points=tuple(float(x) for x in dirs.ravel()))
     if ev is None:
         lo = min(l1_lo, eps)
         ev = Evidence("l1", direction)
     out["Linf"] = (lo, eps, direction, ev, limited)
     return out
+
+
+def _planar_support(W, E, owner, m, eps, u, deadline, gens):
+    """Planar L-infinity lower bound by ``support`` evidence: the hull of support points along
+    the coordinate directions and ``u``, refined along the normals of its faces nearest the
+    origin (each cut adds a vertex of the GWS beyond the face) until the surface proves ``eps``
+    or :data:`MAX_VERTICES` is reached. Returns ``(lo, directions)`` or None."""
+    dirs = [np.array(v, dtype=float) for v in np.vstack([np.eye(3), -np.eye(3), u[None]])]
+    seen = set()
+
+    def fresh(rows):
+        out = []
+        for v, r in zip(rows, planar_support_vertices(W, E, owner, m, np.array(rows))[2]):
+            key = tuple(r)
+            if key not in seen:
+                seen.add(key)
+                out.append(v)
+        return out
+
+    dirs = fresh(dirs)
+    hull, done = None, 0
+    while True:
+        pts = planar_support_vertices(W, E, owner, m, np.array(dirs))[0]
+        try:
+            if hull is None:
+                hull = ConvexHull(pts, incremental=True)
+            else:
+                hull.add_points(pts[done:])
+            done = len(dirs)
+        except (QhullError, ValueError):
+            return None
+        dist = -hull.equations[:, -1]
+        if dist.min() >= eps * (1 - EPS_TOL / 16) or len(dirs) >= 4 * MAX_VERTICES or _expired(deadline):
+            break
+        new = fresh(list(hull.equations[np.argsort(dist, kind="stable")[:2 * _ADD], :-1]))
+        if not new:
+            break
+        dirs += new
+    hull.close()
+    dirs = np.array(dirs)
+    V, EV, R = planar_support_vertices(W, E, owner, m, dirs)
+
+    def vertex(i):
+        C = gens()
+        return [sum((C[r, j] for j in R[i] if j >= 0), 0) for r in range(3)]
+
+    lo = _lower(eps, _prove(V, EV, surface_faces(V), vertex))
+    return None if lo is None else (lo, dirs)
 
 
 def _sweep(W, owner, m, deadline):
@@ -552,44 +609,52 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
         u_best, hi, steps = pieces.local_minimum(u_best, norm)
         work += SOCP_COST * steps
     V, EV, dirs, refs, parts = [], [], [], [], []
+    owner = np.zeros(sup.C.shape[1], dtype=np.int64)
+    for b, blk in enumerate(sup.blocks):
+        owner[list(blk.cols)] = b
 
     def add(v):
         out = sup.vertex(v, norm, len(V))
         if out is not None:
-            w, err, use, X = out
+            w, err, x = out
             V.append(w)
             EV.append(err)
             dirs.append(np.asarray(v, dtype=float))
-            refs.append(use[0] if use else 0)
-            parts.append((use, X))
+            refs.append(int(owner[np.flatnonzero(x)[0]]) if x.any() else 0)
+            parts.append(x)
 
     for v in np.vstack([np.eye(d), -np.eye(d), u_best[None]]):
         add(v)
     spare = iter(U[2 * d:])  # more starting directions while the hull is flat
-    rounds, limited, faces = 0, False, None
+    rounds, limited, hull, done = 0, False, None, 0
     while True:
         rounds += 1
-        pts = np.array(V)
-        faces = surface_faces(pts) if len(V) > d else None
-        if faces is not None:
-            dist = face_distances(pts, faces)
-            if np.isfinite(dist).all() and hi - dist.min() <= rel_gap * hi:
+        if hull is None and len(V) > d:
+            try:
+                hull = ConvexHull(np.array(V), incremental=True)
+                done = len(V)
+            except (QhullError, ValueError):
+                hull = None
+        elif hull is not None and len(V) > done:
+            hull.add_points(np.array(V[done:]))
+            done = len(V)
+        if hull is not None:
+            dist = -hull.equations[:, -1]  # qhull's unit outward normals: a guide, not a proof
+            if hi - dist.min() <= rel_gap * hi:
                 break
         if _expired(deadline):
             limited = True
             break
         if len(V) >= MAX_VERTICES or work >= budget:
             break
-        if faces is None or not np.isfinite(dist).all():
+        if hull is None:
             v = next(spare, None)
             if v is None:
                 break
             add(v)
             work += 1
             continue
-        weakest = np.argsort(dist, kind="stable")[:_ADD]  # finite: the flat case is above
-        normals = generalised_cross(pts[faces[weakest]])
-        normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+        normals = hull.equations[np.argsort(dist, kind="stable")[:_ADD], :-1]
         hv = pieces.h(normals, norm)
         work += len(normals)
         j = int(np.argmin(hv))
@@ -599,11 +664,17 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
             if h_u < hi:
                 u_best, hi = u, h_u
                 add(u_best)
+        before = len(V)
         for v in normals:
             add(v)
+        if len(V) == before and hv[j] >= hi:
+            break  # nothing new to add: the polytope is as good as these directions make it
+    if hull is not None:
+        hull.close()
+    faces = surface_faces(np.array(V)) if len(V) > d else None
     direction = tuple(float(v) for v in u_best)
     lo, ev = 0.0, Evidence("none", direction)
-    bounds = _prove(np.array(V), np.array(EV), faces, lambda i: sup.exact_vertex(*parts[i]))
+    bounds = _prove(np.array(V), np.array(EV), faces, lambda i: sup.exact_vertex(parts[i]))
     if bounds is not None:
         lo = min(stated_lo(*bounds), hi)
         ev = Evidence("support", direction, ref=tuple(refs) if norm == "L1" else (),
