@@ -10,6 +10,7 @@ from pathlib import Path
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
@@ -58,7 +59,7 @@ def certify_command(
                                    eps_time=eps_time if eps_time > 0 else None, workers=workers or None,
                                    dask=dask, resume=resume, chunk_size=chunk_size)
         except CertifyError as err:
-            console.print(f"[red]error:[/red] {err}")
+            console.print(f"[red]error:[/red] {escape(_printable(str(err)))}")
             raise typer.Exit(2)
     if not quiet:
         table = Table(title=f"{summary.rows} grasps -> {output}")
@@ -87,15 +88,20 @@ def verify_command(
     try:
         summary = verify_file(results, grasps, workers=workers or None)
     except CertifyError as err:
-        console.print(f"[red]error:[/red] {err}")
+        console.print(f"[red]error:[/red] {escape(_printable(str(err)))}")
         raise typer.Exit(2)
     for gid, reason in summary.failures:
-        typer.echo(f"{gid}\t{reason}")
+        typer.echo(_printable(f"{gid}\t{reason}"))
     checked = summary.rows - summary.errors
     console.print(f"{checked} certified rows re-checked, {summary.errors} error rows skipped, "
                   f"{len(summary.failures)} failed")
     if summary.failures:
         raise typer.Exit(1)
+
+
+def _printable(text: str) -> str:
+    """``text`` with lone surrogates (from invalid UTF-8 or JSON escapes) escaped, on one line."""
+    return text.encode("utf-8", "backslashreplace").decode("utf-8").replace("\n", "\\n")
 
 
 def bench_command(

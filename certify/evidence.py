@@ -203,41 +203,28 @@ def face_distances(points: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return np.divide(det, norm, out=np.full(len(det), np.nan), where=norm > 0)
 
 
+_CYCLE_REASONS = {
+    1: "a face index is out of range",
+    2: "a face repeats a vertex",
+    3: "the faces do not close up (a ridge is not shared by exactly two faces)",
+    4: "two faces sharing a ridge are not oppositely oriented",
+}
+
+
 def cycle_check(faces: np.ndarray, nv: int) -> str | None:
     """None when ``faces`` (F, d) form a closed oriented cycle on ``nv`` vertices: indices in
     range and distinct within a face, every ridge in exactly two faces with opposite
     orientations; else the reason."""
+    from ._kernels.surface import cycle_code
+
     faces = np.asarray(faces, dtype=np.int64)
-    if faces.ndim != 2 or len(faces) == 0:
+    if faces.ndim != 2 or len(faces) == 0 or faces.shape[1] < 2:
         return "no faces"
-    F, d = faces.shape
-    if faces.min() < 0 or faces.max() >= nv:
-        return "a face index is out of range"
-    srt = np.sort(faces, axis=1)
-    if (np.diff(srt, axis=1) == 0).any():
-        return "a face repeats a vertex"
-    ridges, signs = [], []
-    for k in range(d):
-        r = np.delete(faces, k, axis=1)
-        order = np.argsort(r, axis=1, kind="stable")
-        inv = np.zeros(F, dtype=np.int64)  # parity of the sorting permutation
-        for i in range(d - 1):
-            for j in range(i + 1, d - 1):
-                inv += order[:, i] > order[:, j]
-        ridges.append(np.take_along_axis(r, order, axis=1))
-        signs.append(((-1) ** k) * np.where(inv % 2 == 0, 1, -1))
-    R = np.concatenate(ridges)
-    S = np.concatenate(signs)
-    order = np.lexsort(R.T[::-1])
-    R, S = R[order], S[order]
-    if len(R) % 2:
-        return "the faces do not close up (a ridge is not shared by two faces)"
-    same = (R[0::2] == R[1::2]).all(axis=1)
-    if not same.all() or (len(R) > 2 and (R[2::2] == R[1:-1:2]).all(axis=1).any()):
-        return "the faces do not close up (a ridge is not shared by exactly two faces)"
-    if (S[0::2] + S[1::2] != 0).any():
-        return "two faces sharing a ridge are not oppositely oriented"
-    return None
+    d = faces.shape[1]
+    if nv <= 0 or (d - 1) * math.log2(max(nv, 2)) >= 62:
+        return "too many vertices"
+    code = cycle_code(np.ascontiguousarray(faces), int(nv))
+    return _CYCLE_REASONS.get(int(code))
 
 
 def _bareiss(M: list[list[int]]) -> int:
@@ -303,9 +290,7 @@ def surface_minimum(V: np.ndarray, EV: np.ndarray, faces: np.ndarray, exact_vert
     perms, signs = _LEIBNIZ.setdefault(d - 1, leibniz_tables(d - 1))
     ok, lo, hi = face_bounds(np.ascontiguousarray(V, dtype=float), np.ascontiguousarray(EV, dtype=float),
                              np.ascontiguousarray(faces, dtype=np.int64), perms, signs)
-    lo = [Fraction(float(x)) for x in lo]
-    hi = [Fraction(float(x)) if np.isfinite(x) else None for x in hi]
-    exact = np.zeros(len(faces), dtype=bool)
+    exact: dict[int, Fraction] = {}  # faces settled exactly: their squared distance
     cache: dict[int, Any] = {}
 
     def settle(f: int) -> bool:
@@ -313,22 +298,28 @@ def surface_minimum(V: np.ndarray, EV: np.ndarray, faces: np.ndarray, exact_vert
         d2 = exact_face(verts)
         if d2 is None:
             return False
-        lo[f] = hi[f] = d2
-        exact[f] = True
+        exact[f] = d2
+        x = float(d2)  # float bounds of the exact value, for the float comparisons below
+        lo[f], hi[f] = np.nextafter(x, 0.0), np.nextafter(x, np.inf)
         return True
 
     for f in np.flatnonzero(~ok):
-        if not settle(f):
+        if not settle(int(f)):
             return "a face of the surface is not positively oriented about the origin", Fraction(0), Fraction(0)
+    open_ = np.ones(len(faces), dtype=bool)
+    open_[list(exact)] = False
     while True:
-        top = min(h for h in hi if h is not None)
-        loose = [f for f in range(len(faces)) if not exact[f] and lo[f] < top
-                 and (hi[f] is None or hi[f] > (1 + Fraction(tight)) * lo[f])]
-        if not loose:
+        loose = np.flatnonzero(open_ & (lo < hi.min()) & (hi > lo * (1 + tight)))
+        if not len(loose):
             break
         for f in loose:
-            settle(f)
-    return None, min(lo), min(h for h in hi if h is not None)
+            settle(int(f))
+            open_[f] = False
+    lows, highs = list(exact.values()), list(exact.values())
+    if open_.any():
+        lows.append(Fraction(float(lo[open_].min())))
+        highs.append(Fraction(float(hi[open_].min())))
+    return None, min(lows), min(highs)
 
 
 _LEIBNIZ: dict[int, tuple] = {}

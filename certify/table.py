@@ -30,7 +30,7 @@ from .results import RESULT_SCHEMA
 from .validation import param_names
 
 __all__ = ["CONTACT", "GRASP_SCHEMA", "is_parquet", "Chunk", "iter_chunks", "count_grasps",
-           "grasps_table", "rows_to_table", "table_to_rows", "chunk_values"]
+           "grasps_table", "rows_to_table", "table_to_rows", "chunk_values", "parse_line"]
 
 CONTACT = pa.struct([("p", pa.list_(pa.float64())), ("n", pa.list_(pa.float64())), ("model", pa.string())]
                     + [(name, pa.float64()) for name in param_names()])
@@ -108,7 +108,9 @@ def iter_chunks(path: str | Path, size: int) -> Iterator[Chunk]:
             yield Chunk(index, range(start + 1, start + pending + 1), table)
         return
     try:
-        fh = path.open("r", encoding="utf-8")
+        # undecodable bytes become lone surrogates (and the line an error row, see
+        # chunk_values), so that one bad line neither stops the run nor shifts line numbers
+        fh = path.open("r", encoding="utf-8", errors="surrogateescape")
     except OSError as err:
         raise _open_error(path, err) from None
     with fh:
@@ -138,17 +140,28 @@ def table_values(table: pa.Table) -> list:
     return [clean_value(d) for d in table.to_pylist()]
 
 
+def parse_line(text: str) -> Any:
+    """The JSON value of one line, or a :class:`GraspFileError` saying why there is none (not
+    UTF-8, malformed, nested too deeply, an integer too long to convert)."""
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return GraspFileError("the line is not valid UTF-8")
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as err:
+        return GraspFileError(f"malformed JSON ({err.msg} at column {err.colno})")
+    except RecursionError:
+        return GraspFileError("malformed JSON (nested too deeply)")
+    except ValueError as err:  # e.g. an integer with more digits than Python converts
+        return GraspFileError(f"malformed JSON ({str(err)[:80]})")
+
+
 def chunk_values(chunk: Chunk) -> list:
     """Parsed grasp values of a chunk: dicts, or a :class:`GraspFileError` for a malformed line."""
     if isinstance(chunk.rows, pa.Table):
         return table_values(chunk.rows)
-    values = []
-    for _, text in chunk.rows:
-        try:
-            values.append(json.loads(text))
-        except json.JSONDecodeError as err:
-            values.append(GraspFileError(f"malformed JSON ({err.msg} at column {err.colno})"))
-    return values
+    return [parse_line(text) for _, text in chunk.rows]
 
 
 def count_grasps(path: str | Path) -> int | None:

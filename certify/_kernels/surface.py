@@ -19,7 +19,7 @@ from numba import njit
 
 from .linalg import U, gamma
 
-__all__ = ["face_bounds", "leibniz_tables", "planar_h_bounds"]
+__all__ = ["face_bounds", "leibniz_tables", "planar_h_bounds", "cycle_code"]
 
 
 def leibniz_tables(n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -129,3 +129,56 @@ def planar_h_bounds(W, EW, owner, m, u, linf):
     r_lo = np.sqrt(uu * (1.0 - gamma(4))) * (1.0 - 2 * U)
     r_hi = np.sqrt(uu * (1.0 + gamma(4))) * (1.0 + 2 * U)
     return h_lo / r_hi * (1.0 - 2 * U), h_hi / r_lo * (1.0 + 2 * U)
+
+
+@njit(cache=True)
+def cycle_code(faces, nv):
+    """Whether ``faces`` (F, d) on ``nv`` vertices form a closed oriented cycle: 0 yes; 1 an
+    index out of range; 2 a face repeating a vertex; 3 a ridge not in exactly two faces; 4 two
+    faces sharing a ridge with the same orientation. Ridges (a face without its ``k``-th
+    vertex, sign ``(-1)^k`` times the parity of sorting the rest) are encoded as integers in
+    base ``nv`` (the caller keeps ``nv^(d-1)`` below ``2^62``)."""
+    F, d = faces.shape
+    keys = np.empty(F * d, dtype=np.int64)
+    sgn = np.empty(F * d, dtype=np.int64)
+    r = np.empty(d - 1, dtype=np.int64)
+    for f in range(F):
+        for q in range(d):
+            v = faces[f, q]
+            if v < 0 or v >= nv:
+                return 1
+            for p in range(q):
+                if faces[f, p] == v:
+                    return 2
+        for k in range(d):
+            c = 0
+            for q in range(d):
+                if q != k:
+                    r[c] = faces[f, q]
+                    c += 1
+            parity = 0
+            for i in range(1, d - 1):  # insertion sort, counting swaps
+                j = i
+                while j > 0 and r[j - 1] > r[j]:
+                    r[j - 1], r[j] = r[j], r[j - 1]
+                    parity += 1
+                    j -= 1
+            key = 0
+            for i in range(d - 1):
+                key = key * nv + r[i]
+            keys[f * d + k] = key
+            s = 1 if k % 2 == 0 else -1
+            sgn[f * d + k] = s if parity % 2 == 0 else -s
+    order = np.argsort(keys)
+    n = F * d
+    if n % 2:
+        return 3
+    for i in range(0, n, 2):
+        a, b = order[i], order[i + 1]
+        if keys[a] != keys[b]:
+            return 3
+        if i + 2 < n and keys[order[i + 2]] == keys[a]:
+            return 3
+        if sgn[a] + sgn[b] != 0:
+            return 4
+    return 0
