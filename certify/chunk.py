@@ -155,7 +155,7 @@ def _failure(cols: GraspColumns, i: int, line: int, row: Any, tol: Tolerances, g
                 return gid, f"{name} of an error row must be {_show(expected[name])}, got {_show(row[name])}"
         return None
     if message is not None:
-        return gid, f"grasp is invalid: {message}"
+        return gid, f"status {_show(row['status'])} but the grasp is invalid (the row must be an error row): {message}"
     check = verify_row(cols.grasps([i])[0], row, tol)
     return None if check else (gid, check.reason)
 

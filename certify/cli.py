@@ -59,7 +59,7 @@ def certify_command(
                                    eps_time=eps_time if eps_time > 0 else None, workers=workers or None,
                                    dask=dask, resume=resume, chunk_size=chunk_size)
         except CertifyError as err:
-            console.print(f"[red]error:[/red] {escape(_printable(str(err)))}")
+            console.print(f"[red]error:[/red] {escape(_printable(str(err)))}", soft_wrap=True)
             raise typer.Exit(2)
     if not quiet:
         table = Table(title=f"{summary.rows} grasps -> {output}")
@@ -88,7 +88,7 @@ def verify_command(
     try:
         summary = verify_file(results, grasps, workers=workers or None)
     except CertifyError as err:
-        console.print(f"[red]error:[/red] {escape(_printable(str(err)))}")
+        console.print(f"[red]error:[/red] {escape(_printable(str(err)))}", soft_wrap=True)
         raise typer.Exit(2)
     for gid, reason in summary.failures:
         typer.echo(_printable(f"{gid}\t{reason}"))

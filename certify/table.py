@@ -204,8 +204,8 @@ def table_to_rows(table: pa.Table) -> list[dict]:
     rows = table.to_pylist()
     for r in rows:
         cert = r.get("certificate")
-        if cert:
+        if isinstance(cert, dict):  # any other value is left as it is, for the re-check to refuse
             for key in ("force", "form"):
-                if cert.get(key):
+                if isinstance(cert.get(key), dict):
                     cert[key] = {k: v for k, v in cert[key].items() if v is not None}
     return rows
