@@ -72,6 +72,8 @@ import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
 from . import cones
+from ._kernels.planar import planar_generators
+from ._kernels.surface import cycle_code, face_bounds, leibniz_tables, planar_h_bounds
 from .certificates import Check
 from .grasp import Grasp
 from .problem import grasp_system
@@ -215,8 +217,6 @@ def cycle_check(faces: np.ndarray, nv: int) -> str | None:
     """None when ``faces`` (F, d) form a closed oriented cycle on ``nv`` vertices: indices in
     range and distinct within a face, every ridge in exactly two faces with opposite
     orientations; else the reason."""
-    from ._kernels.surface import cycle_code
-
     faces = np.asarray(faces, dtype=np.int64)
     if faces.ndim != 2 or len(faces) == 0 or faces.shape[1] < 2:
         return "no faces"
@@ -281,8 +281,6 @@ def surface_minimum(V: np.ndarray, EV: np.ndarray, faces: np.ndarray, exact_vert
     lo``. Rigorous float bounds (:func:`qualgrasp.certify._kernels.surface.face_bounds`) decide
     every face they can; ``exact_vertex(i)`` (exact coordinates of vertex ``i``) is asked only
     for the faces they leave undecided, or too loosely bounded to tell the minimum."""
-    from ._kernels.surface import face_bounds, leibniz_tables
-
     reason = cycle_check(faces, len(V))
     if reason:
         return reason, Fraction(0), Fraction(0)
@@ -348,8 +346,6 @@ def planar_generator_arrays(grasp: Grasp):
     """Generator wrenches ``W`` (3, k) of a planar grasp, bounds ``E`` on their distance to the
     exact values (:func:`qualgrasp.certify._kernels.planar.planar_generators`: the floats of
     :func:`qualgrasp.certify.problem.grasp_system`), and the owner contact of each (sorted)."""
-    from ._kernels.planar import planar_generators
-
     P, N, mu, params, c, L = grasp_arrays(grasp)
     models = tuple(ct.model for ct in grasp.contacts)
     owner, offset, friction = generator_layout(models, variants_of(grasp), 2)
@@ -774,8 +770,6 @@ def verify_bounds(grasp: Grasp, vals: dict, evs: dict, arrays=None) -> Check:
             return Check(False, f"eps_evidence.{key}.direction must hold {d} numbers")
         u = np.array(ev.direction, dtype=float)
         if planar:
-            from ._kernels.surface import planar_h_bounds
-
             h_lo, h_hi = planar_h_bounds(W, E, owner, m, u, norm == "Linf")
 
             def exact(norm=norm, u=u):

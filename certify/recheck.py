@@ -18,6 +18,8 @@ the message; a row fails only if that fails. No solver is involved anywhere.
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pyarrow as pa
 
@@ -247,8 +249,6 @@ def _text(gid):
     """An id as the results' string column holds it."""
     if gid is None or isinstance(gid, str):
         return gid
-    import json
-
     return str(gid) if isinstance(gid, (int, float)) and not isinstance(gid, bool) else json.dumps(gid)
 
 

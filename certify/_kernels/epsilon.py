@@ -166,10 +166,26 @@ def _pseudo_angle(x, y):
 
 
 @njit(cache=True)
-def _hull2(xs, ys, idx, n, out):
+def _hull2(xs, ys, idx, n, out, delta):
     """Counter-clockwise convex hull (Andrew's monotone chain) of the ``n`` 2-D points
     ``(xs[idx[i]], ys[idx[i]])``; writes hull positions (into ``idx``) to ``out`` and returns
-    their count (collinear points dropped; 1 when all points coincide)."""
+    their count (1 when all points coincide). Robust to rounding: points within ``delta``
+    (in the 1-norm) of an earlier one are merged into it, and vertices whose turn is within
+    ``1e-12`` of the product of the adjacent edge lengths are dropped as collinear, so that no
+    edge is a rounding artefact with an arbitrary normal."""
+    kept = 0
+    for i in range(n):  # merge near-duplicates (n is a handful)
+        dup = False
+        for j in range(kept):
+            if abs(xs[idx[i]] - xs[idx[j]]) + abs(ys[idx[i]] - ys[idx[j]]) <= delta:
+                dup = True
+                break
+        if not dup:
+            idx[kept] = idx[i]
+            kept += 1
+    n = kept
+    if n == 1:
+        return 1
     for i in range(1, n):  # insertion sort by (x, y)
         j = i
         while j > 0 and (xs[idx[j - 1]] > xs[idx[j]] or
@@ -178,24 +194,27 @@ def _hull2(xs, ys, idx, n, out):
             j -= 1
     h = 0
     for i in range(n):  # lower hull
-        while h >= 2 and ((xs[out[h - 1]] - xs[out[h - 2]]) * (ys[idx[i]] - ys[out[h - 2]])
-                          - (ys[out[h - 1]] - ys[out[h - 2]]) * (xs[idx[i]] - xs[out[h - 2]])) <= 0.0:
+        while h >= 2 and _turns_right(xs, ys, out[h - 2], out[h - 1], idx[i]):
             h -= 1
         out[h] = idx[i]
         h += 1
     low = h + 1
     for i in range(n - 2, -1, -1):  # upper hull
-        while h >= low and ((xs[out[h - 1]] - xs[out[h - 2]]) * (ys[idx[i]] - ys[out[h - 2]])
-                            - (ys[out[h - 1]] - ys[out[h - 2]]) * (xs[idx[i]] - xs[out[h - 2]])) <= 0.0:
+        while h >= low and _turns_right(xs, ys, out[h - 2], out[h - 1], idx[i]):
             h -= 1
         out[h] = idx[i]
         h += 1
     h -= 1  # the first point closes the chain
-    if h < 1:
-        return 1
-    if h == 1 and (xs[out[0]] != xs[out[1]] or ys[out[0]] != ys[out[1]]):
-        return 2  # a segment: both end points
-    return h
+    return max(h, 2) if n >= 2 else 1
+
+
+@njit(cache=True)
+def _turns_right(xs, ys, o, a, b):
+    """Does ``o -> a -> b`` turn clockwise or go straight (within 1e-12 relative)?"""
+    ax, ay = xs[a] - xs[o], ys[a] - ys[o]
+    bx, by = xs[b] - xs[o], ys[b] - ys[o]
+    cross = ax * by - ay * bx
+    return cross <= 1e-12 * (abs(ax) + abs(ay)) * (abs(bx) + abs(by))
 
 
 @njit(cache=True)
@@ -231,6 +250,7 @@ def linf_sweep(Wb, owner, m, E, first, last, top_val, top_u):
     for a in range(E.shape[0]):
         scale = max(scale, abs(E[a, 0]) + abs(E[a, 1]) + abs(E[a, 2]))
     tiny = 1e-12 * max(1.0, scale * scale)
+    delta = 1e-12 * scale
     xs = np.zeros(k + 1)  # projected generators; position k is the origin
     ys = np.zeros(k + 1)
     idx = np.empty(rmax + 1, dtype=np.int64)
@@ -270,7 +290,7 @@ def linf_sweep(Wb, owner, m, E, first, last, top_val, top_u):
             idx[0] = k
             for q in range(1, n):
                 idx[q] = start[i] + q - 1
-            nh = _hull2(xs, ys, idx, n, hull)
+            nh = _hull2(xs, ys, idx, n, hull, delta)
             if nh < 2:
                 continue  # every point projects on the origin: the contact adds 0
             # outward normal of the edge hull[t] -> hull[t+1] (counter-clockwise): (dy, -dx);
