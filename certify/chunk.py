@@ -22,6 +22,7 @@ import json
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
+import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
@@ -189,6 +190,15 @@ class Quality:
             if len(self.ids_without) < 100:
                 self.ids_without.append(gid)
 
+    def add_many(self, count: int, first_ids: list, has_eps: bool) -> None:
+        """Note ``count`` rows of one kind, of which ``first_ids`` are the first ids."""
+        if has_eps:
+            self.with_eps += count
+            self.ids_with += first_ids[: max(0, 100 - len(self.ids_with))]
+        else:
+            self.without_eps += count
+            self.ids_without += first_ids[: max(0, 100 - len(self.ids_without))]
+
     def merge(self, other: "Quality") -> None:
         self.with_eps += other.with_eps
         self.without_eps += other.without_eps
@@ -247,11 +257,12 @@ def verify_chunk(chunk: Chunk, results, tol: Tolerances = Tolerances()) -> tuple
             return failure is None
 
         recheck_table(cols, results, chunk.lines, slow, tol)
-        status = results.column("status").to_pylist()
-        has_eps = results.column("eps_l1_hi").is_valid().to_pylist()
-        for i, (s_, e) in enumerate(zip(status, has_eps)):
-            if s_ in ("closure", "no_closure", "degenerate"):
-                quality.add(cols.id_of(i), e)
+        status = pc.is_in(results.column("status"), pa.array(["closure", "no_closure", "degenerate"]))
+        rows = np.asarray(status.fill_null(False).to_numpy(zero_copy_only=False), dtype=bool)
+        has_eps = np.asarray(results.column("eps_l1_hi").is_valid().to_numpy(zero_copy_only=False), dtype=bool)
+        for mask, flag in ((rows & has_eps, True), (rows & ~has_eps, False)):
+            idx = np.flatnonzero(mask)
+            quality.add_many(len(idx), [cols.id_of(int(i)) for i in idx[:100]], flag)
         return status_counts(results.column("status"))[0], failures, quality
     if isinstance(results, pa.Table):
         results = table_to_rows(results)

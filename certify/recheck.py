@@ -237,11 +237,13 @@ def _claims(cols: GraspColumns, results: pa.Table, lines) -> np.ndarray:
     fine &= lengths == cols.dim
     flat = center.combine_chunks().flatten().to_numpy(zero_copy_only=False) if n else np.zeros(0)
     offsets = np.concatenate([[0], np.cumsum(lengths)]).astype(int)
-    for i in np.flatnonzero(fine):
-        got = flat[offsets[i]:offsets[i + 1]]
-        want = cols.center[i, : cols.dim[i]]
-        if not (np.abs(got - want) <= GEOMETRY_TOL * np.maximum(1.0, np.abs(want))).all():
-            fine[i] = False
+    for d in (2, 3):
+        sel = np.flatnonzero(fine & (lengths == d))
+        if len(sel):
+            got = flat[offsets[sel][:, None] + np.arange(d)].astype(float)
+            want = cols.center[sel, :d]
+            close = (np.abs(got - want) <= GEOMETRY_TOL * np.maximum(1.0, np.abs(want))).all(axis=1)
+            fine[sel[~close]] = False
     return fine
 
 
