@@ -629,15 +629,15 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
     rounds, limited, hull, done = 0, False, None, 0
     while True:
         rounds += 1
-        if hull is None and len(V) > d:
-            try:
+        try:
+            if hull is None and len(V) > d:
                 hull = ConvexHull(np.array(V), incremental=True)
                 done = len(V)
-            except (QhullError, ValueError):
-                hull = None
-        elif hull is not None and len(V) > done:
-            hull.add_points(np.array(V[done:]))
-            done = len(V)
+            elif hull is not None and len(V) > done:
+                hull.add_points(np.array(V[done:]))
+                done = len(V)
+        except (QhullError, ValueError):  # a flat or degenerate set: start again from scratch
+            hull = None
         if hull is not None:
             dist = -hull.equations[:, -1]  # qhull's unit outward normals: a guide, not a proof
             if hi - dist.min() <= rel_gap * hi:
