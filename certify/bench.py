@@ -15,6 +15,11 @@ grasps (a prefix of them for the slow routes):
 The table gives microseconds per grasp, grasps per second and each route's time per grasp as a
 multiple of the batch path's. Speeds are single-process; ``qualgrasp certify --workers N`` runs N
 such processes.
+
+``qualgrasp bench --quality`` times epsilon on small grasps (bound gaps, the 8-edge linearisation
+error); ``qualgrasp bench --contacts`` times one grasp in closure per size (3 to 1000 point
+contacts, planar and spatial): closure (both certificates and their re-check) and quality (both
+epsilons with their evidence), in seconds per grasp, without a time limit.
 """
 
 from __future__ import annotations
@@ -32,13 +37,14 @@ from .chunk import Options
 from .closure import force_closure, form_closure
 from .fastpath import certify_table
 from .grasp import grasp_to_dict
-from .quality import epsilon, epsilon_linearised
+from .quality import epsilon, epsilon_linearised, epsilons
 from .report import certify_grasp
 from .samples import random_grasps
 from .solvers import make_solver
 from .table import grasps_table
 
-__all__ = ["KINDS", "BenchRow", "run_bench", "print_bench"]
+__all__ = ["KINDS", "BenchRow", "run_bench", "print_bench", "CONTACTS", "ContactsRow",
+           "run_contacts_bench", "print_contacts_bench"]
 
 #: name -> keyword arguments of :func:`qualgrasp.certify.samples.random_grasp`
 #: (sizes chosen so that both verdicts are frequent: 17 % to 40 % of the grasps are in closure)
@@ -244,3 +250,60 @@ def print_quality_bench(rows: list[QualityRow]) -> None:
                       f"{r.median_ms:.0f}", f"{r.worst_ms:.0f}", pct(r.lin8_median_err),
                       pct(r.lin8_worst_err))
     Console(width=max(140, Console().width)).print(table)
+
+
+#: Contact counts of ``qualgrasp bench --contacts``.
+CONTACTS = (3, 10, 50, 200, 1000)
+
+
+@dataclass(frozen=True)
+class ContactsRow:
+    """Seconds for one grasp in closure with ``contacts`` point contacts: closure (force and form
+    closure, certificates and their re-check) and quality (L1 and L-infinity epsilon with their
+    evidence), with the relative gaps reached and whether a time limit was hit."""
+
+    dim: int
+    contacts: int
+    closure_s: float
+    quality_s: float
+    gap_l1: float
+    gap_linf: float
+    limited: bool
+
+
+def run_contacts_bench(contacts=CONTACTS, seed: int = 0, time_limit: float | None = None) -> list[ContactsRow]:
+    """Time one grasp in closure per size and dimension (random point contacts, ``mu`` in
+    [0.2, 1], the first of :func:`~qualgrasp.certify.samples.random_grasps` in closure), after a
+    warm-up that compiles the kernels."""
+    rows = []
+    for dim in (2, 3):
+        extra = {"spread": 0.3} if dim == 3 else {}
+        warm = next(g for g in random_grasps(seed, 50, dim=dim, n_contacts=4, **extra)
+                    if force_closure(g).status == "closure")
+        epsilons(warm, verdict=certify_grasp(warm, quality=False).force)
+        for m in contacts:
+            g = next((g for g in random_grasps(seed, 50, dim=dim, n_contacts=m, **extra)
+                      if force_closure(g).status == "closure"), None)
+            if g is None:
+                continue
+            start = time.perf_counter()
+            report = certify_grasp(g, quality=False)
+            t_closure = time.perf_counter() - start
+            start = time.perf_counter()
+            e = epsilons(g, verdict=report.force, time_limit=time_limit)
+            t_quality = time.perf_counter() - start
+            rows.append(ContactsRow(dim, m, t_closure, t_quality, e["L1"].gap, e["Linf"].gap,
+                                    any(x.limited for x in e.values())))
+    return rows
+
+
+def print_contacts_bench(rows: list[ContactsRow]) -> None:
+    """Print the contacts benchmark table with rich."""
+    table = Table(title="one grasp in closure: seconds per grasp by contact count (point contacts)")
+    for col in ("grasp", "contacts", "closure s", "quality s", "gap L1", "gap Linf", "time limit hit"):
+        table.add_column(col, justify="left" if col == "grasp" else "right")
+    for r in rows:
+        table.add_row("planar" if r.dim == 2 else "spatial", str(r.contacts), f"{r.closure_s:.3f}",
+                      f"{r.quality_s:.3f}", f"{100 * r.gap_l1:.2f} %", f"{100 * r.gap_linf:.2f} %",
+                      "yes" if r.limited else "no")
+    Console(width=max(120, Console().width)).print(table)

@@ -49,6 +49,7 @@ __all__ = [
     "verify",
     "verify_span",
     "verify_system",
+    "margin_tolerance",
 ]
 
 
@@ -167,7 +168,7 @@ def margin_of(blocks, x) -> float:
 
 def verify(grasp: Grasp, certificate: Certificate, *, status: str | None = None,
            margin: float | None = None, frictionless: bool = False,
-           tol: Tolerances = Tolerances()) -> Check:
+           tol: Tolerances = Tolerances(), exact_margin: bool = False) -> Check:
     """Re-check ``certificate`` against ``grasp`` without a solver, in exact rational arithmetic
     on the float data (module docstring).
 
@@ -180,11 +181,15 @@ def verify(grasp: Grasp, certificate: Certificate, *, status: str | None = None,
     status : str, optional
         The claimed status; checked against the certificate's kind.
     margin : float, optional
-        The claimed margin; an interior certificate must support it.
+        The claimed margin; an interior certificate must support it: at most the margin ``t``
+        its (corrected) values certify, to within :func:`margin_tolerance` of ``t``.
     frictionless : bool
         Check form closure (every contact frictionless) instead of force closure.
     tol : Tolerances
         The tolerances the verdict was made with.
+    exact_margin : bool
+        Also require the claimed margin to be at least ``t`` minus the tolerance: the claim is
+        then the certified margin itself (how results rows are re-checked).
 
     Returns
     -------
@@ -207,7 +212,8 @@ def verify(grasp: Grasp, certificate: Certificate, *, status: str | None = None,
         Cx, blocks, layout = grasp_system(grasp, frictionless=frictionless, socp=socp, exact=True)
     except ValueError as err:  # a layout the grasp's contacts do not have (pads are polyhedral)
         return Check(False, f"certificate layout {certificate.layout!r}: {err}")
-    return verify_system(Cx, blocks, layout, certificate, status=status, margin=margin, tol=tol)
+    return verify_system(Cx, blocks, layout, certificate, status=status, margin=margin, tol=tol,
+                         exact_margin=exact_margin)
 
 
 def verify_span(vectors, certificate: Certificate, *, status: str | None = None,
@@ -221,15 +227,17 @@ _KIND = {"closure": "interior", "no_closure": "farkas", "degenerate": "degenerat
 
 
 def verify_system(Cx, blocks, layout: str, cert: Certificate, *, status: str | None = None,
-                  margin: float | None = None, tol: Tolerances = Tolerances()) -> Check:
-    """Re-check ``cert`` against exact certificate columns ``Cx`` and their cone ``blocks``."""
+                  margin: float | None = None, tol: Tolerances = Tolerances(),
+                  exact_margin: bool = False) -> Check:
+    """Re-check ``cert`` against exact certificate columns ``Cx`` and their cone ``blocks``
+    (``margin`` and ``exact_margin`` as for :func:`verify`)."""
     if status is not None and _KIND.get(status) != cert.kind:
         return Check(False, f"status {status!r} does not match a {cert.kind} certificate")
     if cert.layout != layout:
         return Check(False, f"certificate layout {cert.layout!r}, expected {layout!r}")
     try:
         if cert.kind == "interior":
-            return _verify_interior(Cx, blocks, cert, margin, tol)
+            return _verify_interior(Cx, blocks, cert, margin, tol, exact_margin)
         if cert.kind == "farkas":
             return _verify_farkas(Cx, blocks, cert)
         return _verify_degenerate(Cx, blocks, cert, tol)
@@ -237,7 +245,14 @@ def verify_system(Cx, blocks, layout: str, cert: Certificate, *, status: str | N
         return Check(False, f"malformed certificate: {err}")
 
 
-def _verify_interior(Cx, blocks, cert: Certificate, margin, tol: Tolerances) -> Check:
+def margin_tolerance(t: float) -> float:
+    """How far a claimed margin may lie from the margin ``t`` that a certificate's values
+    certify: ``1e-9 + 1e-6 |t|``."""
+    return 1e-9 + 1e-6 * abs(t)
+
+
+def _verify_interior(Cx, blocks, cert: Certificate, margin, tol: Tolerances,
+                     exact_margin: bool = False) -> Check:
     d, k = Cx.shape
     if cert.values is None or len(cert.values) != k:
         return Check(False, f"interior certificate needs {k} values")
@@ -261,8 +276,10 @@ def _verify_interior(Cx, blocks, cert: Certificate, margin, tol: Tolerances) -> 
             return Check(False, f"force on columns {list(b.cols)} is not strictly inside its cone")
     if margin is not None:
         t = margin_of(blocks, [float(v) for v in x])
-        if margin > t + 1e-9 + 1e-6 * abs(t):
+        if margin > t + margin_tolerance(t):
             return Check(False, f"claimed margin {margin:.6g} exceeds the certified {t:.6g}")
+        if exact_margin and margin < t - margin_tolerance(t):
+            return Check(False, f"claimed margin {margin:.6g} is below the certified {t:.6g}")
     return Check(True)
 
 

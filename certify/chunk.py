@@ -9,17 +9,21 @@ of a JSON chunk, goes through the per-grasp path (:func:`certify_rows`). A bad r
 results row per input row, in order. A grasp's extra top-level fields are carried through
 (:func:`qualgrasp.certify.results.carried_name`).
 
-Re-checking (:func:`verify_chunk`) mirrors it: Arrow chunks are proved in bulk by the rigorous
-floating-point kernels (:func:`qualgrasp.certify.recheck.recheck_table`), every other row by
-:func:`qualgrasp.certify.report.verify_row` with exact rational arithmetic. No solver is used.
+Re-checking (:func:`verify_chunk`) mirrors it: Arrow chunks with the results schema are proved
+in bulk by the rigorous floating-point kernels (:func:`qualgrasp.certify.recheck.recheck_table`),
+every other row (and every row the bulk proof leaves open) by
+:func:`qualgrasp.certify.report.verify_row` with exact rational arithmetic, which checks every
+column the row states. A malformed row is a failure with a message naming the column, never an
+exception. No solver is used.
 """
 
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Sequence
 
+import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
@@ -27,26 +31,28 @@ from .certificates import Tolerances
 from .columns import GraspColumns, grasp_columns, value_columns
 from .errors import CertifyError, GraspFileError
 from .fastpath import certify_table
-from .recheck import recheck_table
+from .recheck import recheck_table, schema_matches
 from .report import certify_grasp, verify_row
-from .results import carried_name, error_row
+from .results import NAMES, carried_name, error_row
 from .solvers import make_solver
 from .table import Chunk, chunk_values, table_to_rows
 
-__all__ = ["Options", "certify_rows", "certify_values", "certify_chunk_results", "certify_arrow", "verify_rows",
-           "verify_chunk", "status_counts"]
+__all__ = ["Options", "Quality", "certify_rows", "certify_values", "certify_chunk_results", "certify_arrow",
+           "verify_rows", "verify_chunk", "status_counts"]
 
 
 @dataclass(frozen=True)
 class Options:
     """What is computed for every grasp (recorded in a run's manifest; part of a chunk's
-    identity): the solver ``method``, whether to compute epsilon (``quality``) and the spatial
-    epsilon's relative gap and budget."""
+    identity): the solver ``method``, whether to compute epsilon (``quality``), the spatial
+    epsilon's relative gap and budget, and the per-grasp time limit of quality in seconds
+    (``eps_time``, None for none; see :func:`qualgrasp.certify.certify_grasp`)."""
 
     method: str = "fast"
     quality: bool = True
     eps_gap: float = 0.01
     eps_budget: int = 200_000
+    eps_time: float | None = 10.0
 
 
 def certify_rows(cols: GraspColumns, rows: Sequence[int], lines: Sequence[int],
@@ -63,7 +69,8 @@ def certify_rows(cols: GraspColumns, rows: Sequence[int], lines: Sequence[int],
             try:
                 grasp = cols.grasps([i])[0]
                 report = certify_grasp(grasp, solver=solver, tol=tol, quality=options.quality,
-                                       eps_gap=options.eps_gap, eps_budget=options.eps_budget)
+                                       eps_gap=options.eps_gap, eps_budget=options.eps_budget,
+                                       eps_time=options.eps_time)
                 out.append({**report.row(line=line), **carried})
                 continue
             except CertifyError as err:
@@ -163,31 +170,134 @@ def certify_arrow(data: Any, options: Options = Options(), tol: Tolerances = Tol
     return _certify_arrow_rows(data, range(1, data.num_rows + 1), options, tol)
 
 
+_STATUSES = ("closure", "no_closure", "degenerate", "error")
+
+
+def _status_of(row: Any) -> str:
+    """The status a row states, for the counts (``malformed`` when it is not one of them)."""
+    status = row.get("status") if isinstance(row, dict) else None
+    return status if isinstance(status, str) and status in _STATUSES else "malformed"
+
+
+def _id_text(gid: Any) -> Any:
+    """The id as a Parquet results file stores it (a string; see
+    :func:`qualgrasp.certify.table.rows_to_table`)."""
+    if gid is None or isinstance(gid, str):
+        return gid
+    return str(gid) if isinstance(gid, (int, float)) and not isinstance(gid, bool) else json.dumps(gid)
+
+
+def _same_id(stated: Any, gid: Any) -> bool:
+    if stated == gid and type(stated) is type(gid):
+        return True
+    return isinstance(stated, str) and stated == _id_text(gid)
+
+
 def _verify_one(cols: GraspColumns, i: int, line: int, row: Any, tol: Tolerances) -> tuple[str, tuple | None]:
-    """Re-check the results ``row`` of grasp ``i``: ``(status, failure or None)``."""
-    if not isinstance(row, dict):
-        return "error", (None, f"results row for line {line}: not a JSON object")
-    status = str(row.get("status"))
+    """Re-check the results ``row`` of grasp ``i``: ``(status, failure or None)``; never
+    raises on a malformed row."""
+    status = _status_of(row)
     gid = cols.id_of(i)
-    if row.get("line") not in (None, line):
-        return status, (row.get("id"), f"results row is for line {row.get('line')}, grasp is line {line}")
-    if row.get("id") != gid and str(row.get("id")) != str(gid):
-        return status, (row.get("id"), f"id does not match grasp line {line} ({gid!r})")
+    try:
+        return status, _failure(cols, i, line, row, tol, gid)
+    except RecursionError:
+        return status, (gid, "malformed row (too deeply nested)")
+    except Exception as err:  # a last resort: a malformed row is a failure, never a traceback
+        return status, (gid, f"malformed row ({type(err).__name__})")
+
+
+def _failure(cols: GraspColumns, i: int, line: int, row: Any, tol: Tolerances, gid: Any):
+    if not isinstance(row, dict):
+        return None, f"results row for line {line}: not a JSON object"
+    missing = [name for name in NAMES if name not in row]
+    if missing:
+        return gid, f"column{'s' if len(missing) > 1 else ''} {', '.join(missing)} missing"
+    stated_line = row["line"]
+    if isinstance(stated_line, bool) or not isinstance(stated_line, int) or stated_line != line:
+        return gid, f"line {_show(stated_line)} does not match the grasp's line {line}"
+    if not _same_id(row["id"], gid):
+        return gid, f"id {_show(row['id'])} does not match the grasp's id {_show(gid)} (line {line})"
+    # a grasp whose extra fields cannot be carried is an error row, as certify_rows writes it
     message = cols.message(i) or _carried(cols.meta[i] if cols.meta else None)[1]
-    if status == "error":
+    if row["status"] == "error":
         if message is None:
-            return status, (gid, "row says error but the grasp is valid")
-        return status, None
+            return gid, "status says error but the grasp is valid"
+        expected = error_row(f"line {line}: {message}", id=row["id"], line=line)
+        for name in NAMES:
+            if row[name] != expected[name] or type(row[name]) is not type(expected[name]):
+                return gid, f"{name} of an error row must be {_show(expected[name])}, got {_show(row[name])}"
+        return None
     if message is not None:
-        return status, (gid, f"grasp is invalid: {message}")
+        return gid, f"status {_show(row['status'])} but the grasp is invalid (the row must be an error row): {message}"
     check = verify_row(cols.grasps([i])[0], row, tol)
-    return status, None if check else (gid, check.reason)
+    return None if check else (gid, check.reason)
+
+
+def _show(value: Any) -> str:
+    try:
+        text = repr(value)
+    except RecursionError:
+        return "(deeply nested value)"
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+@dataclass
+class Quality:
+    """Which rows (not errors) of a re-checked file state epsilon and which do not: a run
+    computes quality for every row or for none, so a file mixing both has been altered. Counts
+    and the first ids of each kind."""
+
+    with_eps: int = 0
+    without_eps: int = 0
+    ids_with: list = field(default_factory=list)
+    ids_without: list = field(default_factory=list)
+
+    def add(self, gid: Any, has_eps: bool) -> None:
+        if has_eps:
+            self.with_eps += 1
+            if len(self.ids_with) < 100:
+                self.ids_with.append(gid)
+        else:
+            self.without_eps += 1
+            if len(self.ids_without) < 100:
+                self.ids_without.append(gid)
+
+    def add_many(self, count: int, first_ids: list, has_eps: bool) -> None:
+        """Note ``count`` rows of one kind, of which ``first_ids`` are the first ids."""
+        if has_eps:
+            self.with_eps += count
+            self.ids_with += first_ids[: max(0, 100 - len(self.ids_with))]
+        else:
+            self.without_eps += count
+            self.ids_without += first_ids[: max(0, 100 - len(self.ids_without))]
+
+    def merge(self, other: "Quality") -> None:
+        self.with_eps += other.with_eps
+        self.without_eps += other.without_eps
+        self.ids_with += other.ids_with[: max(0, 100 - len(self.ids_with))]
+        self.ids_without += other.ids_without[: max(0, 100 - len(self.ids_without))]
+
+    def failures(self) -> list:
+        """Failures for the rarer kind when both occur."""
+        if not (self.with_eps and self.without_eps):
+            return []
+        if self.without_eps <= self.with_eps:
+            return [(gid, "epsilon columns null although the other rows state epsilon (quality was on)")
+                    for gid in self.ids_without]
+        return [(gid, "epsilon columns stated although the other rows have none (quality was off)")
+                for gid in self.ids_with]
+
+
+def _note_quality(quality: Quality, row: Any, gid: Any) -> None:
+    if isinstance(row, dict) and row.get("status") in ("closure", "no_closure", "degenerate"):
+        quality.add(gid, row.get("eps_l1_hi") is not None)
 
 
 def verify_rows(cols: GraspColumns, rows: Sequence[int], lines: Sequence[int], results: Sequence[Any],
-                tol: Tolerances = Tolerances()) -> tuple[dict[str, int], list]:
+                tol: Tolerances = Tolerances(), quality: Quality | None = None) -> tuple[dict[str, int], list]:
     """Re-check results rows (dicts) against rows of checked grasp columns, one by one: status
-    counts and ``(id, reason)`` of each failure."""
+    counts and ``(id, reason)`` of each failure (``quality``, if given, notes which rows state
+    epsilon)."""
     statuses: dict[str, int] = {}
     failures = []
     for i, line, row in zip(rows, lines, results):
@@ -195,14 +305,19 @@ def verify_rows(cols: GraspColumns, rows: Sequence[int], lines: Sequence[int], r
         statuses[status] = statuses.get(status, 0) + 1
         if failure:
             failures.append(failure)
+        if quality is not None:
+            _note_quality(quality, row, cols.id_of(i))
     return statuses, failures
 
 
-def verify_chunk(chunk: Chunk, results, tol: Tolerances = Tolerances()) -> tuple[dict[str, int], list]:
+def verify_chunk(chunk: Chunk, results, tol: Tolerances = Tolerances()) -> tuple[dict[str, int], list, Quality]:
     """Re-check a chunk's results (a list of parsed rows, or an Arrow table aligned with an
-    Arrow chunk): status counts and failures. Arrow pairs are proved in bulk where the rigorous
-    float kernels can; only the other rows are turned into Python values."""
-    if isinstance(chunk.rows, pa.Table) and isinstance(results, pa.Table) and results.num_rows == len(chunk):
+    Arrow chunk): status counts, failures and which rows state epsilon (:class:`Quality`).
+    Arrow pairs with the results schema are proved in bulk where the rigorous float kernels
+    can; only the other rows are turned into Python values."""
+    quality = Quality()
+    if (isinstance(chunk.rows, pa.Table) and isinstance(results, pa.Table) and results.num_rows == len(chunk)
+            and schema_matches(results.schema)):
         cols = grasp_columns(chunk.rows)
         failures: list = []
 
@@ -214,11 +329,18 @@ def verify_chunk(chunk: Chunk, results, tol: Tolerances = Tolerances()) -> tuple
             return failure is None
 
         recheck_table(cols, results, chunk.lines, slow, tol)
-        return status_counts(results.column("status"))[0], failures
+        status = pc.is_in(results.column("status"), pa.array(["closure", "no_closure", "degenerate"]))
+        rows = np.asarray(status.fill_null(False).to_numpy(zero_copy_only=False), dtype=bool)
+        has_eps = np.asarray(results.column("eps_l1_hi").is_valid().to_numpy(zero_copy_only=False), dtype=bool)
+        for mask, flag in ((rows & has_eps, True), (rows & ~has_eps, False)):
+            idx = np.flatnonzero(mask)
+            quality.add_many(len(idx), [cols.id_of(int(i)) for i in idx[:100]], flag)
+        return status_counts(results.column("status"))[0], failures, quality
     if isinstance(results, pa.Table):
         results = table_to_rows(results)
     cols = grasp_columns(chunk.rows) if isinstance(chunk.rows, pa.Table) else value_columns(chunk_values(chunk))
-    return verify_rows(cols, range(len(chunk)), chunk.lines, results, tol)
+    statuses, failures = verify_rows(cols, range(len(chunk)), chunk.lines, results, tol, quality)
+    return statuses, failures, quality
 
 
 def status_counts(statuses, verified=None) -> tuple[dict[str, int], int]:

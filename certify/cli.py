@@ -19,7 +19,8 @@ from rich.table import Table
 
 from . import models
 from .batch import certify_file, verify_file
-from .bench import print_bench, print_quality_bench, run_bench, run_quality_bench
+from .bench import (print_bench, print_contacts_bench, print_quality_bench, run_bench,
+                    run_contacts_bench, run_quality_bench)
 from .errors import CertifyError
 from .regions import DEFAULT_BUDGET, certify_region_file, verify_region_file
 from .samples import write_random_grasp_file
@@ -36,7 +37,7 @@ METHODS = ("fast", "reference")
 
 def _fail(message: str) -> None:
     """Print a one-line error (no markup interpreted in it) and exit with code 2."""
-    console.print("[red]error:[/red]", escape(message), soft_wrap=True)
+    console.print("[red]error:[/red]", escape(_printable(message)), soft_wrap=True)
     raise typer.Exit(2)
 
 
@@ -47,7 +48,10 @@ def certify_command(
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar or summary."),
     quality: bool = typer.Option(True, help="Compute the epsilon columns (eps_l1_lo ... eps_linf_hi)."),
     eps_gap: float = typer.Option(0.01, help="Spatial epsilon: stop when hi - lo <= gap * hi."),
-    eps_budget: int = typer.Option(200_000, help="Spatial epsilon: most work per grasp and norm, in direction cells examined."),
+    eps_budget: int = typer.Option(200_000, help="Spatial epsilon: most work per grasp and norm, in directions examined."),
+    eps_time: float = typer.Option(10.0, help="Time limit of quality per grasp, in seconds (0: none); when hit, "
+                                              "the row keeps its closure verdict, states the epsilon bounds reached "
+                                              "and eps_limited (results then depend on the machine)."),
     workers: int = typer.Option(0, help="Local worker processes (0: all cores)."),
     dask: str = typer.Option(None, "--dask", help="'local' for a dask LocalCluster, or a scheduler address."),
     resume: bool = typer.Option(False, "--resume", help="Continue an interrupted run, keeping its complete chunks."),
@@ -75,7 +79,8 @@ def certify_command(
         try:
             summary = certify_file(grasps, output, method=method,
                                    progress=lambda n: bar.advance(task, n), quality=quality,
-                                   eps_gap=eps_gap, eps_budget=eps_budget, workers=workers or None,
+                                   eps_gap=eps_gap, eps_budget=eps_budget,
+                                   eps_time=eps_time if eps_time > 0 else None, workers=workers or None,
                                    dask=dask, resume=resume, chunk_size=chunk_size)
         except CertifyError as err:
             _fail(str(err))
@@ -121,7 +126,7 @@ def verify_command(
     except CertifyError as err:
         _fail(str(err))
     for gid, reason in summary.failures:
-        typer.echo(f"{gid}\t{reason}")
+        typer.echo(_printable(f"{gid}\t{reason}"))
     checked = summary.rows - summary.errors
     console.print(f"{checked} certified rows re-checked, {summary.errors} error rows skipped, "
                   f"{len(summary.failures)} failed")
@@ -164,6 +169,9 @@ def certify_regions_command(
         console.print(f"{summary.seconds:.1f} s")
     if summary.errors or summary.unverified:
         raise typer.Exit(1)
+def _printable(text: str) -> str:
+    """``text`` with lone surrogates (from invalid UTF-8 or JSON escapes) escaped, on one line."""
+    return text.encode("utf-8", "backslashreplace").decode("utf-8").replace("\n", "\\n")
 
 
 def bench_command(
@@ -171,6 +179,8 @@ def bench_command(
     seed: int = typer.Option(0, help="Random seed of the grasps."),
     reference_n: int = typer.Option(300, "--reference-n", help="Grasps per kind for slow routes."),
     quality: bool = typer.Option(False, "--quality", help="Benchmark epsilon instead: gaps, times, 8-edge error."),
+    contacts: bool = typer.Option(False, "--contacts", help="Time closure and quality of one grasp per contact count "
+                                                            "(3 to 1000 point contacts, planar and spatial)."),
 ) -> None:
     """Time every certification route on the same random grasps, with ratios to the batch path.
 
@@ -179,11 +189,17 @@ def bench_command(
 
     With --quality: epsilon bound gaps and time per grasp, and the error of the 8-edge cone
     linearisation other toolkits use, on --n random grasps in closure per kind.
+
+    With --contacts: seconds per grasp of closure and of quality (both epsilons with their
+    evidence, no time limit) for one grasp in closure with 3, 10, 50, 200 and 1000 point
+    contacts, planar and spatial (about a minute).
     """
     if n < 1 or reference_n < 0:
         _fail(f"--n must be at least 1 and --reference-n at least 0, got {n} and {reference_n}")
 
-    if quality:
+    if contacts:
+        print_contacts_bench(run_contacts_bench(seed=seed))
+    elif quality:
         print_quality_bench(run_quality_bench(n=n, seed=seed))
     else:
         print_bench(run_bench(n=n, seed=seed, reference_n=reference_n))

@@ -6,8 +6,10 @@ row equal to what :func:`qualgrasp.certify.certify_grasp` gives grasp by grasp. 
 grouped by contact pattern (dimension, contact count, each contact's model and variant):
 
 * planar groups go through :func:`qualgrasp.certify._kernels.planar.planar_batch`: the LP (the
-  same kernel the per-grasp path calls), the certificate, its rigorous re-check in floating point
-  with error bounds, and the exact planar epsilon;
+  same kernel the per-grasp path calls), the certificate and its rigorous re-check in floating
+  point with error bounds; with quality, the exact planar epsilon and its evidence of every
+  closure row by :func:`qualgrasp.certify.quality.planar_epsilons`, the per-grasp path's own
+  function;
 * spatial groups through the compiled dual barrier method over exact cones, with clear verdicts
   proved columnar, and near-boundary rows decided by the per-grasp rules on the arrays already
   built (the squeeze rule, then clarabel); form closure with six or more contacts by the fast
@@ -20,6 +22,7 @@ the per-grasp path, so the two agree by construction.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,7 +30,7 @@ import pyarrow as pa
 
 from ._kernels.barrier import barrier_batch
 from ._kernels.linalg import projection_bound, world_values
-from ._kernels.planar import planar_batch
+from ._kernels.planar import planar_batch, planar_generators
 from ._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
 from .certificates import Tolerances, verify
 from .closure import decide, farkas_from_arrays
@@ -35,6 +38,7 @@ from .columns import GraspColumns, extra_columns, grasp_columns
 from .cones import LORENTZ, cone_code
 from .grasp import Contact, Grasp
 from .problem import Block, ClosureProblem, System, conic_columns, grasp_problem, grasp_system
+from .quality import planar_epsilons
 from .results import CERTIFICATE, RESULT_SCHEMA, carried_name, result_table
 from .solvers import BARRIER_NEAR_ZERO, FastSolver, make_solver
 from .solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
@@ -214,14 +218,39 @@ def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances
         # the per-grasp fast route solves these by the barrier method: both routes give its rows
         return np.zeros(len(rows), dtype=bool), {}
     P, N, params = cols.contacts(rows)
-    (code, t, lam, basis, y, code_f, t_f, lam_f, basis_f, y_f, eps) = _planar_kernel(
-        P[:, :, :2], N[:, :, :2], params["mu"], params["width"], cols.center[rows, :2], cols.length[rows],
-        models, variants, tol, options.quality)
+    P, N, mu, width = P[:, :, :2], N[:, :, :2], params["mu"], params["width"]
+    c, L = cols.center[rows, :2], cols.length[rows]
+    (code, t, lam, basis, y, code_f, t_f, lam_f, basis_f, y_f, _) = _planar_kernel(
+        P, N, mu, width, c, L, models, variants, tol, False)
     settled = (code > 0) & (code_f > 0)
     out = {"force": (code, t, lam, basis, y), "form": (code_f, t_f, lam_f, basis_f, y_f)}
     if options.quality:
-        out["L1"], out["Linf"] = eps[:, 0], eps[:, 1]
+        out["eps"] = _planar_quality(cols, rows, (code == 1) & settled, P, N, mu, width, c, L, models,
+                                     variants, options)
     return settled, out
+
+
+def _planar_quality(cols, rows, closure, P, N, mu, width, c, L, models, variants, options):
+    """Epsilon columns of a planar group: :func:`qualgrasp.certify.quality.planar_epsilons`
+    (the per-grasp path's function, on the same generator floats) for every closure row; 0 and
+    no evidence elsewhere. Returns ``(l1_lo, l1_hi, linf_lo, linf_hi, limited, evidence)``."""
+    B, m = mu.shape
+    owner, offset, friction = generator_layout(models, variants, 2)
+    W = np.empty((3, len(owner)))
+    E = np.empty((3, len(owner)))
+    vals = np.zeros((B, 4))
+    limited = np.zeros(B, dtype=bool)
+    evidence = np.full(B, None, dtype=object)
+    for i in np.flatnonzero(closure):
+        planar_generators(P[i], N[i], mu[i], width[i], c[i], L[i], owner, offset, friction, W, E)
+        deadline = None if options.eps_time is None else time.perf_counter() + options.eps_time
+        exact = lambda i=i: grasp_system(cols.grasps([rows[i]])[0], exact=True).columns  # noqa: E731
+        eps = planar_epsilons(W, E, owner, m, deadline=deadline, exact=exact)
+        (a, b, _, ev1, lim1), (p, q, _, ev2, lim2) = eps["L1"], eps["Linf"]
+        vals[i] = a, b, p, q
+        limited[i] = lim1 or lim2
+        evidence[i] = {"l1": ev1.to_json(), "linf": ev2.to_json()}
+    return vals[:, 0], vals[:, 1], vals[:, 2], vals[:, 3], limited, evidence
 
 
 def _ray_blocks(m: int):
@@ -493,10 +522,15 @@ def _group_table(cols: GraspColumns, rows: np.ndarray, lines: np.ndarray, out, o
          _certificates(fcode, flam, fbasis, fyn, tight=out.get("form_tight"))],
         fields=list(RESULT_SCHEMA.field("certificate").type))
     eps = {}
-    for norm, key in (("L1", "l1"), ("Linf", "linf")):
-        values = out.get(norm) if options.quality else None
-        arr = pa.array(values) if values is not None else pa.nulls(n, pa.float64())
-        eps[f"eps_{key}_lo"] = eps[f"eps_{key}_hi"] = arr
+    if options.quality:  # spatial groups settle rows not in closure only: 0 there
+        l1_lo, l1_hi, linf_lo, linf_hi, limited, evidence = out.get("eps") or (
+            np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n, dtype=bool),
+            np.full(n, None, dtype=object))
+        for key, values in (("eps_l1_lo", l1_lo), ("eps_l1_hi", l1_hi), ("eps_linf_lo", linf_lo),
+                            ("eps_linf_hi", linf_hi)):
+            eps[key] = pa.array(values, type=pa.float64())
+        eps["eps_limited"] = pa.array(limited, type=pa.bool_())
+        eps["eps_evidence"] = pa.array(list(evidence), type=RESULT_SCHEMA.field("eps_evidence").type)
     return result_table({
         "id": cols.id_column(rows),
         "line": pa.array(lines, type=pa.int64()),

@@ -1,4 +1,4 @@
-"""Grasp quality: Ferrari-Canny epsilon of the L1 and L-infinity grasp wrench spaces.
+"""Grasp quality: Ferrari-Canny epsilon of the L1 and L-infinity grasp wrench spaces, with evidence.
 
 The grasp wrench space (GWS) is built from each contact's wrenches with unit normal force,
 ``W_i = {G_i f : f in cone_i, f_n = 1}``. The L1 GWS is ``conv(0 and all W_i)`` (total normal
@@ -15,20 +15,46 @@ Torque scaling is explicit: wrenches are ``(f, (p - center) x f / length)``, so 
 ``center`` and ``length`` together leaves epsilon unchanged; dividing ``length`` by ``s`` multiplies
 the torque coordinates by ``s``. The min-weight margin of :mod:`qualgrasp.certify.closure` depends on neither.
 
-Planar grasps: every contact model is polyhedral in the plane, so epsilon is exact: the minimum
-of ``h`` over a finite set of directions that contains every facet normal of the GWS (normals of
-triples of generator points for L1; cross products of pairs of edges of the per-contact polytopes
-``conv(0, generators of the contact)`` for L-infinity, since every facet of a Minkowski sum in 3-D
-is a facet of a summand or spanned by two summands' edges).
+Every :class:`Epsilon` states rigorous bounds ``lo <= epsilon <= hi`` and carries
+:class:`~qualgrasp.certify.evidence.Evidence` that :mod:`qualgrasp.certify.evidence` re-checks
+without a solver: a direction ``u`` with ``h(u) = hi`` and an inscribed polytope (a closed
+triangulated surface on points of the GWS) whose faces are all at distance ``lo`` or more.
 
-Spatial grasps with exact cones: rigorous bounds ``lo <= epsilon <= hi`` by branch and bound over
-the sphere of wrench directions. ``h(u)`` at any unit ``u`` is an upper bound; the best one is
-refined by local minimisation (a tangent-plane SOCP). The sphere is covered by cells (the faces of
-the cube ``[-1, 1]^d`` cut into boxes, projected radially); each cell gets a lower bound of ``h``
-over it from global linear minorants of the contacts' pieces (and, for L1, the exact minimum over
-the flat cell, an SOCP solved by clarabel whose dual is turned into a minorant valid whatever the
-solver's accuracy). Cells whose bound reaches ``(1 - rel_gap) hi`` are retired, the others split,
-until ``hi - lo <= rel_gap * hi`` or the budget of cells is spent.
+Planar grasps: every contact model is polyhedral in the plane, so epsilon is exact, the minimum of
+``h`` over a finite set of directions holding every facet normal of the GWS (``k`` generators,
+``m`` contacts):
+
+* L1: the grasp is in closure, so the origin is interior and the facets of the GWS are those of
+  the hull of the generators: the compiled enumeration of triples for ``k <= L1_ENUMERATION_MAX``,
+  else qhull's hull (``O(k log k)``). The hull's triangles are the lower-bound evidence, so
+  ``lo = hi``.
+* L-infinity: every facet normal of a Minkowski sum in 3-D is normal to two edges of the summands:
+  the compiled enumeration of pairs of edges for ``k <= LINF_ENUMERATION_MAX`` (``O(k^3)``), else
+  a sweep around the great circle orthogonal to each edge (``O(k^2 log k)``,
+  :func:`qualgrasp.certify._kernels.epsilon.linf_sweep`). The evidence for ``lo`` is the hull of
+  all sums of one vertex per summand when there are at most ``SUMS_MAX`` of them (then
+  ``lo = hi``); beyond that the hull of support points of the GWS (each the sum of every contact's
+  generator furthest along a direction), refined along the normals of its faces nearest the
+  origin until it proves ``hi`` (each cut adds a vertex of the GWS beyond the face, so this
+  ends), stored as its directions. If that does not succeed within ``4 MAX_VERTICES`` vertices
+  or the time limit, the L1 GWS, which lies inside the L-infinity one, proves the L1 epsilon
+  (``lo < hi``, honestly reported).
+
+Spatial grasps with exact cones: an inner and an outer approximation refined together. ``hi`` is
+the least ``h(u)`` found over directions ``u`` (the best of a fixed set of starting directions,
+refined by local minimisation, a tangent-plane SOCP solved by clarabel, and the normals of the
+polytope below). ``lo`` is the epsilon of an inscribed polytope: the hull of support points of
+the GWS (the contact wrenches maximising ``u . w``, pulled inside their cones and proved inside
+exactly, scaled by at most ``2^-14`` towards the origin to put them in general position), starting from the 12 coordinate directions, then adding the support points along the
+normals of its weakest faces, which pushes those faces out, until ``hi - lo <= rel_gap * hi``,
+the polytope has ``MAX_VERTICES`` vertices or the work ``budget`` is spent. Each round costs
+``O(m)`` per direction examined plus a hull of at most ``MAX_VERTICES`` points, whatever ``m``.
+
+A per-grasp time limit (``time_limit``, seconds) stops the L-infinity sweep and the spatial
+refinement early: the row keeps its closure verdict and reports the bounds reached (planar
+L-infinity: ``hi`` the best support value found, ``lo`` the L1 epsilon; spatial: the polytope's
+``lo`` and the best ``hi``), with ``limited`` set. Results then depend on the machine's speed;
+without the limit being hit they are deterministic.
 
 Epsilon is 0 for grasps not in closure (and for degenerate ones): the closure verdict is decided
 first, so flat hulls and rank-deficient sets never reach qhull.
@@ -36,6 +62,8 @@ first, so flat hulls and rank-deficient sets never reach qhull.
 
 from __future__ import annotations
 
+import math
+import time
 from dataclasses import dataclass
 
 import clarabel
@@ -43,15 +71,39 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import ConvexHull, QhullError
 
-from ._kernels.epsilon import planar_epsilon as kernel_planar_epsilon
+from ._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .closure import Verdict, force_closure
+from .evidence import (EPS_TOL, ConicSupport, Evidence, planar_generator_arrays,
+                       planar_support_vertices, stated_lo, sum_errors, surface_faces,
+                       surface_minimum)
 from .grasp import Grasp
 from .problem import System, grasp_system
 from .solvers.clarabel_direct import settings
 
-__all__ = ["NORMS", "Epsilon", "epsilon", "planar_epsilon", "epsilon_of_points", "epsilon_linearised"]
+__all__ = ["NORMS", "Epsilon", "epsilon", "epsilons", "planar_epsilon", "planar_epsilons",
+           "epsilon_of_points", "epsilon_linearised", "L1_ENUMERATION_MAX", "LINF_ENUMERATION_MAX",
+           "SUMS_MAX", "MAX_VERTICES", "SOCP_COST"]
 
 NORMS = ("L1", "Linf")
+
+#: Planar L1 with at most this many generators: compiled enumeration of triples (else the hull).
+L1_ENUMERATION_MAX = 16
+#: Planar L-infinity with at most this many generators: compiled enumeration of edge pairs
+#: (else the sweep).
+LINF_ENUMERATION_MAX = 24
+#: Planar L-infinity: the surface of all sums is the lower-bound evidence when there are at
+#: most this many sums (the product over contacts of generators + 1), else the L1 surface.
+SUMS_MAX = 4096
+#: Spatial: most vertices of the inscribed polytope (bounds its hull and its evidence).
+MAX_VERTICES = 160
+#: Work of one local minimisation step (an SOCP) in units of directions examined, for the budget.
+SOCP_COST = 25
+#: Candidate directions kept by the L-infinity sweep for the direct evaluation of ``h``.
+_TOP = 16
+#: Circles swept between two looks at the clock.
+_SWEEP_BATCH = 64
+#: Weakest faces whose normals are added per round of the spatial refinement.
+_ADD = 2
 
 
 @dataclass(frozen=True)
@@ -62,17 +114,24 @@ class Epsilon:
     ----------
     norm : {'L1', 'Linf'}
     lo, hi : float
-        Rigorous bounds ``lo <= epsilon <= hi`` (equal for planar grasps, 0 when not in closure).
+        Rigorous bounds ``lo <= epsilon <= hi`` (0 when not in closure), in the unit of the
+        wrenches (force, with torques divided by ``length``).
     direction : tuple of float or None
-        Unit wrench direction where ``h`` attains ``hi``: the weakest direction of the grasp.
+        Unit wrench direction where ``h`` attains ``hi``: the weakest direction found.
     center : tuple of float
         Reference point of torques used.
     length : float
         Length dividing torques used.
     exact : bool
-        True when ``lo == hi`` by construction (planar grasps, grasps not in closure).
+        True when ``lo == hi`` (planar grasps whose surface evidence is complete, grasps not in
+        closure).
     rounds : int
-        Branch-and-bound rounds spent (spatial grasps).
+        Refinement rounds spent (spatial grasps).
+    limited : bool
+        The time limit stopped the computation (the bounds are those reached).
+    evidence : Evidence or None
+        What proves ``lo`` and ``hi`` (:mod:`qualgrasp.certify.evidence`); None when not in
+        closure.
     """
 
     norm: str
@@ -83,6 +142,8 @@ class Epsilon:
     length: float
     exact: bool
     rounds: int = 0
+    limited: bool = False
+    evidence: Evidence | None = None
 
     @property
     def gap(self) -> float:
@@ -95,22 +156,268 @@ def _check_norm(norm: str) -> None:
         raise ValueError(f"unknown norm {norm!r}; use 'L1' or 'Linf'")
 
 
-def planar_epsilon(grasp: Grasp, norm: str) -> tuple[float, np.ndarray]:
-    """Exact planar epsilon and its direction (the compiled kernel that also serves whole
-    batches), over the grasp's generator wrenches (:func:`qualgrasp.certify.problem.grasp_system`)."""
-    system = grasp_system(grasp)
-    owner = np.array([b.contact for b in system.blocks], dtype=np.int64)
-    eps, arg = kernel_planar_epsilon(np.ascontiguousarray(system.columns[None]), owner,
-                                     len(grasp.contacts), norm == "Linf")
-    return float(eps[0]), arg[0]
-
-
 def _zero(grasp: Grasp, norm: str) -> Epsilon:
     return Epsilon(norm, 0.0, 0.0, None, tuple(grasp.center), grasp.length, True)
 
 
+def _expired(deadline: float | None) -> bool:
+    return deadline is not None and time.perf_counter() > deadline
+
+
+# --- planar ---------------------------------------------------------------------------------------
+
+class _NoExact(Exception):
+    """The exact data needed to settle a face is not available."""
+
+
+def _prove(V: np.ndarray, EV: np.ndarray, faces, exact_vertex):
+    """Bounds ``(lo, hi)`` of the smallest squared face distance of a surface proving a ball
+    (:func:`qualgrasp.certify.evidence.surface_minimum`, the checker's own rule), or None when
+    it proves nothing."""
+    if faces is None or len(faces) == 0:
+        return None
+    try:
+        reason, lo, hi = surface_minimum(V, EV, faces, exact_vertex)
+    except _NoExact:
+        return None
+    return None if reason or lo <= 0 else (lo, hi)
+
+
+def _no_exact(i):
+    raise _NoExact
+
+
+def _lower(eps: float, bounds) -> float | None:
+    """The ``lo`` to state from proved bounds of the squared surface distance: ``eps`` itself
+    when the surface proves it to well within the evidence tolerance, else the surface's own
+    value (None: nothing proved)."""
+    if bounds is None:
+        return None
+    d2_lo, d2_hi = bounds
+    x = eps * eps
+    if d2_lo >= x * (1 - EPS_TOL / 4) and d2_hi <= x * (1 + EPS_TOL / 4):
+        return eps
+    return min(stated_lo(d2_lo, d2_hi), eps)
+
+
+def _hull_minimum(W, owner, m, faces):
+    """Planar L1 epsilon from the hull's triangles: the support function, evaluated directly,
+    at the normals (computed as the enumeration computes them) of the faces nearest the origin."""
+    tri = np.sort(faces, axis=1)
+    A, B, C = W.T[tri[:, 0]], W.T[tri[:, 1]], W.T[tri[:, 2]]
+    n = np.cross(B - A, C - A)
+    norm = np.linalg.norm(n, axis=1)
+    good = norm > 0
+    n = n[good] / norm[good, None]
+    off = np.einsum("fd,fd->f", n, A[good])
+    n[off < 0] *= -1
+    near = np.argsort(np.abs(off), kind="stable")[:_TOP]
+    U = np.ascontiguousarray(n[near])
+    h = support_rows(W, owner, m, U, False)
+    j = int(np.argmin(h))
+    return float(h[j]), U[j]
+
+
+def _sums(W, E, owner, m):
+    """Every sum of one point per contact polytope (the origin or a generator): the points
+    (n, 3), their error bounds and the generator chosen per contact (n, m; -1 for the origin);
+    None when there are more than :data:`SUMS_MAX`."""
+    groups = [np.flatnonzero(owner == i) for i in range(m)]
+    if math.prod(len(g) + 1 for g in groups) > SUMS_MAX:
+        return None
+    pts = np.zeros((1, 3))
+    err = np.zeros((1, 3))
+    mag = np.zeros((1, 3))
+    choice = np.zeros((1, 0), dtype=np.int64)
+    for g in groups:
+        opt = np.vstack([np.zeros(3), W.T[g]])
+        oerr = np.vstack([np.zeros(3), E.T[g]])
+        ids = np.r_[-1, g]
+        n = len(opt)
+        pts = (pts[:, None, :] + opt[None]).reshape(-1, 3)
+        err = (err[:, None, :] + oerr[None]).reshape(-1, 3)
+        mag = (mag[:, None, :] + np.abs(opt)[None]).reshape(-1, 3)
+        choice = np.hstack([np.repeat(choice, n, axis=0), np.tile(ids, len(choice))[:, None]])
+    return pts, sum_errors(err, mag, m), choice
+
+
+def planar_epsilons(W, E, owner, m: int, *, deadline: float | None = None, exact=None) -> dict:
+    """Planar epsilon of both norms with evidence (module docstring), for a grasp in closure.
+
+    Parameters
+    ----------
+    W, E : ndarray, shape (3, k)
+        Generator wrenches and bounds on their distance to the exact ones
+        (:func:`planar_generator_arrays`).
+    owner : ndarray of int, shape (k,)
+        Contact of each generator (sorted).
+    m : int
+        Number of contacts.
+    deadline : float, optional
+        :func:`time.perf_counter` value after which the L-infinity sweep stops.
+    exact : callable, optional
+        ``exact()`` returns the exact generators (3, k) (Fractions), asked for only when the
+        rigorous float checks of a surface cannot decide a face; without it such a surface
+        proves nothing.
+
+    Returns
+    -------
+    dict
+        ``{"L1": (lo, hi, direction, evidence, limited), "Linf": (...)}``.
+    """
+    W = np.ascontiguousarray(W, dtype=float)
+    E = np.ascontiguousarray(E, dtype=float)
+    owner = np.ascontiguousarray(owner, dtype=np.int64)
+    k = W.shape[1]
+    out = {}
+    # L1: the hull of the generators
+    faces = surface_faces(W.T)
+    if k <= L1_ENUMERATION_MAX or faces is None:
+        eps, u = planar_epsilon_one(W, owner, m, False)
+        eps = float(eps)
+    else:
+        eps, u = _hull_minimum(W, owner, m, faces)
+    cache = []
+
+    def gens():
+        if exact is None:
+            raise _NoExact
+        if not cache:
+            cache.append(exact())
+        return cache[0]
+
+    lo = _lower(eps, _prove(W.T, E.T, faces, lambda i: list(gens()[:, i])))
+    direction = tuple(float(v) for v in u)
+    if lo is None:
+        out["L1"] = (0.0, eps, direction, Evidence("none", direction), False)
+    else:
+        out["L1"] = (lo, eps, direction, Evidence("generators", direction, faces=tuple(int(i) for i in faces.ravel())), False)
+    l1_lo = out["L1"][0]
+    # L-infinity
+    limited = False
+    if k <= LINF_ENUMERATION_MAX:
+        eps, u = planar_epsilon_one(W, owner, m, True)
+        eps = float(eps)
+    else:
+        eps, u, limited = _sweep(W, owner, m, deadline)
+    direction = tuple(float(v) for v in u)
+    ev = None
+    if not limited:
+        sums = _sums(W, E, owner, m)
+        if sums is not None:
+            pts, err, choice = sums
+            faces = surface_faces(pts)
+            if faces is not None:
+                used = np.unique(faces)
+                remap = np.full(len(pts), -1, dtype=np.int64)
+                remap[used] = np.arange(len(used))
+                faces = remap[faces]
+                picks = choice[used]
+
+                def vertex(i, picks=picks):
+                    C = gens()
+                    return [sum((C[r, j] for j in picks[i] if j >= 0), 0) for r in range(3)]
+
+                lo = _lower(eps, _prove(pts[used], err[used], faces, vertex))
+                if lo is not None and lo >= l1_lo:
+                    ev = Evidence("sums", direction, ref=tuple(int(i) for i in choice[used].ravel()),
+                                  faces=tuple(int(i) for i in faces.ravel()))
+        else:
+            found = _planar_support(W, E, owner, m, eps, np.asarray(u, dtype=float), deadline, gens)
+            if found is not None and found[0] >= l1_lo:
+                lo, dirs = found
+                ev = Evidence("support", direction, points=tuple(float(x) for x in dirs.ravel()))
+    if ev is None:
+        lo = min(l1_lo, eps)
+        ev = Evidence("l1", direction)
+    out["Linf"] = (lo, eps, direction, ev, limited)
+    return out
+
+
+def _planar_support(W, E, owner, m, eps, u, deadline, gens):
+    """Planar L-infinity lower bound by ``support`` evidence: the hull of support points along
+    the coordinate directions and ``u``, refined along the normals of its faces nearest the
+    origin (each cut adds a vertex of the GWS beyond the face) until the surface proves ``eps``
+    or :data:`MAX_VERTICES` is reached. Returns ``(lo, directions)`` or None."""
+    dirs = [np.array(v, dtype=float) for v in np.vstack([np.eye(3), -np.eye(3), u[None]])]
+    seen = set()
+
+    def fresh(rows):
+        out = []
+        for v, r in zip(rows, planar_support_vertices(W, E, owner, m, np.array(rows))[2]):
+            key = tuple(r)
+            if key not in seen:
+                seen.add(key)
+                out.append(v)
+        return out
+
+    dirs = fresh(dirs)
+    hull, done = None, 0
+    while True:
+        pts = planar_support_vertices(W, E, owner, m, np.array(dirs))[0]
+        try:
+            if hull is None:
+                hull = ConvexHull(pts, incremental=True)
+            else:
+                hull.add_points(pts[done:])
+            done = len(dirs)
+        except (QhullError, ValueError):
+            return None
+        dist = -hull.equations[:, -1]
+        if dist.min() >= eps * (1 - EPS_TOL / 16) or len(dirs) >= 4 * MAX_VERTICES or _expired(deadline):
+            break
+        new = fresh(list(hull.equations[np.argsort(dist, kind="stable")[:2 * _ADD], :-1]))
+        if not new:
+            break
+        dirs += new
+    hull.close()
+    dirs = np.array(dirs)
+    V, EV, R = planar_support_vertices(W, E, owner, m, dirs)
+
+    def vertex(i):
+        C = gens()
+        return [sum((C[r, j] for j in R[i] if j >= 0), 0) for r in range(3)]
+
+    lo = _lower(eps, _prove(V, EV, surface_faces(V), vertex))
+    return None if lo is None else (lo, dirs)
+
+
+def _sweep(W, owner, m, deadline):
+    """Planar L-infinity epsilon by :func:`~qualgrasp.certify._kernels.epsilon.linf_sweep`, a
+    batch of circles at a time; ``(value, direction, limited)``."""
+    E = planar_edges(W, owner)
+    top_val = np.full(_TOP, np.inf)
+    top_u = np.zeros((_TOP, 3))
+    n, a, limited = len(E), 0, False
+    while a < n:
+        b = min(n, a + _SWEEP_BATCH)
+        linf_sweep(W, owner, m, E, a, b, top_val, top_u)
+        a = b
+        if a < n and _expired(deadline):
+            limited = True
+            break
+    U = top_u[np.isfinite(top_val)]
+    if not len(U):  # stopped before any candidate: the coordinate directions bound it
+        U = np.vstack([np.eye(3), -np.eye(3)])
+    h = support_rows(W, owner, m, np.ascontiguousarray(U), True)
+    j = int(np.argmin(h))
+    return float(h[j]), U[j], limited
+
+
+def planar_epsilon(grasp: Grasp, norm: str) -> tuple[float, np.ndarray]:
+    """Exact planar epsilon and its direction, for a grasp in force closure (the value
+    :func:`epsilon` reports as ``hi``)."""
+    _check_norm(norm)
+    W, E, owner = planar_generator_arrays(grasp)
+    lo, hi, u, ev, limited = planar_epsilons(W, E, owner, len(grasp.contacts),
+                                             exact=lambda: grasp_system(grasp, exact=True).columns)[norm]
+    return hi, np.array(u)
+
+
+# --- entry points --------------------------------------------------------------------------------
+
 def epsilon(grasp: Grasp, norm: str = "L1", *, rel_gap: float = 0.01, budget: int = 200_000,
-            verdict: Verdict | None = None) -> Epsilon:
+            time_limit: float | None = None, verdict: Verdict | None = None) -> Epsilon:
     """Ferrari-Canny epsilon of ``grasp`` for the ``norm`` GWS (module docstring).
 
     Parameters
@@ -120,16 +427,19 @@ def epsilon(grasp: Grasp, norm: str = "L1", *, rel_gap: float = 0.01, budget: in
     rel_gap : float
         Spatial grasps: stop when ``hi - lo <= rel_gap * hi``.
     budget : int
-        Spatial grasps: the most work spent, in cells of the sphere of directions examined (an
-        exact cell bound, an SOCP, counts as :data:`EXACT_CELL_COST` cells); the gap reached is
-        reported. A count, not a time, so that results are reproducible on any machine.
+        Spatial grasps: the most work spent, in directions examined (a local minimisation step,
+        an SOCP, counts as :data:`SOCP_COST`); the gap reached is reported. A count, not a
+        time, so that results are reproducible on any machine.
+    time_limit : float, optional
+        Seconds after which the computation stops with the bounds reached (``limited``).
     verdict : Verdict, optional
         The grasp's force-closure verdict, if already known.
 
     Returns
     -------
     Epsilon
-        Bounds with the ``center`` and ``length`` used; 0 unless the grasp is in force closure.
+        Bounds with the ``center`` and ``length`` used and their evidence; 0 unless the grasp is
+        in force closure.
 
     Raises
     ------
@@ -144,27 +454,58 @@ def epsilon(grasp: Grasp, norm: str = "L1", *, rel_gap: float = 0.01, budget: in
     >>> from qualgrasp.certify.quality import epsilon
     >>> g = Grasp((Contact((1, 0), (-1, 0), "point", 0.5), Contact((-1, 0), (1, 0), "point", 0.5)))
     >>> e = epsilon(g, "L1")
-    >>> round(e.lo, 6), e.exact, e.center, e.length
-    (0.333333, True, (0.0, 0.0), 1.0)
+    >>> round(e.lo, 6), e.exact, e.center, e.length, e.evidence.kind
+    (0.333333, True, (0.0, 0.0), 1.0, 'generators')
     """
     _check_norm(norm)
+    norms = ("L1",) if norm == "L1" else ("L1", "Linf")
+    return epsilons(grasp, norms, rel_gap=rel_gap, budget=budget, time_limit=time_limit,
+                    verdict=verdict)[norm]
+
+
+def epsilons(grasp: Grasp, norms=NORMS, *, rel_gap: float = 0.01, budget: int = 200_000,
+             time_limit: float | None = None, verdict: Verdict | None = None) -> dict[str, Epsilon]:
+    """Epsilon of ``grasp`` for each of ``norms`` (:func:`epsilon`), sharing the work: the
+    planar generators, and the L1 bounds that serve as the L-infinity lower bound. The
+    ``time_limit`` (seconds) is for all norms together.
+
+    Returns
+    -------
+    dict
+        ``{norm: Epsilon}``.
+    """
+    for norm in norms:
+        _check_norm(norm)
+    deadline = None if time_limit is None else time.perf_counter() + time_limit
     verdict = verdict or force_closure(grasp)
     if verdict.status != "closure":
-        return _zero(grasp, norm)
+        return {norm: _zero(grasp, norm) for norm in norms}
+    center, length = tuple(grasp.center), grasp.length
+    out = {}
     if grasp.dim == 2:
-        eps, u = planar_epsilon(grasp, norm)
-        return Epsilon(norm, eps, eps, tuple(float(v) for v in u), tuple(grasp.center),
-                       grasp.length, True)
-    return _refine(grasp, grasp_system(grasp, socp=True), norm, rel_gap, budget)
+        W, E, owner = planar_generator_arrays(grasp)
+        exact = lambda: grasp_system(grasp, exact=True).columns  # noqa: E731
+        for norm, (lo, hi, u, ev, limited) in planar_epsilons(W, E, owner, len(grasp.contacts),
+                                                             deadline=deadline, exact=exact).items():
+            if norm in norms:
+                out[norm] = Epsilon(norm, lo, hi, u, center, length, lo == hi, 0, limited, ev)
+        return out
+    sup = ConicSupport(grasp)
+    pieces = _Pieces(grasp_system(grasp, socp=True))
+    l1 = None
+    for norm in ("L1", "Linf"):
+        if norm == "L1" or "Linf" in norms:
+            out[norm] = _spatial(grasp, sup, pieces, norm, rel_gap, budget, deadline, l1)
+            l1 = out["L1"]
+    return {norm: out[norm] for norm in norms}
 
+
+# --- spatial --------------------------------------------------------------------------------------
 
 class _Pieces:
-    """Each contact's support ``c_b(v) = p_b . v + kappa_b norm(T_b v)`` as stacked arrays.
-
-    ``h_L1 = max_b max(0, c_b)`` and ``h_Linf = sum_b max(0, c_b)``. Because
-    ``norm(x) >= s . x`` for every ``norm(s) <= 1``, ``g_b = p_b + kappa_b T_b' s`` with
-    ``s = T_b v0 / norm(T_b v0)`` is a global linear minorant of ``c_b``, exact along ``v0``.
-    """
+    """Each contact's support ``c_b(v) = p_b . v + kappa_b norm(T_b v)`` as stacked arrays, so
+    that ``h_L1 = max_b max(0, c_b)`` and ``h_Linf = sum_b max(0, c_b)`` cost ``O(m)`` per
+    direction."""
 
     def __init__(self, system: System) -> None:
         C = system.columns
@@ -192,241 +533,62 @@ class _Pieces:
         self.T = np.zeros((len(rows), r, d))
         for i, t in enumerate(rows):
             self.T[i, : len(t)] = t
-
-    def at(self, V: np.ndarray):
-        """Values ``c`` (n, nb) and minorant gradients ``g`` (n, nb, d) at directions ``V``."""
-        Tv = np.einsum("brd,nd->nbr", self.T, V)
-        norm = np.linalg.norm(Tv, axis=2)
-        c = V @ self.p.T + self.kappa * norm
-        s = np.divide(Tv, norm[..., None], out=np.zeros_like(Tv), where=norm[..., None] > 0)
-        g = self.p + self.kappa[:, None] * np.einsum("nbr,brd->nbd", s, self.T)
-        return c, g
+        self.rank = [int(np.count_nonzero(np.abs(t).sum(axis=1))) for t in self.T]
 
     def h(self, V: np.ndarray, norm: str) -> np.ndarray:
-        c = np.maximum(self.at(V)[0], 0.0)
+        """Support function at the rows of ``V`` (n, d)."""
+        Tv = np.einsum("brd,nd->nbr", self.T, V)
+        c = np.maximum(V @ self.p.T + self.kappa * np.linalg.norm(Tv, axis=2), 0.0)
         return c.max(axis=1) if norm == "L1" else c.sum(axis=1)
 
-    def cell_bound(self, V: np.ndarray, centre: np.ndarray, norm: str, rounds: int = 24) -> np.ndarray:
-        """Lower bound of ``h`` over each flat cell ``conv(V[i])`` (V: (n, m, d)).
-
-        Each piece is linearised at the cell's centre: ``g_b`` is a global linear minorant of
-        piece ``b``. For L1 any convex combination of them is a minorant of ``h``; for
-        L-infinity any weights in [0, 1]. The minimum of a linear minorant over a cell is at a
-        vertex. The weights are improved by a few rounds of multiplicative (L1) or projected
-        (L-infinity) updates against the worst vertex: every round's value is a valid bound, and
-        the best is kept.
-        """
-        c, g = self.at(centre)
-        M = np.einsum("nbd,nmd->nbm", g, V)  # minorant of piece b at vertex j
-        n = len(M)
-        rows = np.arange(n)
-        if norm == "L1":
-            w = np.where(c >= c.max(axis=1, keepdims=True) - 1e-12, 1.0, 0.0)
-            w /= w.sum(axis=1, keepdims=True)
-        else:
-            w = (c > 0).astype(float)
-        scale = np.abs(M).max(axis=(1, 2))[:, None] + 1e-300
-        best = np.zeros(n)
-        for k in range(rounds):
-            vals = np.einsum("nb,nbm->nm", w, M)
-            j = np.argmin(vals, axis=1)
-            best = np.maximum(best, vals[rows, j])
-            grad = M[rows, :, j] / scale
-            step = 2.0 / np.sqrt(k + 1)
-            if norm == "L1":
-                w = w * np.exp(step * grad)
-                w /= w.sum(axis=1, keepdims=True)
-            else:
-                w = np.clip(w + 0.5 * step * grad, 0.0, 1.0)
-        return best
-
-    def tangent_minimum(self, u0: np.ndarray, norm: str):
-        """Minimise ``h`` over the tangent plane ``u . u0 = 1`` (an SOCP, solved by clarabel).
-
-        Returns the unit minimiser direction and the gradient of the minorant given by the
-        multipliers: ``sum_b w_b (p_b + kappa_b T_b' s_b)`` with ``w_b`` the multiplier of piece
-        ``b`` and ``s_b = -z_rest / w_b`` its dual subgradient (norm at most 1, meaningful even
-        at a cone's apex where ``T_b u = 0``). At a minimiser of ``h`` on the sphere the
-        tangent-plane problem has the same solution, so iterating from ``u / norm(u)`` converges
-        to it, and this minorant is then tight to second order around it.
-        """
-
+    def tangent_minimum(self, u0: np.ndarray, norm: str) -> np.ndarray | None:
+        """Minimise ``h`` over the tangent plane ``u . u0 = 1`` (an SOCP, solved by clarabel;
+        built sparse, so its size is linear in the number of contacts); the unit minimiser, or
+        None when clarabel fails. At a minimiser of ``h`` on the sphere the tangent-plane
+        problem has the same solution, so iterating from ``u / norm(u)`` converges to it."""
         nb, r, d = self.T.shape
         nt = 1 if norm == "L1" else nb
         n = d + nt
-        rows = [np.r_[u0, np.zeros(nt)]]
-        cones = [clarabel.ZeroConeT(1)]
-        b = [1.0]
-        rows += list(np.hstack([np.zeros((nt, d)), -np.eye(nt)]))
-        cones.append(clarabel.NonnegativeConeT(nt))
-        b += [0.0] * nt
+        ri, ci, vals = [np.zeros(d, int)], [np.arange(d)], [u0]
+        ri.append(1 + np.arange(nt)), ci.append(d + np.arange(nt)), vals.append(-np.ones(nt))
+        cones = [clarabel.ZeroConeT(1), clarabel.NonnegativeConeT(nt)]
+        row = 1 + nt
         for i in range(nb):
-            tcol = np.zeros(nt)
-            tcol[0 if norm == "L1" else i] = -1.0
-            rows.append(np.r_[self.p[i], tcol])
-            rk = int(np.count_nonzero(np.abs(self.T[i]).sum(axis=1)))
-            rows += list(np.hstack([-self.kappa[i] * self.T[i, :rk], np.zeros((rk, nt))]))
+            rk = self.rank[i]
+            ri.append(np.full(d, row)), ci.append(np.arange(d)), vals.append(self.p[i])
+            ri.append(np.array([row])), ci.append(np.array([d + (0 if norm == "L1" else i)]))
+            vals.append(np.array([-1.0]))
+            if rk:
+                ri.append(np.repeat(row + 1 + np.arange(rk), d)), ci.append(np.tile(np.arange(d), rk))
+                vals.append((-self.kappa[i] * self.T[i, :rk]).ravel())
             cones.append(clarabel.SecondOrderConeT(1 + rk) if rk else clarabel.NonnegativeConeT(1))
-            b += [0.0] * (1 + rk)
-        A = sp.csc_matrix(np.array(rows))
+            row += 1 + rk
+        A = sp.csc_matrix((np.concatenate(vals), (np.concatenate(ri), np.concatenate(ci))), shape=(row, n))
+        b = np.zeros(row)
+        b[0] = 1.0
         q = np.r_[np.zeros(d), np.ones(nt)]
-
-        sol = clarabel.DefaultSolver(sp.csc_matrix((n, n)), q, A, np.array(b), cones,
-                                     settings()).solve()
+        sol = clarabel.DefaultSolver(sp.csc_matrix((n, n)), q, A, b, cones, settings()).solve()
         if str(sol.status) not in ("Solved", "AlmostSolved"):
-            return None, None
-        x, z = np.asarray(sol.x), np.asarray(sol.z)
-        grad, k = np.zeros(d), 1 + nt
-        for i in range(nb):
-            rk = int(np.count_nonzero(np.abs(self.T[i]).sum(axis=1)))
-            w = min(max(z[k], 0.0), 1.0)
-            g = self.p[i].copy()
-            if rk and z[k] > 0:
-                s_dual = -z[k + 1:k + 1 + rk] / z[k]
-                s_dual /= max(1.0, np.linalg.norm(s_dual))  # stay a valid subgradient
-                g += self.kappa[i] * s_dual @ self.T[i, :rk]
-            grad += w * g
-            k += 1 + rk
-        if norm == "L1":
-            grad /= max(1.0, sum(min(max(z[j], 0.0), 1.0) for j in self._starts(nt)))
-        u = x[:d]
-        return u / np.linalg.norm(u), grad
-
-    def _starts(self, nt: int):
-        """Positions in clarabel's ``z`` of each piece's first (scalar) multiplier."""
-        k, out = 1 + nt, []
-        for i in range(len(self.p)):
-            out.append(k)
-            k += 1 + int(np.count_nonzero(np.abs(self.T[i]).sum(axis=1)))
-        return out
+            return None
+        u = np.asarray(sol.x)[:d]
+        norm_u = np.linalg.norm(u)
+        return u / norm_u if norm_u > 0 else None
 
     def local_minimum(self, u: np.ndarray, norm: str, iters: int = 8):
         """Refine ``u`` towards a local minimiser of ``h`` on the sphere; return ``(u, h(u),
-        minorant gradient)``, the minorant built from the multipliers at the final ``u``."""
+        SOCPs solved)``."""
         h_u = float(self.h(u[None], norm)[0])
-        grad = np.zeros(len(u))
+        steps = 0
         for _ in range(iters):
-            v, gv = self.tangent_minimum(u, norm)
+            v = self.tangent_minimum(u, norm)
+            steps += 1
             if v is None:
                 break
-            grad = gv
             h_v = float(self.h(v[None], norm)[0])
             if h_v >= h_u * (1 - 1e-12) or np.linalg.norm(v - u) < 1e-10:
                 break
             u, h_u = v, h_v
-        return u, h_u, grad
-
-
-#: Work of one exact cell bound (an SOCP) in units of cheap cell bounds, for the budget.
-EXACT_CELL_COST = 25
-
-
-class _CellSolver:
-    """Exact minimum of ``h`` over flat cells ``conv(V)``, as a rigorous lower bound.
-
-    For a cell with vertices ``V`` (m, d) it solves ``min over lambda in the simplex of
-    h(V' lambda)`` (an SOCP, clarabel with prebuilt sparse structure refilled per cell), then
-    turns the dual solution into a linear minorant of ``h`` (weights ``w_b`` and dual
-    subgradients ``s_b``, clipped to be exactly feasible) and returns its minimum over the
-    vertices: a bound valid whatever the solver's accuracy, equal to the flat minimum when the
-    solver is accurate.
-    """
-
-    def __init__(self, pieces: _Pieces, m: int, norm: str) -> None:
-
-        self.pieces, self.m, self.norm = pieces, m, norm
-        self.rk = [int(np.count_nonzero(np.abs(t).sum(axis=1))) for t in pieces.T]
-        nt = 1 if norm == "L1" else len(pieces.p)
-        n = m + nt
-        # rows: simplex (1), lambda >= 0 and t >= 0 (n), then per piece 1 + rk rows
-        rows, cols, self.piece_rows = [np.zeros(m, int)], [np.arange(m)], []
-        rows.append(1 + np.arange(n)), cols.append(np.arange(n))
-        r = 1 + n
-        cones = [clarabel.ZeroConeT(1), clarabel.NonnegativeConeT(n)]
-        for i, rk in enumerate(self.rk):
-            block = np.arange(r, r + 1 + rk)
-            self.piece_rows.append(block)
-            rows.append(np.repeat(block, m)), cols.append(np.tile(np.arange(m), 1 + rk))
-            rows.append(np.array([r])), cols.append(np.array([m + (0 if norm == "L1" else i)]))
-            cones.append(clarabel.SecondOrderConeT(1 + rk) if rk else clarabel.NonnegativeConeT(1))
-            r += 1 + rk
-        rows, cols = np.concatenate(rows), np.concatenate(cols)
-        order = sp.csc_matrix((np.arange(len(rows), dtype=float), (rows, cols)), shape=(r, n))
-        self.perm = order.data.astype(int)
-        self.template = np.concatenate([np.ones(m), -np.ones(n)] + [
-            np.concatenate([np.zeros(m * (1 + rk)), [-1.0]]) for rk in self.rk])
-        self.fill = np.concatenate([
-            m + n + sum((1 + rk) * m + 1 for rk in self.rk[:i]) + np.arange((1 + rk) * m)
-            for i, rk in enumerate(self.rk)])
-        b = np.zeros(r)
-        b[0] = 1.0
-        settings_ = settings()
-        settings_.tol_gap_abs = settings_.tol_gap_rel = settings_.tol_feas = 1e-5
-        self.solver = clarabel.DefaultSolver(
-            sp.csc_matrix((n, n)), np.r_[np.zeros(m), np.ones(nt)],
-            sp.csc_matrix((self._values(np.ones((m, pieces.p.shape[1])))[self.perm], order.indices,
-                           order.indptr), shape=(r, n)),
-            b, cones, settings_)
-
-    def _values(self, V: np.ndarray) -> np.ndarray:
-        P, vals = self.pieces, self.template.copy()
-        blocks = []
-        for i, rk in enumerate(self.rk):
-            blocks.append(P.p[i] @ V.T)
-            if rk:
-                blocks.append((-P.kappa[i] * P.T[i, :rk] @ V.T).ravel())
-        vals[self.fill] = np.concatenate(blocks)
-        return vals
-
-    def bound(self, V: np.ndarray) -> float:
-        self.solver.update(A=self._values(V)[self.perm])
-        sol = self.solver.solve()
-        if str(sol.status) not in ("Solved", "AlmostSolved"):
-            return 0.0
-        z = np.asarray(sol.z)
-        P = self.pieces
-        g, total = np.zeros(V.shape[1]), 0.0
-        for i, (rk, block) in enumerate(zip(self.rk, self.piece_rows)):
-            z0 = z[block[0]]
-            w = min(max(z0, 0.0), 1.0)
-            gi = P.p[i].copy()
-            if rk and z0 > 0:
-                s_dual = -z[block[1:]] / z0
-                s_dual /= max(1.0, np.linalg.norm(s_dual))
-                gi += P.kappa[i] * s_dual @ P.T[i, :rk]
-            g += w * gi
-            total += w
-        if self.norm == "L1" and total > 1.0:
-            g /= total
-        return max(0.0, float((V @ g).min()))
-
-
-def _face_cells(d: int, splits: int):
-    """Initial cells: each of the 2d faces of the cube [-1, 1]^d cut into ``splits^(d-1)`` boxes."""
-    edges = np.linspace(-1.0, 1.0, splits + 1)
-    grid = np.array(np.meshgrid(*[np.arange(splits)] * (d - 1), indexing="ij")).reshape(d - 1, -1).T
-    faces = np.repeat(np.arange(2 * d), len(grid))
-    lo = np.tile(edges[grid], (2 * d, 1))
-    hi = np.tile(edges[grid + 1], (2 * d, 1))
-    return faces, lo, hi
-
-
-def _cell_vertices(faces, lo, hi, d):
-    """Unit vertex directions of the cells, shape (n, 2^(d-1), d), and unit centre directions."""
-    bits = np.array(list(np.ndindex(*([2] * (d - 1)))), dtype=float)
-    others = np.array([[j for j in range(d) if j != k] for k in range(d)])
-    axis, sign = faces // 2, np.where(faces % 2 == 0, 1.0, -1.0)
-
-    def lift(box):  # box: (n, m, d-1) on the face -> (n, m, d)
-        n, m = box.shape[:2]
-        full = np.empty((n, m, d))
-        full[np.arange(n)[:, None, None], np.arange(m)[None, :, None], others[axis][:, None, :]] = box
-        full[np.arange(n), :, axis] = sign[:, None]
-        return full / np.linalg.norm(full, axis=2, keepdims=True)
-
-    V = lift(lo[:, None, :] + bits[None] * (hi - lo)[:, None, :])
-    centre = lift(((lo + hi) / 2)[:, None, :])[:, 0]
-    return V, centre
+        return u, h_u, steps
 
 
 def _initial_directions(d: int) -> np.ndarray:
@@ -435,48 +597,92 @@ def _initial_directions(d: int) -> np.ndarray:
     return np.vstack([np.eye(d), -np.eye(d), R / np.linalg.norm(R, axis=1, keepdims=True)])
 
 
-def _refine(grasp, system, norm, rel_gap, budget) -> Epsilon:
-    """Branch and bound over the sphere of wrench directions (see :func:`epsilon`)."""
-    pieces = _Pieces(system)
-    d = system.columns.shape[0]
+def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, deadline,
+             l1: Epsilon | None) -> Epsilon:
+    """Spatial epsilon by the inner polytope and outer directions (module docstring)."""
+    d = sup.C.shape[0]
     U = _initial_directions(d)
     h = pieces.h(U, norm)
-    u_best, hi, g_star = pieces.local_minimum(U[int(np.argmin(h))], norm)
-    faces, lo_box, hi_box = _face_cells(d, 2)
-    exact_cells = _CellSolver(pieces, 2 ** (d - 1), norm) if norm == "L1" else None
-    retired, rounds, examined = np.inf, 0, 0
+    work = len(U)
+    u_best, hi = U[int(np.argmin(h))], float(h.min())
+    if not _expired(deadline):
+        u_best, hi, steps = pieces.local_minimum(u_best, norm)
+        work += SOCP_COST * steps
+    V, EV, dirs, refs, parts = [], [], [], [], []
+    owner = np.zeros(sup.C.shape[1], dtype=np.int64)
+    for b, blk in enumerate(sup.blocks):
+        owner[list(blk.cols)] = b
+
+    def add(v):
+        out = sup.vertex(v, norm, len(V))
+        if out is not None:
+            w, err, x = out
+            V.append(w)
+            EV.append(err)
+            dirs.append(np.asarray(v, dtype=float))
+            refs.append(int(owner[np.flatnonzero(x)[0]]) if x.any() else 0)
+            parts.append(x)
+
+    for v in np.vstack([np.eye(d), -np.eye(d), u_best[None]]):
+        add(v)
+    spare = iter(U[2 * d:])  # more starting directions while the hull is flat
+    rounds, limited, hull, done = 0, False, None, 0
     while True:
         rounds += 1
-        examined += len(faces)
-        V, centre = _cell_vertices(faces, lo_box, hi_box, d)
-        hc = pieces.h(centre, norm)
-        k = int(np.argmin(hc))
-        if hc[k] < hi:
-            u, h_u, g = pieces.local_minimum(centre[k], norm)
-            if h_u < hi:
-                u_best, hi, g_star = u, h_u, g
-        bound = np.maximum(pieces.cell_bound(V, centre, norm), (V @ g_star).min(axis=1))
-        if exact_cells is not None:
-            for i in np.flatnonzero(bound < (1 - rel_gap) * hi):
-                bound[i] = max(bound[i], exact_cells.bound(V[i]))
-                examined += EXACT_CELL_COST
-        target = (1 - rel_gap) * hi
-        done = bound >= target
-        retired = min(retired, bound[done].min(initial=np.inf))
-        lo = min(retired, bound[~done].min(initial=np.inf))
-        if done.all() or examined + 2 * np.count_nonzero(~done) > budget:
+        try:
+            if hull is None and len(V) > d:
+                hull = ConvexHull(np.array(V), incremental=True)
+                done = len(V)
+            elif hull is not None and len(V) > done:
+                hull.add_points(np.array(V[done:]))
+                done = len(V)
+        except (QhullError, ValueError):  # a flat or degenerate set: start again from scratch
+            hull = None
+        if hull is not None:
+            dist = -hull.equations[:, -1]  # qhull's unit outward normals: a guide, not a proof
+            if hi - dist.min() <= rel_gap * hi:
+                break
+        if _expired(deadline):
+            limited = True
             break
-        faces, lo_box, hi_box = faces[~done], lo_box[~done], hi_box[~done]
-        # split every open cell in two across its longest side
-        axis = np.argmax(hi_box - lo_box, axis=1)
-        mid = (lo_box[np.arange(len(axis)), axis] + hi_box[np.arange(len(axis)), axis]) / 2
-        lo2, hi2 = lo_box.copy(), hi_box.copy()
-        hi_box[np.arange(len(axis)), axis] = mid
-        lo2[np.arange(len(axis)), axis] = mid
-        faces = np.concatenate([faces, faces])
-        lo_box, hi_box = np.concatenate([lo_box, lo2]), np.concatenate([hi_box, hi2])
-    lo = min(lo, hi) * (1 - 1e-12)  # float safety on a bound computed in floating point
-    return Epsilon(norm, lo, hi, tuple(u_best), tuple(grasp.center), grasp.length, False, rounds)
+        if len(V) >= MAX_VERTICES or work >= budget:
+            break
+        if hull is None:
+            v = next(spare, None)
+            if v is None:
+                break
+            add(v)
+            work += 1
+            continue
+        normals = hull.equations[np.argsort(dist, kind="stable")[:_ADD], :-1]
+        hv = pieces.h(normals, norm)
+        work += len(normals)
+        j = int(np.argmin(hv))
+        if hv[j] < hi:
+            u, h_u, steps = pieces.local_minimum(normals[j], norm)
+            work += SOCP_COST * steps
+            if h_u < hi:
+                u_best, hi = u, h_u
+                add(u_best)
+        before = len(V)
+        for v in normals:
+            add(v)
+        if len(V) == before and hv[j] >= hi:
+            break  # nothing new to add: the polytope is as good as these directions make it
+    if hull is not None:
+        hull.close()
+    faces = surface_faces(np.array(V)) if len(V) > d else None
+    direction = tuple(float(v) for v in u_best)
+    lo, ev = 0.0, Evidence("none", direction)
+    bounds = _prove(np.array(V), np.array(EV), faces, lambda i: sup.exact_vertex(parts[i]))
+    if bounds is not None:
+        lo = min(stated_lo(*bounds), hi)
+        ev = Evidence("support", direction, ref=tuple(refs) if norm == "L1" else (),
+                      points=tuple(float(v) for v in np.ravel(dirs)))
+    if norm == "Linf" and l1 is not None and l1.lo > lo:
+        lo, ev = l1.lo, Evidence("l1", direction)
+    return Epsilon(norm, lo, hi, direction, tuple(grasp.center), grasp.length, lo == hi, rounds,
+                   limited, ev)
 
 
 def epsilon_of_points(points) -> float:

@@ -5,13 +5,20 @@
 The common certificates are proved in bulk with the rigorous floating-point kernels of
 :mod:`qualgrasp.certify._kernels.recheck` (error bounds instead of rationals):
 planar generator certificates (interior, strict Farkas, null space) and spatial ones (interior
-forces, strict Farkas, null-space form certificates). Each row's claims are checked as
-:func:`qualgrasp.certify.report.verify_row` checks them (status against certificate kind, closure flags,
-margins). Every row not proved in bulk goes through :func:`qualgrasp.certify.report.verify_row`, which uses
-exact rational arithmetic; a row fails only if that fails. No solver is involved anywhere.
+forces, strict Farkas, null-space form certificates). Each row's other claims are checked as
+:func:`qualgrasp.certify.report.verify_row` checks them: ``verified`` true and ``error`` null,
+``dim``, ``n_contacts``, ``center`` and ``length`` against the grasp, status against certificate
+kind and closure flags, both margins equal to the certified ones (two-sided), and the epsilon
+columns (0 and no evidence without closure; with closure, the evidence re-checked by
+:func:`qualgrasp.certify.evidence.verify_bounds`, rigorous float bounds first). A table whose
+schema is not the results schema is not proved in bulk at all. Every row not proved in bulk goes
+through :func:`qualgrasp.certify.report.verify_row`, which uses exact rational arithmetic and gives
+the message; a row fails only if that fails. No solver is involved anywhere.
 """
 
 from __future__ import annotations
+
+import json
 
 import numpy as np
 import pyarrow as pa
@@ -19,13 +26,26 @@ import pyarrow as pa
 from . import models as registry
 from ._kernels.planar import planar_generators
 from ._kernels.recheck import null_rows, verify_farkas_general, verify_interior_general
-from .certificates import Tolerances, margin_of
+from .certificates import Tolerances, margin_of, margin_tolerance
 from .columns import GraspColumns
 from .cones import CONES, cone_code
+from .evidence import EPS_COLUMNS, Evidence, verify_bounds
 from .problem import Block
+from .report import GEOMETRY_TOL
+from .results import RESULT_SCHEMA
 from .wrench import force_column_errors, force_columns, generator_columns, generator_layout
 
-__all__ = ["recheck_table", "generator_errors"]
+__all__ = ["recheck_table", "generator_errors", "schema_matches"]
+
+
+def schema_matches(schema: pa.Schema) -> bool:
+    """Does a results table have every column of the results schema with its type (extra
+    columns allowed)? Only such tables are proved in bulk."""
+    for field in RESULT_SCHEMA:
+        i = schema.get_field_index(field.name)
+        if i < 0 or not schema.field(i).type.equals(field.type):
+            return False
+    return True
 
 _FLAGS = {"closure": True, "no_closure": False}
 
@@ -84,6 +104,7 @@ def _group_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, tol: Tole
     form_flag = res.column("form_closure").to_pylist()
     proved = np.ones(len(rows), dtype=bool)
     polyhedral = dim == 2 or all(name == "frictionless" for name in models)
+    planar_W = None
     for key, fl, st, mg, flags in (("force", False, status, margin, [force_flag[r] for r in rows]),
                                    ("form", True, form_status, form_margin, [form_flag[r] for r in rows])):
         struct = cert.field(key)
@@ -122,7 +143,7 @@ def _group_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, tol: Tole
         for i in np.flatnonzero(interior):
             if verify_interior_general(C[i], E[i], cone, first, width, nb[i], mub[i], gb[i], values[i],
                                        basis[i], tol.residual) and \
-                    mg[i] <= _certified_margin(cone, first, width, nb[i], mub[i], gb[i], values[i]):
+                    _margin_ok(mg[i], cone, first, width, nb[i], mub[i], gb[i], values[i]):
                 good[i] = True
         for i in np.flatnonzero(farkas):
             good[i] = verify_farkas_general(C[i], E[i], cone, first, width, nb[i], mub[i], gb[i], y[i],
@@ -131,16 +152,105 @@ def _group_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, tol: Tole
             good[nulls] = null_rows(C[nulls], np.ascontiguousarray(E[nulls]),
                                     np.ascontiguousarray(y[nulls])) == 3
         proved &= good
+        if key == "force" and dim == 2:
+            planar_W = (C, E)
+    proved &= _eps_proofs(cols, rows, res, status, planar_W if dim == 2 else None, models, variants)
     return proved
 
 
-def _certified_margin(cone, first, width, n, mu, g, x) -> float:
-    """Margin the values certify (slack over total normal force), with slack for rounding; the
-    claimed margin may not exceed it (the exact checker's rule, with its tolerance)."""
+def _eps_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, status: np.ndarray, planar,
+                models, variants) -> np.ndarray:
+    """Rows (of ``rows``) whose epsilon columns hold: all null (no quality), 0 without evidence
+    and not limited when not in closure, or proved by their evidence in closure."""
+    vals = np.column_stack([res.column(k).to_numpy(zero_copy_only=False).astype(float)[rows]
+                            for k in EPS_COLUMNS])
+    limited = res.column("eps_limited").to_pylist()
+    evidence = res.column("eps_evidence")
+    present = res.column("eps_l1_hi").is_valid().to_numpy(zero_copy_only=False)[rows]
+    ok = np.zeros(len(rows), dtype=bool)
+    nulls = ~np.isfinite(vals).any(axis=1)
+    ev_null = ~evidence.is_valid().to_numpy(zero_copy_only=False)[rows]
+    lim = np.array([limited[r] for r in rows], dtype=object)
+    none = ~present & nulls & ev_null & np.array([x is None for x in lim])
+    ok |= none
+    closure = status == "closure"
+    zero = present & ~closure & (vals == 0).all(axis=1) & ev_null & np.array([x is False for x in lim])
+    ok |= zero
+    candidates = np.flatnonzero(present & closure & np.isfinite(vals).all(axis=1) & ~ev_null
+                                & np.array([isinstance(x, bool) for x in lim]))
+    if len(candidates):
+        if planar is not None:
+            W, E = planar
+            owner = generator_layout(models, variants, 2)[0]
+        for j in candidates:
+            r = int(rows[j])
+            v = dict(zip(EPS_COLUMNS, vals[j]))
+            if not ((v["eps_l1_lo"] <= v["eps_l1_hi"]) and (v["eps_linf_lo"] <= v["eps_linf_hi"])
+                    and (vals[j] >= 0).all()):
+                continue
+            ev = evidence[r].as_py()
+            try:
+                evs = {key: Evidence.from_json(ev.get(key)) for key in ("l1", "linf")}
+                grasp = cols.grasps([r])[0]
+                arrays = (np.ascontiguousarray(W[j]), np.ascontiguousarray(E[j]), owner) if planar is not None else None
+                ok[j] = bool(verify_bounds(grasp, v, evs, arrays))
+            except (ValueError, TypeError, IndexError, ZeroDivisionError, OverflowError):
+                ok[j] = False
+    return ok
+
+
+def _margin_ok(claimed: float, cone, first, width, n, mu, g, x) -> bool:
+    """The claimed margin is the margin the values certify (slack over total normal force) to
+    within the exact checker's tolerance, kept a little tighter here: the exact checker
+    corrects the values first, so a row near the edge goes to it."""
     blocks = [Block(CONES[cone[b]], tuple(range(first[b], first[b] + width[b])), tuple(n[b]), mu[b], g[b], b)
               for b in range(len(cone))]
     t = margin_of(blocks, x)
-    return t + 1e-9 + 1e-6 * abs(t)
+    return abs(claimed - t) <= 0.5 * margin_tolerance(t)
+
+
+def _claims(cols: GraspColumns, results: pa.Table, lines) -> np.ndarray:
+    """Rows whose statements other than certificates, margins and epsilon hold, in bulk: a
+    valid grasp, status closure or no_closure, ``line`` and ``id``, ``verified`` true, ``error``
+    null, ``dim``, ``n_contacts``, ``center`` and ``length`` the grasp's."""
+    n = results.num_rows
+
+    def column(name, fill):
+        return results.column(name).fill_null(fill).to_numpy(zero_copy_only=False)
+
+    status = np.asarray(column("status", ""), dtype=object)
+    line = column("line", -1)
+    ids = results.column("id").to_pylist()
+    ids_ok = np.array([a == _text(cols.id_of(i)) for i, a in enumerate(ids)], dtype=bool)
+    fine = cols.ok & np.isin(status, ["closure", "no_closure"]) & ids_ok
+    fine &= np.asarray(line) == np.asarray(lines)
+    fine &= column("verified", False).astype(bool) & ~results.column("error").is_valid().to_numpy(zero_copy_only=False)
+    for name in ("margin", "form_margin"):
+        fine &= np.isfinite(column(name, np.nan).astype(float))
+    fine &= column("dim", 0) == cols.dim
+    fine &= column("n_contacts", -1) == cols.count
+    length = column("length", np.nan).astype(float)
+    fine &= np.abs(length - cols.length) <= GEOMETRY_TOL * np.maximum(1.0, np.abs(cols.length))
+    center = results.column("center")
+    lengths = center.combine_chunks().value_lengths().fill_null(0).to_numpy(zero_copy_only=False) if n else np.zeros(0)
+    fine &= lengths == cols.dim
+    flat = center.combine_chunks().flatten().to_numpy(zero_copy_only=False) if n else np.zeros(0)
+    offsets = np.concatenate([[0], np.cumsum(lengths)]).astype(int)
+    for d in (2, 3):
+        sel = np.flatnonzero(fine & (lengths == d))
+        if len(sel):
+            got = flat[offsets[sel][:, None] + np.arange(d)].astype(float)
+            want = cols.center[sel, :d]
+            close = (np.abs(got - want) <= GEOMETRY_TOL * np.maximum(1.0, np.abs(want))).all(axis=1)
+            fine[sel[~close]] = False
+    return fine
+
+
+def _text(gid):
+    """An id as the results' string column holds it."""
+    if gid is None or isinstance(gid, str):
+        return gid
+    return str(gid) if isinstance(gid, (int, float)) and not isinstance(gid, bool) else json.dumps(gid)
 
 
 def generator_errors(P, N, params, models, variants, c, L, *, frictionless: bool = False):
@@ -169,12 +279,11 @@ def recheck_table(cols: GraspColumns, results: pa.Table, lines, slow, tol: Toler
     bulk. Returns the boolean array of rows that passed.
     """
     n = results.num_rows
-    status = np.asarray(results.column("status").to_numpy(zero_copy_only=False), dtype=object)
     passed = np.zeros(n, dtype=bool)
-    line = results.column("line").to_numpy(zero_copy_only=False)
-    ids = results.column("id").to_pylist()
-    ids_ok = np.array([a == cols.id_of(i) or str(a) == str(cols.id_of(i)) for i, a in enumerate(ids)], dtype=bool)
-    fine = cols.ok & (status != "error") & ids_ok & (np.asarray(line) == np.asarray(lines))
+    if schema_matches(results.schema):
+        fine = _claims(cols, results, lines)
+    else:
+        fine = passed.copy()
     label = cols.pattern()
     for k in np.unique(label[fine]):
         rows = np.flatnonzero(fine & (label == k))

@@ -222,7 +222,6 @@ class Boundary:
     def stretch(self, lo: float, hi: float, limits: tuple[float, float], tol_normal: float = 0.0):
         """The region over arc lengths ``[lo, hi]`` (within ``limits``, unwrapped)."""
         n = len(self.points)
-        per = self.perimeter
         e0 = self._edge_unwrapped(lo, up=True)
         e1 = self._edge_unwrapped(hi, up=False)
         edges = range(e0, e1 + 1)

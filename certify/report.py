@@ -3,23 +3,28 @@
 :func:`certify_grasp` returns a :class:`Report`; :meth:`Report.row` is the results-file row
 (:data:`qualgrasp.certify.results.COLUMNS`): the force and form closure verdicts, margins and
 certificates, whether both certificates re-checked, the ``center`` and ``length`` used, and the
-Ferrari-Canny epsilon bounds (equal in the plane; 0 when not in force closure; null when quality
-was not asked for). ``status`` refers to force closure under the declared contact models.
+Ferrari-Canny epsilon bounds with their evidence (:mod:`qualgrasp.certify.evidence`; 0 and no
+evidence when not in force closure; null when quality was not asked for). ``status`` refers to
+force closure under the declared contact models.
+
+:func:`verify_row` re-checks every number a row states against its grasp, without a solver.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
 from .certificates import Certificate, Check, Tolerances, verify
 from .errors import CertificateError
 from .closure import Verdict, form_closure, force_closure
+from .evidence import verify_epsilon
 from .grasp import Grasp
-from .quality import Epsilon, epsilon
-from .results import result_row
+from .quality import Epsilon, epsilons
+from .results import NAMES, result_row
 
-__all__ = ["Report", "certify_grasp", "verify_row"]
+__all__ = ["Report", "certify_grasp", "verify_row", "GEOMETRY_TOL"]
 
 
 @dataclass(frozen=True)
@@ -50,6 +55,12 @@ class Report:
             e = self.epsilons.get(norm) if self.epsilons else None
             eps[f"eps_{key}_lo"] = None if e is None else e.lo
             eps[f"eps_{key}_hi"] = None if e is None else e.hi
+        eps["eps_limited"] = eps["eps_evidence"] = None
+        if self.epsilons:
+            eps["eps_limited"] = any(e.limited for e in self.epsilons.values())
+            if all(e.evidence is not None for e in self.epsilons.values()):
+                eps["eps_evidence"] = {key: self.epsilons[norm].evidence.to_json()
+                                       for norm, key in (("L1", "l1"), ("Linf", "linf"))}
         return result_row(
             id=g.id, line=line, dim=g.dim, status=self.force.status,
             form_closure=self.form.closure, force_closure=self.force.closure,
@@ -62,7 +73,7 @@ class Report:
 
 def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
                   tol: Tolerances = Tolerances(), quality: bool = True, eps_gap: float = 0.01,
-                  eps_budget: int = 200_000) -> Report:
+                  eps_budget: int = 200_000, eps_time: float | None = None) -> Report:
     """Certify one grasp end to end: force and form closure, the re-check of both certificates
     and, with ``quality``, the L1 and L-infinity Ferrari-Canny epsilon.
 
@@ -76,6 +87,10 @@ def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
     eps_gap, eps_budget
         Spatial epsilon: relative gap to reach and most work (see
         :func:`qualgrasp.certify.quality.epsilon`).
+    eps_time : float, optional
+        Time limit of the quality computation for this grasp, in seconds (both norms
+        together); when it is hit the epsilons are the bounds reached, flagged ``limited``
+        (results then depend on the machine). None: no limit.
 
     Returns
     -------
@@ -100,32 +115,115 @@ def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
     )
     eps = None
     if quality:
-        eps = {norm: epsilon(grasp, norm, rel_gap=eps_gap, budget=eps_budget, verdict=force)
-               for norm in ("L1", "Linf")}
+        eps = epsilons(grasp, rel_gap=eps_gap, budget=eps_budget, time_limit=eps_time, verdict=force)
     return Report(grasp, force, form, ok, eps)
 
 
+#: Relative tolerance of a row's ``center`` and ``length`` against the grasp's own (or recomputed
+#: default) values, relative to ``max(1, |value|)``.
+GEOMETRY_TOL = 1e-12
+
+
+def _number(value: Any) -> float | None:
+    """A finite float from a JSON or Arrow number (not a bool), else None."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    try:
+        x = float(value)
+    except OverflowError:
+        return None
+    return x if math.isfinite(x) else None
+
+
+def _show(value: Any) -> str:
+    try:
+        text = repr(value)
+    except RecursionError:
+        return "(deeply nested value)"
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 def verify_row(grasp: Grasp, row: dict[str, Any], tol: Tolerances = Tolerances()) -> Check:
-    """Re-check both certificates of a results row against its grasp."""
-    if not isinstance(row.get("certificate"), dict):
-        return Check(False, "row has no certificate")
+    """Re-check every claim of a results row (not an error row) against its grasp, without a
+    solver.
+
+    * ``verified`` is true and ``error`` null; ``dim``, ``n_contacts``, ``center`` and
+      ``length`` are the grasp's (:data:`GEOMETRY_TOL`);
+    * ``status`` and ``form_status`` agree with ``force_closure`` and ``form_closure`` and are
+      proved by their certificates (:func:`qualgrasp.certify.verify`, exact rationals); each
+      margin is 0 without closure and otherwise the margin the certificate's values certify, to
+      within :func:`qualgrasp.certify.certificates.margin_tolerance` either way;
+    * the epsilon columns are proved by their evidence
+      (:func:`qualgrasp.certify.evidence.verify_epsilon`).
+
+    Returns
+    -------
+    Check
+        Failed with a reason naming the column at the first claim that does not hold; a
+        malformed row (wrong types, missing columns, deep nesting) is a failed check, never an
+        exception.
+    """
+    try:
+        return _verify_row(grasp, row, tol)
+    except RecursionError:
+        return Check(False, "malformed row (too deeply nested)")
+    except (TypeError, ValueError, KeyError, AttributeError, IndexError, OverflowError,
+            ZeroDivisionError) as err:
+        return Check(False, f"malformed row ({type(err).__name__}: {_show(str(err))})")
+
+
+def _verify_row(grasp: Grasp, row: Any, tol: Tolerances) -> Check:
+    if not isinstance(row, dict):
+        return Check(False, "row is not an object")
+    missing = [name for name in NAMES if name not in row]
+    if missing:
+        return Check(False, f"column{'s' if len(missing) > 1 else ''} {', '.join(missing)} "
+                            f"{'are' if len(missing) > 1 else 'is'} missing")
+    if row["verified"] is not True:
+        return Check(False, f"verified must be true on a certified row, got {_show(row['verified'])}")
+    if row["error"] is not None:
+        return Check(False, f"error must be null on a certified row, got {_show(row['error'])}")
+    for key, expected in (("dim", grasp.dim), ("n_contacts", len(grasp.contacts))):
+        value = row[key]
+        if isinstance(value, bool) or not isinstance(value, int) or value != expected:
+            return Check(False, f"{key} {_show(value)} does not match the grasp's {expected}")
+    center = row["center"]
+    if not isinstance(center, (list, tuple)) or len(center) != grasp.dim:
+        return Check(False, f"center must hold {grasp.dim} numbers, got {_show(center)}")
+    for a, b in zip(center, grasp.center):
+        x = _number(a)
+        if x is None or abs(x - b) > GEOMETRY_TOL * max(1.0, abs(b)):
+            return Check(False, f"center {_show(center)} does not match the grasp's {list(grasp.center)}")
+    x = _number(row["length"])
+    if x is None or abs(x - grasp.length) > GEOMETRY_TOL * max(1.0, grasp.length):
+        return Check(False, f"length {_show(row['length'])} does not match the grasp's {grasp.length!r}")
+    if not isinstance(row["certificate"], dict):
+        return Check(False, "certificate must be an object with force and form")
     flags = {"closure": True, "no_closure": False, "degenerate": None}
     for key, fl, status_key, margin_key, flag_key in (
         ("force", False, "status", "margin", "force_closure"),
         ("form", True, "form_status", "form_margin", "form_closure"),
     ):
-        status = row.get(status_key)
-        if status not in flags or row.get(flag_key) != flags[status]:
-            return Check(False, f"{flag_key} does not match {status_key} {status!r}")
+        status = row[status_key]
+        if not isinstance(status, str) or status not in flags:
+            return Check(False, f"{status_key} must be closure, no_closure or degenerate, got {_show(status)}")
+        if row[flag_key] is not flags[status]:
+            return Check(False, f"{flag_key} {_show(row[flag_key])} does not match {status_key} {status!r}")
+        margin = _number(row[margin_key])
+        if margin is None:
+            return Check(False, f"{margin_key} must be a finite number, got {_show(row[margin_key])}")
+        if status != "closure" and margin != 0:
+            return Check(False, f"{margin_key} must be 0 when not in closure")
         try:
             cert = Certificate.from_json(row["certificate"].get(key))
         except CertificateError as err:
-            return Check(False, f"{key} certificate: {err}")
-        margin = row.get(margin_key)
-        if status != "closure" and margin != 0:
-            return Check(False, f"{margin_key} must be 0 when not in closure")
+            return Check(False, f"certificate.{key}: {err}")
         check = verify(grasp, cert, status=status, margin=margin if status == "closure" else None,
-                       frictionless=fl, tol=tol)
+                       frictionless=fl, tol=tol, exact_margin=True)
         if not check:
-            return Check(False, f"{key} certificate: {check.reason}")
+            what = margin_key if "margin" in check.reason else f"certificate.{key}"
+            return Check(False, f"{what}: {check.reason}")
+    check = verify_epsilon(grasp, row, row["status"] == "closure")
+    if not check:
+        return check
     return Check(True)

@@ -20,7 +20,7 @@ from typing import Any, Mapping
 
 import pyarrow as pa
 
-__all__ = ["Column", "CERTIFICATE", "COLUMNS", "NAMES", "RESULT_SCHEMA", "RESULT_WRITE_OPTIONS",
+__all__ = ["Column", "CERTIFICATE", "EVIDENCE", "COLUMNS", "NAMES", "RESULT_SCHEMA", "RESULT_WRITE_OPTIONS",
            "carried_name", "result_row", "error_row", "result_table"]
 
 CERTIFICATE = pa.struct([
@@ -29,6 +29,13 @@ CERTIFICATE = pa.struct([
     ("null_space", pa.bool_()), ("reason", pa.string()),
 ])
 """A certificate (:class:`qualgrasp.certify.Certificate`) as an Arrow struct."""
+
+EVIDENCE = pa.struct([
+    ("kind", pa.string()), ("direction", pa.list_(pa.float64())), ("ref", pa.list_(pa.int32())),
+    ("points", pa.list_(pa.float64())), ("faces", pa.list_(pa.int32())),
+])
+"""Evidence of one norm's epsilon bounds (:class:`qualgrasp.certify.evidence.Evidence`) as an
+Arrow struct."""
 
 
 @dataclass(frozen=True)
@@ -66,6 +73,11 @@ COLUMNS: tuple[Column, ...] = (
     Column("eps_l1_hi", pa.float64(), "upper bound of the L1 epsilon (equal to lo in the plane)"),
     Column("eps_linf_lo", pa.float64(), "lower bound of the L-infinity epsilon"),
     Column("eps_linf_hi", pa.float64(), "upper bound of the L-infinity epsilon"),
+    Column("eps_limited", pa.bool_(), "the per-grasp time limit of quality stopped the epsilon "
+                                      "computation (the bounds are those reached); null without quality"),
+    Column("eps_evidence", pa.struct([("l1", EVIDENCE), ("linf", EVIDENCE)]),
+           "evidence of the epsilon bounds ({l1, linf}), re-checkable without a solver; null "
+           "without quality or when not in force closure"),
 )
 
 NAMES = tuple(c.name for c in COLUMNS)
@@ -75,7 +87,8 @@ RESULT_SCHEMA = pa.schema([(c.name, c.type) for c in COLUMNS])
 # than half the time of writing results, and make the file larger.
 RESULT_WRITE_OPTIONS = {"use_dictionary": [
     "status", "form_status", "certificate.force.kind", "certificate.force.layout",
-    "certificate.form.kind", "certificate.form.layout"]}
+    "certificate.form.kind", "certificate.form.layout", "eps_evidence.l1.kind",
+    "eps_evidence.linf.kind"]}
 
 
 def carried_name(name: str) -> str:

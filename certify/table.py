@@ -64,7 +64,7 @@ _MAGIC = ((b"\x1f\x8b", "gzip-compressed data: decompress it first (gunzip)"),
 
 
 def _not_grasps(path: Path, what: str) -> GraspFileError:
-    return GraspFileError(f"{path} is not a grasp set (JSON Lines or Parquet): {what}")
+    return GraspFileError(f"{path} is neither JSON Lines nor Parquet: {what}")
 
 
 def input_format(path: str | Path) -> str:
@@ -353,8 +353,8 @@ def table_to_rows(table: pa.Table) -> list[dict]:
     rows = table.to_pylist()
     for r in rows:
         cert = r.get("certificate")
-        if cert:
+        if isinstance(cert, dict):  # any other value is left as it is, for the re-check to refuse
             for key in ("force", "form"):
-                if cert.get(key):
+                if isinstance(cert.get(key), dict):
                     cert[key] = {k: v for k, v in cert[key].items() if v is not None}
     return rows

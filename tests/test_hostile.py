@@ -75,7 +75,7 @@ def test_corpus_files_are_read_or_refused_in_one_line(case, code, tmp_path):
     assert result.exception is None or isinstance(result.exception, SystemExit)
     assert result.exit_code == code, result.output
     if code == 2:
-        assert result.output.startswith("error: ") and "not a grasp set" in result.output
+        assert result.output.startswith("error: ") and "neither JSON Lines nor Parquet" in result.output
         assert not out.exists()
     else:
         assert all(r["status"] != "error" for r in _rows(out))

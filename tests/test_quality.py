@@ -233,3 +233,123 @@ def test_efficiency_never_exceeds_one(seed):
     pick = rng.choice(len(cs), 3, replace=False)
     eff = efficiency(Grasp(tuple(cs[i] for i in pick)), poly, spacing=0.01)
     assert 0.0 <= eff.ratio <= 1.0 + 1e-9
+
+
+# --- routes at many contacts, evidence, time limit ---------------------------------------------
+
+from qualgrasp.certify import certify_grasp  # noqa: E402
+from qualgrasp.certify import quality as quality_module  # noqa: E402
+from qualgrasp.certify._kernels.epsilon import planar_epsilon_one  # noqa: E402
+from qualgrasp.certify.evidence import planar_generator_arrays, verify_epsilon  # noqa: E402
+from qualgrasp.certify.quality import epsilons, planar_epsilons  # noqa: E402
+
+PLANAR_KINDS = [dict(n_contacts=3, model="point"), dict(n_contacts=5, model="frictionless"),
+                dict(n_contacts=3, model="pad"), dict(n_contacts=8, model="point"),
+                dict(n_contacts=14, model="point"), dict(n_contacts=6, model="pad")]
+
+
+def _closure(grasps):
+    return [g for g in grasps if force_closure(g).status == "closure"]
+
+
+def _row(e):
+    """The epsilon columns of a results row from :func:`epsilons`."""
+    row = {}
+    for norm, key in (("L1", "l1"), ("Linf", "linf")):
+        row[f"eps_{key}_lo"], row[f"eps_{key}_hi"] = e[norm].lo, e[norm].hi
+    row["eps_limited"] = any(x.limited for x in e.values())
+    row["eps_evidence"] = {"l1": e["L1"].evidence.to_json(), "linf": e["Linf"].evidence.to_json()}
+    return row
+
+
+def test_planar_routes_agree_with_the_enumeration(monkeypatch):
+    """The hull (L1) and the sweep (L-infinity) give the compiled enumeration's epsilon to
+    1e-12 relative, on every planar contact model and across the size thresholds."""
+    worst, count = 0.0, 0
+    for kw in PLANAR_KINDS:
+        for g in _closure(random_grasps(11, 30, dim=2, **kw)):
+            W, E, owner = planar_generator_arrays(g)
+            m = len(g.contacts)
+            ref = {"L1": planar_epsilon_one(W, owner, m, False)[0],
+                   "Linf": planar_epsilon_one(W, owner, m, True)[0]}
+            monkeypatch.setattr(quality_module, "L1_ENUMERATION_MAX", 0)
+            monkeypatch.setattr(quality_module, "LINF_ENUMERATION_MAX", 0)
+            fast = planar_epsilons(W, E, owner, m)
+            monkeypatch.undo()
+            for norm in ("L1", "Linf"):
+                worst = max(worst, abs(fast[norm][1] - ref[norm]) / ref[norm])
+            count += 1
+    assert count > 60
+    assert worst < 1e-12
+
+
+def test_linf_sweep_equals_the_hull_of_all_sums(monkeypatch):
+    """Brute force: the L-infinity GWS is the hull of every sum of one vertex (the origin or a
+    generator) per contact."""
+    monkeypatch.setattr(quality_module, "LINF_ENUMERATION_MAX", 0)
+    for kw in (dict(n_contacts=4, model="point"), dict(n_contacts=3, model="pad"),
+               dict(n_contacts=6, model="frictionless")):
+        for g in _closure(random_grasps(12, 25, dim=2, **kw)):
+            W, E, owner = planar_generator_arrays(g)
+            parts = [np.vstack([np.zeros(3), W.T[owner == i]]) for i in range(len(g.contacts))]
+            brute = _qhull_eps(np.array([sum(c) for c in product(*parts)]))
+            hi = planar_epsilons(W, E, owner, len(g.contacts))["Linf"][1]
+            assert hi == pytest.approx(brute, rel=1e-12)
+
+
+@pytest.mark.parametrize("dim, kw", [
+    (2, dict(n_contacts=3, model="point")), (2, dict(n_contacts=10, model="point")),
+    (2, dict(n_contacts=60, model="point")), (2, dict(n_contacts=4, model="pad")),
+    (3, dict(n_contacts=3, model="point", spread=0.3)), (3, dict(n_contacts=2, model="soft", spread=0.15)),
+    (3, dict(n_contacts=8, model="frictionless")),
+])
+def test_evidence_proves_the_stated_bounds(dim, kw):
+    """Every bound comes with evidence that the solver-free checker accepts; planar bounds are
+    exact (lo == hi) at any size, spatial ones within the relative gap; tampering with a bound by
+    1e-6 relative is refused."""
+    for g in _closure(random_grasps(13, 40, dim=dim, **kw))[:2]:
+        e = epsilons(g)
+        row = _row(e)
+        assert verify_epsilon(g, row, True)
+        for norm in ("L1", "Linf"):
+            assert 0 < e[norm].lo <= e[norm].hi and not e[norm].limited
+            if dim == 2:
+                assert e[norm].lo == e[norm].hi
+            elif norm == "L1":
+                assert e[norm].gap <= 0.0101
+        for key in ("eps_l1_lo", "eps_l1_hi", "eps_linf_lo", "eps_linf_hi"):
+            bad = dict(row, **{key: row[key] * (1 + 1e-6)})
+            check = verify_epsilon(g, bad, True)
+            assert not check and key in check.reason
+
+
+def test_time_limit_keeps_the_verdict_and_states_the_bounds_reached():
+    """With a time limit that is hit, the row keeps its certified closure and states rigorous
+    bounds with their evidence (planar L-infinity: hi the best support value found, lo the L1
+    epsilon); without the limit nothing is flagged."""
+    g = _closure(random_grasps(14, 5, dim=2, n_contacts=400, model="point"))[0]
+    full = epsilons(g)
+    cut = epsilons(g, time_limit=1e-6)
+    assert cut["Linf"].limited and not full["Linf"].limited
+    assert cut["Linf"].lo == cut["L1"].lo and cut["Linf"].evidence.kind == "l1"
+    assert cut["Linf"].hi >= full["Linf"].hi * (1 - 1e-12)
+    assert cut["L1"].hi == full["L1"].hi  # the hull needs no limit
+    assert verify_epsilon(g, _row(cut), True)
+    s = _closure(random_grasps(15, 5, dim=3, n_contacts=40, model="point", spread=0.3))[0]
+    report = certify_grasp(s, eps_time=1e-6)
+    row = report.row(line=1)
+    assert row["status"] == "closure" and row["verified"] and row["eps_limited"] is True
+    assert 0 <= row["eps_l1_lo"] <= row["eps_l1_hi"] and 0 <= row["eps_linf_lo"] <= row["eps_linf_hi"]
+    assert verify_epsilon(s, row, True)
+
+
+def test_default_time_limit_is_never_hit_on_small_grasps():
+    """The default limit (10 s per grasp, Options.eps_time) leaves the benchmark's and the
+    study's grasps (2 to 10 contacts) untouched."""
+    from qualgrasp.certify.bench import QUALITY_KINDS
+    from qualgrasp.certify.chunk import Options
+
+    for kwargs in QUALITY_KINDS.values():
+        for g in _closure(random_grasps(16, 20, **kwargs))[:2]:
+            row = certify_grasp(g, eps_time=Options().eps_time).row(line=1)
+            assert row["eps_limited"] is False

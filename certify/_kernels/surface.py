@@ -1,0 +1,184 @@
+"""Rigorous floating-point checks of epsilon evidence (numba): the faces of an inscribed surface
+and the support function of a planar GWS, with error bounds instead of rationals (the float half
+of :mod:`qualgrasp.certify.evidence`; the exact half decides whatever these cannot).
+
+Vertex coordinates ``V`` come with bounds ``EV`` on their distance to the exact values. A
+determinant computed from floats by Leibniz's formula (a signed sum of products of ``d - 1``
+entries) is within ``perm(|D| + E) - perm(|D|) + gamma * perm(|D| + E)`` of the exact one,
+``perm`` the permanent (the same sum without signs): each product moves by at most the
+difference of the products of the enlarged and the plain magnitudes, and rounding adds
+Higham's ``gamma_n`` of the sum of magnitudes.
+"""
+
+from __future__ import annotations
+
+from itertools import permutations
+
+import numpy as np
+from numba import njit
+
+from .linalg import U, gamma
+
+__all__ = ["face_bounds", "leibniz_tables", "planar_h_bounds", "cycle_code"]
+
+
+def leibniz_tables(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Permutations of ``range(n)`` (rows) and their signs, for :func:`face_bounds`."""
+    perms = np.array(list(permutations(range(n))), dtype=np.int64).reshape(-1, n)
+    signs = np.array([(-1.0) ** sum(p[i] > p[j] for i in range(n) for j in range(i + 1, n))
+                      for p in perms])
+    return perms, signs
+
+
+@njit(cache=True)
+def face_bounds(V, EV, faces, perms, psign):
+    """For every face (row of ``faces``, ``d`` vertex indices into ``V`` (nv, d)): whether its
+    determinant ``det(v_1, ..., v_d)`` is proved positive, and rigorous lower and upper bounds
+    of its squared distance from the origin, ``det^2 / |n|^2`` (``n`` the generalised cross
+    product of ``v_2 - v_1, ..., v_d - v_1``, for which ``n . v_1 = det``), for the exact
+    vertices within ``EV`` of ``V``. ``perms``/``psign``: :func:`leibniz_tables` of ``d - 1``.
+    Returns ``(ok, dist2_lo, dist2_hi)``; ``dist2_lo`` is 0 where ``ok`` is False."""
+    F, d = faces.shape
+    ok = np.zeros(F, dtype=np.bool_)
+    lo = np.zeros(F)
+    hi = np.full(F, np.inf)
+    D = np.empty((d - 1, d))
+    ED = np.empty((d - 1, d))
+    n = np.empty(d)
+    en = np.empty(d)
+    npm = perms.shape[0]
+    g = 3.0 * gamma(d + npm + 2)
+    for f in range(F):
+        i0 = faces[f, 0]
+        for q in range(1, d):
+            j = faces[f, q]
+            for r in range(d):
+                D[q - 1, r] = V[j, r] - V[i0, r]
+                ED[q - 1, r] = EV[j, r] + EV[i0, r] + U * (abs(V[j, r]) + abs(V[i0, r]))
+        for r in range(d):  # n_r = (-1)^r det(D without column r)
+            s, pa_sum, pe_sum = 0.0, 0.0, 0.0
+            for t in range(npm):
+                prod, pa, pe = psign[t], 1.0, 1.0
+                for q in range(d - 1):
+                    c = perms[t, q]
+                    col = c if c < r else c + 1
+                    x = D[q, col]
+                    prod *= x
+                    pa *= abs(x)
+                    pe *= abs(x) + ED[q, col]
+                s += prod
+                pa_sum += pa
+                pe_sum += pe
+            n[r] = s if r % 2 == 0 else -s
+            en[r] = (pe_sum - pa_sum) + g * pe_sum
+        det, edet, mag = 0.0, 0.0, 0.0
+        for r in range(d):
+            a, ea = V[i0, r], EV[i0, r]
+            det += n[r] * a
+            big = (abs(n[r]) + en[r]) * (abs(a) + ea)
+            edet += big - abs(n[r]) * abs(a)
+            mag += big
+        edet = (edet + 3.0 * gamma(2 * d + 2) * mag) * (1.0 + 4 * U)
+        nn_hi, nn_lo = 0.0, 0.0
+        for r in range(d):
+            up = abs(n[r]) + en[r]
+            dn = max(0.0, abs(n[r]) - en[r])
+            nn_hi += up * up
+            nn_lo += dn * dn
+        nn_hi *= 1.0 + gamma(d + 4)
+        nn_lo *= 1.0 - gamma(d + 4)
+        d_lo, d_hi = det - edet, det + edet
+        if d_lo > 0.0 and nn_hi > 0.0:
+            ok[f] = True
+            lo[f] = d_lo * d_lo / nn_hi * (1.0 - gamma(4))
+        if nn_lo > 0.0:
+            hi[f] = d_hi * d_hi / nn_lo * (1.0 + gamma(4))
+    return ok, lo, hi
+
+
+@njit(cache=True)
+def planar_h_bounds(W, EW, owner, m, u, linf):
+    """Rigorous bounds ``(lo, hi)`` of ``h(u) / |u|`` for the exact generators within ``EW`` of
+    ``W`` (3, k): per contact the largest ``u . g`` (at least 0), combined by max (L1) or sum
+    (L-infinity); ``(0, -1)`` for a zero ``u``."""
+    k = W.shape[1]
+    best_lo = np.zeros(m)
+    best_hi = np.zeros(m)
+    for j in range(k):
+        v, err = 0.0, 0.0
+        for r in range(3):
+            v += W[r, j] * u[r]
+            err += (EW[r, j] + gamma(4) * abs(W[r, j])) * abs(u[r])
+        i = owner[j]
+        best_lo[i] = max(best_lo[i], v - err)
+        best_hi[i] = max(best_hi[i], v + err)
+    h_lo, h_hi = 0.0, 0.0
+    for i in range(m):
+        if linf:
+            h_lo += best_lo[i]
+            h_hi += best_hi[i]
+        else:
+            h_lo = max(h_lo, best_lo[i])
+            h_hi = max(h_hi, best_hi[i])
+    if linf:
+        h_lo *= 1.0 - gamma(m + 1)
+        h_hi *= 1.0 + gamma(m + 1)
+    uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2]
+    if uu <= 0.0:
+        return 0.0, -1.0
+    r_lo = np.sqrt(uu * (1.0 - gamma(4))) * (1.0 - 2 * U)
+    r_hi = np.sqrt(uu * (1.0 + gamma(4))) * (1.0 + 2 * U)
+    return h_lo / r_hi * (1.0 - 2 * U), h_hi / r_lo * (1.0 + 2 * U)
+
+
+@njit(cache=True)
+def cycle_code(faces, nv):
+    """Whether ``faces`` (F, d) on ``nv`` vertices form a closed oriented cycle: 0 yes; 1 an
+    index out of range; 2 a face repeating a vertex; 3 a ridge not in exactly two faces; 4 two
+    faces sharing a ridge with the same orientation. Ridges (a face without its ``k``-th
+    vertex, sign ``(-1)^k`` times the parity of sorting the rest) are encoded as integers in
+    base ``nv`` (the caller keeps ``nv^(d-1)`` below ``2^62``)."""
+    F, d = faces.shape
+    keys = np.empty(F * d, dtype=np.int64)
+    sgn = np.empty(F * d, dtype=np.int64)
+    r = np.empty(d - 1, dtype=np.int64)
+    for f in range(F):
+        for q in range(d):
+            v = faces[f, q]
+            if v < 0 or v >= nv:
+                return 1
+            for p in range(q):
+                if faces[f, p] == v:
+                    return 2
+        for k in range(d):
+            c = 0
+            for q in range(d):
+                if q != k:
+                    r[c] = faces[f, q]
+                    c += 1
+            parity = 0
+            for i in range(1, d - 1):  # insertion sort, counting swaps
+                j = i
+                while j > 0 and r[j - 1] > r[j]:
+                    r[j - 1], r[j] = r[j], r[j - 1]
+                    parity += 1
+                    j -= 1
+            key = 0
+            for i in range(d - 1):
+                key = key * nv + r[i]
+            keys[f * d + k] = key
+            s = 1 if k % 2 == 0 else -1
+            sgn[f * d + k] = s if parity % 2 == 0 else -s
+    order = np.argsort(keys)
+    n = F * d
+    if n % 2:
+        return 3
+    for i in range(0, n, 2):
+        a, b = order[i], order[i + 1]
+        if keys[a] != keys[b]:
+            return 3
+        if i + 2 < n and keys[order[i + 2]] == keys[a]:
+            return 3
+        if sgn[a] + sgn[b] != 0:
+            return 4
+    return 0
