@@ -262,15 +262,17 @@ class Boundary:
         return v + k * n
 
 
-def _unwrap(lo: float, hi: float, s: float, per: float) -> tuple[float, float]:
-    """``(lo, hi)`` shifted by whole perimeters so that ``lo <= s <= hi`` (when possible)."""
+def _unwrap(lo: float, hi: float, s: float, per: float, slack: float = 0.0) -> tuple[float, float]:
+    """``(lo, hi)`` shifted by whole perimeters so that ``lo <= s <= hi`` (when possible); a
+    contact up to ``slack`` outside the limits (its projection onto the boundary and the limits'
+    sample positions differ by rounding, up to a boundary step) widens them to reach it."""
     if hi < lo:
         hi += per
-    shift = math.floor((s - lo) / per) * per
+    shift = math.floor((s - lo + slack) / per) * per  # s = lo + per up to rounding: that period
     lo, hi = lo + shift, hi + shift
-    if s > hi + 1e-9 * per:
+    if s > hi + slack + 1e-9 * per or s < lo - slack - 1e-9 * per:
         raise GraspError(f"limits ({lo}, {hi}) do not contain the contact's position {s}")
-    return lo, hi
+    return min(lo, s), max(hi, s)
 
 
 @dataclass(frozen=True)
@@ -435,7 +437,7 @@ def independent_regions(boundary, normals, contacts, *, limits=None, models=None
             if len(limits) != k:
                 raise GraspError(f"limits: {len(limits)} intervals for {k} contacts")
             lo, hi = (float(v) for v in limits[i])
-            lim = _unwrap(lo, hi, s, B.perimeter)
+            lim = _unwrap(lo, hi, s, B.perimeter, B.perimeter / len(B.points))
         if not (lim[0] - 1e-9 * B.perimeter <= s <= lim[1] + 1e-9 * B.perimeter):
             raise GraspError(f"limits[{i}]: ({lim[0]:.6g}, {lim[1]:.6g}) does not contain the contact "
                              f"(arc length {s:.6g})")

@@ -1,6 +1,7 @@
 """``qualgrasp demo``: the main job on the built-in objects, end to end.
 
-1. The paper's figures 3 to 8 (:func:`qualgrasp.experiments.figures.make_figures`) into ``OUT/figures``.
+1. The paper's figures 3 to 8 and figure 9, certified regions
+   (:func:`qualgrasp.experiments.figures.make_figures`), into ``OUT/figures``.
 2. Synthesis on the built-in camera images (polygon, hexagonal nut, circular contour, figure-3
    object): FormGrasp (4 frictionless fingers) and ForceGrasp (2 and 3 fingers, ``mu = 0.5``);
    every grasp written in certify's grasp format (``OUT/grasps/grasps.jsonl``, with the
@@ -158,13 +159,16 @@ def write_report(result: DemoResult) -> Path:
               "Quick setting of the comparison study on the built-in objects (the baseline searches "
               "densely sampled boundary contacts for the best certified epsilon; robustness: the "
               "fraction of planned grasps that still certify when executed on the true object after "
-              "a perturbation of the image).", "",
-              "| route | grasps | certified | eps median | eps best | best / baseline best | s per object | robustness |",
-              "|---|---|---|---|---|---|---|---|"]
+              "a perturbation of the image; certified tolerance: median over objects of how far, as a "
+              "fraction of the object's size, every finger of the route's best grasp may slide along "
+              "the outline with force closure still certified).", "",
+              "| route | grasps | certified | eps median | eps best | best / baseline best | s per object | robustness "
+              "| certified tolerance |",
+              "|---|---|---|---|---|---|---|---|---|"]
     for r in result.study.routes:
         lines.append(f"| {r.route} | {r.grasps} | {_fmt(r.certified_fraction)} | {_fmt(r.eps_median)} | "
                      f"{_fmt(r.eps_best)} | {_fmt(r.ratio_best)} | {_fmt(r.seconds_median, '.2f')} | "
-                     f"{_fmt(r.robustness)} |")
+                     f"{_fmt(r.robustness)} | {_fmt(r.delta_median)} |")
     lines.append("")
     for path in result.study.files:
         if path.suffix == ".png":

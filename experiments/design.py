@@ -58,21 +58,29 @@ ROUTES = tuple((r.name.rsplit(" ", 1)[0], r.fingers) for r in routes())
 
 OBJECT_COLUMNS = ("object", "route", "method", "fingers", "mu", "grasps", "certified",
                   "certified_fraction", "eps_median", "eps_best", "ratio_best", "ratio_median",
-                  "seconds", "candidates", "error", "procedure")
+                  "seconds", "candidates", "error", "procedure", "delta_best", "delta_status")
 """Per object and route: grasps returned, certified, certified fraction, median and best certified
 L1 epsilon (uncertified grasps count 0), the qualitative best and median over the baseline's best
 with the same fingers (empty for the baseline), seconds (image to certified grasps), candidates
-screened (baseline), error message (route failed on the image)."""
+screened (baseline), error message (route failed on the image), and the **certified tolerance**
+of the route's best grasp (largest certified epsilon, the one the route would execute): ``delta``
+of its independent contact regions on the unperturbed outline, as a fraction of the object's size
+(:func:`qualgrasp.qualitative.independent.independent_grasp`), with the status (``robust``;
+``undecided``: no sliding certified, delta 0; ``none: <why>``: a contact on a corner, where no
+finger can slide, delta 0)."""
 
 OVERALL_COLUMNS = ("route", "method", "fingers", "objects", "objects_with_grasps", "grasps",
                    "certified_fraction", "eps_median", "eps_best", "ratio_best", "ratio_median",
-                   "seconds_median", "seconds_total", "robustness", "robustness_paired", "procedure")
+                   "seconds_median", "seconds_total", "robustness", "robustness_paired", "procedure",
+                   "delta_median", "delta_robust")
 """Per route over all objects: objects, objects where the route found a certified grasp, grasps,
 certified fraction (pooled), medians over objects of the per-object median and best epsilon and
 of the ratios (objects where both routes found grasps), median and total seconds, robustness
 pooled over every perturbation (not ``none``), and the same over the trials where both methods
 planned a certified grasp with the route's finger count (``paired``: the qualitative route finds
-no grasp on some objects, where the baseline's grasps may be the most fragile)."""
+no grasp on some objects, where the baseline's grasps may be the most fragile); the median over
+objects of the best grasp's certified tolerance (fraction of the size; objects where it was
+computed) and the share of those objects where some sliding is certified (``delta > 0``)."""
 
 ROBUSTNESS_COLUMNS = ("route", "method", "fingers", "kind", "size", "unit", "trials", "planned",
                       "held", "fraction", "misses", "collisions", "eps_planned", "eps_executed", "procedure")
@@ -152,6 +160,8 @@ class RouteSummary:
     seconds_median: float | None
     robustness: float | None
     robustness_paired: float | None
+    delta_median: float | None = None
+    delta_robust: float | None = None
 
 
 @dataclass(frozen=True)

@@ -1,11 +1,14 @@
-"""The paper's figures 3 to 8, drawn from the project's own computations.
+"""The paper's figures 3 to 8, and figure 9 (certified independent contact regions), drawn from
+the project's own computations.
 
 Every figure starts from a synthetic camera image of a built-in object
 (:func:`qualgrasp.qualitative.objects.render`, 512 x 512 pixels) and shows what the toolkit computes from it:
 the qualitative outline and its canonical string (figure 3), feasible grasp regions (figure 4),
 the zones of freedom of a synthesised FormGrasp grasp contact by contact (figure 5), ForceGrasp
 grasps with two and three fingers and their friction cones (figures 6 and 7), and the
-positive-spanning test on normals (figure 8). Numbers in the titles (strings, angles, margins,
+positive-spanning test on normals (figure 8), and the certified independent contact regions of a
+three-finger grasp beside a region tuple that is not robust, with its witness (figure 9, the
+paper's figure 4 turned into a guarantee). Numbers in the titles (strings, angles, margins,
 epsilons) are read from those computations and from :mod:`qualgrasp.certify`, never typed in.
 
 Choices
@@ -22,6 +25,9 @@ Choices
   feasible region, away from the other two fingers) that leaves the three normals farthest inside
   a half-plane, among those for which :func:`qualgrasp.certify.certify_grasp` finds no force closure
   (:func:`spanning_examples`).
+* Figure 9 shows, among the three-finger grasps with certified regions, the one of largest
+  certified tolerance whose whole feasible regions are not robust (:func:`regions_example`), so
+  that both panels are about the same fingers.
 
 Conventions: pixel coordinates of the image (x = column, y = row, y pointing down), so
 "clockwise" is as seen on the page; axes carry no ticks (pixels mean nothing to a reader).
@@ -44,13 +50,15 @@ from matplotlib.patches import Circle, Patch, Polygon as MplPolygon, Wedge
 from shapely.geometry import Polygon as ShapelyPolygon
 
 from qualgrasp.certify import Contact, Grasp, Report, Verdict, certify_grasp, positive_span
+from qualgrasp.certify.region_certify import RegionVerdict, certify_regions
+from qualgrasp.certify.region_data import CurvedRegion, RegionTuple, StraightRegion
 from qualgrasp.qualitative.candidates import separated
 from qualgrasp.qualitative.forcegrasp import GAP, ForceGrasp, friction_zone, positively_spans, span_margin
 from qualgrasp.qualitative.formgrasp import zone_steps
-from qualgrasp.qualitative.grasp_plot import plot_form_step, plot_grasp
+from qualgrasp.qualitative.grasp_plot import plot_contacts, plot_form_step, plot_grasp
 from qualgrasp.qualitative.objects import render
 from qualgrasp.qualitative.outline import NAMES, Outline, outline_image
-from qualgrasp.qualitative.plot import curvature_handles, plot_outline, plot_regions
+from qualgrasp.qualitative.plot import curvature_handles, draw_frame, plot_outline, plot_regions
 from qualgrasp.qualitative.regions import ALPHA, feasible_regions
 from qualgrasp.qualitative.synthesis import MU, Synthesis, synthesize
 from qualgrasp.qualitative.zones import Zones
@@ -59,14 +67,14 @@ from . import style
 
 __all__ = ["OBJECT", "MU", "NEAR_BEST", "STEMS", "Spanning", "best_grasp", "form_example", "nguyen_example",
            "spanning_examples", "zone_share", "fig3_outline", "fig4_regions", "fig5_zones", "fig6_two_fingers",
-           "fig7_three_fingers", "fig8_spanning", "make_figures"]
+           "fig7_three_fingers", "fig8_spanning", "regions_example", "fig9_regions", "make_figures"]
 
 OBJECT = "polygon"
 NEAR_BEST = 0.05
 THETA_MIN = r"$\theta_{\min}$"
 FIG4_OBJECTS = (("polygon", "polygon"), ("nut", "hexagonal nut"), ("disc", "circular contour"))
 STEMS = ("fig3_outline", "fig4_regions", "fig5_zones", "fig6_two_fingers", "fig7_three_fingers",
-         "fig8_spanning")
+         "fig8_spanning", "fig9_regions")
 
 
 # --------------------------------------------------------------------------------------------------
@@ -589,12 +597,126 @@ def _spanning_grasp(ax: Axes, synth: Synthesis, ex: Spanning, image: np.ndarray 
 # Driver
 
 
+def feasible_tuple(synth: Synthesis, k: int) -> RegionTuple:
+    """The whole feasible regions grasp ``k`` of ``synth`` lies on, as a region tuple: straight
+    regions (end points of the feasible run, the contact's normal) on straight elements, the
+    run's points and normals on curves; the grasp's contact models, ``center`` and ``length``."""
+    grasp = synth.grasps[k]
+    regions = []
+    for c, index in zip(grasp.contacts, grasp.meta["regions"]):
+        run = synth.regions[index]
+        params = {"mu": c.mu} if c.mu is not None else {}
+        if run.type == "/":
+            regions.append(StraightRegion(run.points[0], run.points[-1], c.n, model=c.model, **params))
+        else:
+            regions.append(CurvedRegion(run.points, run.normals, model=c.model, **params))
+    return RegionTuple(regions, center=grasp.center, length=grasp.length)
+
+
+def regions_example(synth: Synthesis) -> tuple[int, RegionVerdict | None]:
+    """The grasp figure 9 shows: among the grasps with certified regions, the one of largest
+    certified tolerance whose whole feasible regions are **not** robust (so that both halves of
+    the figure are about one grasp), and the verdict on those whole regions (a witness); failing
+    that, the grasp of largest tolerance and None."""
+    ranked = sorted((k for k, f in enumerate(synth.tolerances) if f is not None and f.status == "robust"),
+                    key=lambda k: -synth.tolerances[k].delta)
+    if not ranked:
+        raise ValueError("no synthesised grasp has certified regions")
+    for k in ranked:
+        verdict = certify_regions(feasible_tuple(synth, k))
+        if verdict.status == "not_robust":
+            return k, verdict
+    return ranked[0], None
+
+
+def _cone(ax: Axes, p: np.ndarray, n: np.ndarray, theta: float, reach: float) -> None:
+    """A friction cone of half-angle ``theta`` (radians) about the inward normal ``n``, drawn as
+    a triangle of side ``reach`` (pixels)."""
+    edges = [np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]]) @ n for a in (-theta, theta)]
+    ax.add_patch(MplPolygon([p, p + reach * edges[0], p + reach * edges[1]], closed=True,
+                            facecolor="tab:orange", edgecolor="tab:orange", alpha=0.22, lw=0.8, zorder=3))
+
+
+def _draw_region(ax: Axes, region, color: str, width: float) -> None:
+    if isinstance(region, StraightRegion):
+        xy = np.array([region.a, region.b])
+    else:
+        xy = np.asarray(region.points)
+    ax.plot(xy[:, 0], xy[:, 1], color=color, lw=width, alpha=0.8, solid_capstyle="round", zorder=6)
+
+
+def fig9_regions(synth: Synthesis | None = None, image: np.ndarray | None = None) -> Figure:
+    """Certified independent contact regions (figure 4 as a guarantee) and a region tuple that
+    is not robust, with its witness.
+
+    Left: a synthesised grasp with its certified independent regions (every choice of one contact
+    per green stretch is in force closure; :func:`qualgrasp.qualitative.independent.independent_grasp`).
+    Right: the same fingers anywhere on the whole feasible regions they lie on, which is not robust:
+    the witness grasp (one contact per region) is not in force closure, with a Farkas certificate.
+
+    Parameters
+    ----------
+    synth : Synthesis, optional
+        A synthesis with certified tolerances (default: three-finger ForceGrasp on the
+        ``polygon``, ``mu = 0.5``).
+    image : numpy.ndarray, optional
+        Its camera image, drawn underneath.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    if synth is None:
+        image = render(OBJECT) if image is None else image
+        synth = synthesize(image, 3, mu=MU, name=OBJECT, quality=False)
+    k, verdict = regions_example(synth)
+    found = synth.tolerances[k]
+    size = synth.outline.size
+    with style.context():
+        fig = style.new_figure(11.0, 6.4)
+        left, right = fig.subplots(1, 2)
+        plot_grasp(left, synth, k, inset=False)
+        for region in found.regions.regions:
+            _draw_region(left, region, style.GOOD, 7)
+        left.set_title(f"{synth.grasps[k].id}: certified regions, every choice in closure\n"
+                       f"$\\delta$ = {found.delta:.1f} px = {found.delta_fraction:.3f} of the size "
+                       f"on each side of every finger", color=style.GOOD)
+        draw_frame(right, synth.outline, None)
+        right.set_xlim(left.get_xlim())
+        right.set_ylim(left.get_ylim())
+        for region in feasible_tuple(synth, k).regions:
+            _draw_region(right, region, style.BAD, 7)
+        if verdict is not None:
+            w = verdict.witness
+            P, N = np.array([c.p for c in w.contacts]), np.array([c.n for c in w.contacts])
+            for p, n in zip(P, N):
+                _cone(right, p, n, synth.theta_min, 0.3 * size)
+            plot_contacts(right, P, N, size)
+            right.plot(*P.T, "X", color=style.BAD, ms=11, mec="white", zorder=9)
+            right.set_title("the whole feasible regions: not robust\nwitness X (one contact per region): "
+                            "no force closure, Farkas certificate", color=style.BAD)
+        else:
+            right.set_title("the whole feasible regions are robust too", color=style.GOOD)
+        for ax in (left, right):
+            if image is not None:
+                style.show_image(ax, image)
+            style.clean(ax)
+        fig.legend(handles=[Line2D([], [], color=style.GOOD, lw=6, label="certified independent regions"),
+                            Line2D([], [], color=style.BAD, lw=6, label="regions that are not robust"),
+                            Line2D([], [], color="black", marker="X", ls="", mfc=style.BAD, ms=10,
+                                   label="witness grasp")],
+                   loc="outside lower center", ncols=3)
+        fig.suptitle(f"Figure 9: independent contact regions, {synth.procedure.title} with "
+                     f"{synth.fingers} fingers, $\\mu$ = {synth.mu:g}")
+    return fig
+
+
 def make_figures(out: str | Path, *, formats: Sequence[str] = ("pdf", "png"),
                  progress: Callable[[str], None] | None = None) -> list[Path]:
-    """Draw figures 3 to 8 into ``out`` (created if needed) and return the paths written.
+    """Draw figures 3 to 9 into ``out`` (created if needed) and return the paths written.
 
     Writes ``fig3_outline``, ``fig4_regions``, ``fig5_zones``, ``fig6_two_fingers``,
-    ``fig7_three_fingers`` and ``fig8_spanning``, one file per format. The three syntheses
+    ``fig7_three_fingers``, ``fig8_spanning`` and ``fig9_regions``, one file per format. The three syntheses
     (FormGrasp, ForceGrasp with two and three fingers on the ``polygon``) are computed once.
 
     Parameters
@@ -623,8 +745,9 @@ def make_figures(out: str | Path, *, formats: Sequence[str] = ("pdf", "png"),
     builders: list[tuple[str, Callable[[], Figure]]] = [
         ("fig3_outline", lambda: fig3_outline()),
         ("fig4_regions", lambda: fig4_regions()),
-        ("fig5_zones", lambda: fig5_zones(synthesize(image, 4, name=OBJECT), image)),
-        ("fig6_two_fingers", lambda: fig6_two_fingers(synthesize(image, 2, mu=MU, name=OBJECT), image)),
+        ("fig5_zones", lambda: fig5_zones(synthesize(image, 4, name=OBJECT, tolerance=False), image)),
+        ("fig6_two_fingers", lambda: fig6_two_fingers(synthesize(image, 2, mu=MU, name=OBJECT, tolerance=False),
+                                                      image)),
     ]
     triple: list[Synthesis] = []  # figures 7 and 8 share one synthesis
 
@@ -634,7 +757,8 @@ def make_figures(out: str | Path, *, formats: Sequence[str] = ("pdf", "png"),
         return triple[0]
 
     builders += [("fig7_three_fingers", lambda: fig7_three_fingers(three(), image)),
-                 ("fig8_spanning", lambda: fig8_spanning(three(), image))]
+                 ("fig8_spanning", lambda: fig8_spanning(three(), image)),
+                 ("fig9_regions", lambda: fig9_regions(three(), image))]
     paths: list[Path] = []
     for stem, build in builders:
         say(f"drawing {stem}")

@@ -74,9 +74,12 @@ import cv2
 import numpy as np
 
 from qualgrasp.certify import Contact, Grasp
+from qualgrasp.certify.errors import GraspError
 from qualgrasp.qualitative.errors import QualitativeError
 from qualgrasp.qualitative.formgrasp import ray_edges
+from qualgrasp.qualitative.independent import independent_grasp
 from qualgrasp.qualitative.objects import NAMES, render
+from qualgrasp.qualitative.outline import Outline, outline_image
 from qualgrasp.qualitative.synthesis import synthesize
 from qualgrasp.qualitative.vision import read_image, segment
 
@@ -91,7 +94,7 @@ from .study_tables import overall_rows, robustness_rows, summarise, write_tables
 __all__ = ["BUILTINS", "KINDS", "UNITS", "ROUTES", "QUICK", "FULL", "SETTINGS", "OBJECT_COLUMNS",
            "OVERALL_COLUMNS", "ROBUSTNESS_COLUMNS", "GRASP_COLUMNS", "Settings", "Subject",
            "RouteSummary", "StudyResult", "subjects", "perturb", "execute", "evaluate_object",
-           "robustness_trial", "warm_up", "workload", "compare"]
+           "robustness_trial", "best_tolerance", "warm_up", "workload", "compare"]
 
 _ON = 1e-3  # a point this close to a contour (pixels) is on it
 
@@ -305,7 +308,7 @@ def _plan(image: np.ndarray, route: Route, settings: Settings, name: str, thresh
         return (found.grasps, np.array(found.certified, dtype=bool), np.array(found.epsilons),
                 found.seconds, found.candidates, found.boundary.points)
     s = synthesize(image, procedure=proc.name, mu=mu, name=name, certify=final, quality=final,
-                   threshold=threshold, largest=True)
+                   threshold=threshold, largest=True, tolerance=False)
     if final:
         ok = np.array(s.certified, dtype=bool)
         eps = np.array([r.eps_l1 for r in s.reports])
@@ -328,6 +331,10 @@ def evaluate_object(subject: Subject, settings: Settings = QUICK) -> tuple[list[
     """Both routes on one unperturbed image: per-route rows (:data:`OBJECT_COLUMNS`, ratios still
     empty) and per-grasp rows (:data:`GRASP_COLUMNS`)."""
     rows, grasp_rows = [], []
+    try:
+        outline = outline_image(subject.image, largest=True)
+    except QualitativeError:
+        outline = None  # every route reports the error below
     for route in routes():
         row = dict.fromkeys(OBJECT_COLUMNS)
         row.update(object=subject.name, **_route_fields(route, settings),
@@ -343,10 +350,23 @@ def evaluate_object(subject: Subject, settings: Settings = QUICK) -> tuple[list[
         row.update(grasps=len(grasps), certified=int(ok.sum()), eps_median=median, eps_best=best,
                    certified_fraction=float(ok.mean()) if len(ok) else None, seconds=seconds,
                    candidates=candidates)
+        if ok.any() and outline is not None:
+            row["delta_best"], row["delta_status"] = best_tolerance(outline, grasps[int(np.argmax(eps))])
         rows.append(row)
         grasp_rows += [{"object": subject.name, **_route_fields(route, settings), "certified": bool(c),
                         "eps": float(e)} for c, e in zip(ok, eps)]
     return _with_ratios(rows), grasp_rows
+
+
+def best_tolerance(outline: Outline, grasp: Grasp) -> tuple[float | None, str]:
+    """Certified tolerance of a certified grasp on the outline it was planned on: ``(delta as a
+    fraction of the object's size, status)`` (:data:`OBJECT_COLUMNS`). A contact on a corner or
+    off the outline's elements has no stretch to slide on: tolerance 0, status ``none: <why>``."""
+    try:
+        found = independent_grasp(outline, grasp)
+    except GraspError as err:
+        return 0.0, f"none: {err}"
+    return float(found.delta_fraction), found.status
 
 
 def _with_ratios(rows: list[dict]) -> list[dict]:

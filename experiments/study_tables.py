@@ -72,6 +72,7 @@ def overall_rows(object_rows: list[dict], grasp_rows: list[dict], trial_rows: li
         rows = [r for r in object_rows if r["route"] == route]
         grasps = [g for g in grasp_rows if g["route"] == route]
         seconds = [r["seconds"] for r in rows if r["seconds"] is not None]
+        deltas = [r["delta_best"] for r in rows if r.get("delta_best") is not None]
         out.append({
             "route": route, "method": r_.method, "procedure": r_.procedure.name, "fingers": r_.fingers,
             "objects": len(rows),
@@ -85,6 +86,8 @@ def overall_rows(object_rows: list[dict], grasp_rows: list[dict], trial_rows: li
             "seconds_median": _median(seconds), "seconds_total": float(sum(seconds)),
             "robustness": _pooled(trial_rows, route, KINDS),
             "robustness_paired": _pooled(trial_rows, route, KINDS, paired=True),
+            "delta_median": _median(deltas),
+            "delta_robust": sum(d > 0 for d in deltas) / len(deltas) if deltas else None,
         })
     return out
 
@@ -93,7 +96,8 @@ def summarise(overall: list[dict], trial_rows: list[dict]):
     """Headline :class:`RouteSummary` per route, and robustness per (route, kind)."""
     routes = tuple(RouteSummary(r["route"], r["fingers"], r["grasps"], r["certified_fraction"],
                                 r["eps_median"], r["eps_best"], r["ratio_best"], r["ratio_median"],
-                                r["seconds_median"], r["robustness"], r["robustness_paired"])
+                                r["seconds_median"], r["robustness"], r["robustness_paired"],
+                                r["delta_median"], r["delta_robust"])
                    for r in overall)
     by_kind = {(r["route"], kind): _pooled(trial_rows, r["route"], (kind,))
                for r in overall for kind in KINDS}

@@ -183,14 +183,18 @@ def synthesize_command(
                                          + ", ".join(f"{p.name} ({p.fingers} fingers, {p.model})"
                                                      for p in procedures.procedures())
                                          + "; instead of --fingers."),
+    no_tolerance: bool = typer.Option(False, "--no-tolerance", help="Skip the certified tolerance (independent "
+                                      "contact regions) of each grasp, about 0.05 to 0.5 s per grasp."),
 ) -> None:
     """Synthesise grasps of the object in an image and write them in certify's grasp format.
 
     Contacts are in pixels of the input image (x = column, y = row) with inward unit normals;
     center is the object's area centroid and length its radius. The file goes straight into
     'qualgrasp certify'. Prints one line per grasp (id, regions, certified margin and L1 epsilon,
-    and whether the image resolves it: a grasp whose certified epsilon is below the wrench change a
-    pixel of error can cause is flagged) and a summary. Exit code 0 (with an empty file) when no
+    the certified tolerance delta -- how far, in pixels and as a fraction of the object's size, every
+    finger may slide along the outline with closure still certified; also written to the grasp
+    file as delta and delta_fraction -- and whether the image resolves it: a grasp whose certified
+    epsilon is below the wrench change a pixel of error can cause is flagged) and a summary. Exit code 0 (with an empty file) when no
     grasp exists, 1 when a synthesised grasp fails certification, 2 on unusable input or options.
     """
 
@@ -211,7 +215,8 @@ def synthesize_command(
         if plot is not None:
             output_file(plot, "--plot", suffixes=FIGURE_SUFFIXES, reads=[image, output])
         result = synthesize(image, fingers, mu, None if theta_min is None else math.radians(theta_min),
-                            alpha, procedure=procedure, threshold=threshold, largest=largest)
+                            alpha, procedure=procedure, threshold=threshold, largest=largest,
+                            tolerance=not no_tolerance)
     except (QualitativeError, ValueError) as err:
         _fail(str(err))
     try:
@@ -229,13 +234,18 @@ def synthesize_command(
     for grasp, report, ok, good in zip(result.grasps, result.reports, result.certified, result.resolved):
         eps = report.epsilons["L1"].hi if report.epsilons else float("nan")
         verdict = "NOT CERTIFIED" if not ok else "verified" if good else "verified, BELOW IMAGE RESOLUTION"
+        delta = grasp.meta.get("delta")
+        tol = "" if no_tolerance else ("\tdelta -" if delta is None else
+                                       f"\tdelta {delta:.1f} px ({grasp.meta['delta_fraction']:.3f})")
         typer.echo(f"{grasp.id}\tregions {grasp.meta['regions']}\t{report.force.status}\t"
-                   f"margin {report.force.margin:.4f}\teps {eps:.4f}\t{verdict}")
+                   f"margin {report.force.margin:.4f}\teps {eps:.4f}{tol}\t{verdict}")
     s = result.summary()
     typer.echo(f"{s['grasps']} grasp(s) by {result.procedure.title} ({result.fingers} fingers, {friction}) "
                f"-> {output}; "
                f"{100 * s['certified_fraction']:.0f} % certified, {s['resolved']} resolved by the image; "
-               f"synthesis {s['seconds']:.2f} s, certification {s['certify_seconds']:.2f} s")
+               f"synthesis {s['seconds']:.2f} s, certification {s['certify_seconds']:.2f} s"
+               + ("" if s["median_delta_fraction"] is None else
+                  f"; median certified tolerance {s['median_delta_fraction']:.3f} of the object's size"))
     if s["resolved"] < s["certified"]:
         typer.echo(f"note: {s['certified'] - s['resolved']} certified grasp(s) are below the image's "
                    "resolution: their certified epsilon is smaller than the wrench change that a pixel "

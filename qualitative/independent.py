@@ -79,6 +79,8 @@ def outline_boundary(outline: Outline) -> tuple[np.ndarray, np.ndarray]:
         if seg.symbol != "/":
             continue
         a, b = seg.endpoints
+        if not np.linalg.norm(b - a) > 0:  # a degenerate fitted line: keep the smoothed samples
+            continue
         t = (b - a) / np.linalg.norm(b - a)
         idx = np.arange(seg.start, seg.stop) % n
         points[idx] = a + np.outer((outline.contour[idx] - a) @ t, t)

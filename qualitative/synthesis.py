@@ -18,6 +18,18 @@ comparable across procedures -- with the id ``<name>-<tag>-0007`` (the procedure
 (``zone_depth`` for FormGrasp, ``cone_margin`` in radians for ForceGrasp). Each is then certified by :func:`qualgrasp.certify.certify_grasp`;
 a synthesised grasp that does not certify is a bug of the synthesis, and is reported, not dropped.
 
+Certified tolerance
+-------------------
+With ``tolerance`` (the default), every certified grasp also gets its **independent contact
+regions** (:func:`qualgrasp.qualitative.independent.independent_grasp`): the largest stretch of
+the outline, ``delta`` pixels of arc on each side of every contact and within the contact's
+feasible region, over which each finger may land anywhere and the grasp is still certified in
+force closure. ``delta`` (pixels) and ``delta_fraction`` (of the object's size) are added to the
+grasp's fields (so they reach the grasp file), and :attr:`Synthesis.tolerances` holds the regions
+with their certificates. A grasp not certified, or with a contact no stretch can be placed
+around (on a corner), has ``delta`` None; a certified grasp for which no sliding is certified
+has ``delta`` 0.
+
 Image resolution
 ----------------
 A grasp certified on the contour the image gives may still rest on details the image cannot
@@ -45,12 +57,15 @@ from typing import Any
 import numpy as np
 
 from ..certify import Contact, Grasp, Report, certify_grasp
+from ..certify.errors import GraspError
 from ..certify.quality import epsilon
+from ..certify.region_boundary import IndependentRegions
 from . import procedures as registry
 from .candidates import INSET, PER_REGION, STEP, Candidates, candidates, object_frame
 from .errors import SynthesisError
 from .forcegrasp import MARGIN, friction
 from .formgrasp import ERROR
+from .independent import independent_grasp
 from .outline import Outline, outline_image
 from .procedures import Procedure, SearchInput
 from .regions import ALPHA, FINGER_WIDTH, MARGIN as REGION_MARGIN, Region, feasible_regions
@@ -105,6 +120,10 @@ class Synthesis:
         Synthesis time, image to grasps (vision included, certification excluded), seconds.
     certify_seconds : float
         Certification time, seconds.
+    tolerances : tuple of IndependentRegions or None
+        Per grasp, its certified independent contact regions (module notes), None when not
+        computed (``tolerance=False``, no certification, or the grasp not certified); empty when
+        not asked for.
     """
 
     name: str
@@ -122,6 +141,13 @@ class Synthesis:
     reports: tuple[Report, ...]
     seconds: float
     certify_seconds: float
+    tolerances: tuple[IndependentRegions | None, ...] = ()
+
+    @property
+    def deltas(self) -> tuple[float | None, ...]:
+        """Per grasp, the certified tolerance ``delta`` as a fraction of the object's size (None
+        when not computed or undecided; 0 when no sliding is certified)."""
+        return tuple(g.meta.get("delta_fraction") for g in self.grasps)
 
     @property
     def resolved(self) -> tuple[bool, ...]:
@@ -146,6 +172,7 @@ class Synthesis:
         """Counts, certified fraction, medians of margin and L1 epsilon (certified grasps), times."""
         ok = [r for r, c in zip(self.reports, self.certified) if c]
         eps = [r.epsilons["L1"].hi for r in ok if r.epsilons]
+        deltas = [d for d in self.deltas if d is not None]
         return {
             "name": self.name,
             "procedure": self.procedure.title,
@@ -158,6 +185,7 @@ class Synthesis:
             "certified_fraction": self.certified_fraction,
             "median_margin": float(np.median([r.force.margin for r in ok])) if ok else None,
             "median_eps_l1": float(np.median(eps)) if eps else None,
+            "median_delta_fraction": float(np.median(deltas)) if deltas else None,
             "seconds": self.seconds,
             "certify_seconds": self.certify_seconds,
         }
@@ -259,7 +287,8 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
                name: str | None = None, certify: bool = True, quality: bool = True,
                threshold: float | None = None, largest: bool = False, finger_width: float = FINGER_WIDTH,
                region_margin: float = REGION_MARGIN, step: float = STEP, inset: float = INSET,
-               per_region: int = PER_REGION, error: float = ERROR, margin: float = MARGIN) -> Synthesis:
+               per_region: int = PER_REGION, error: float = ERROR, margin: float = MARGIN,
+               tolerance: bool = True) -> Synthesis:
     """Synthesise and certify grasps of the object in an image.
 
     Parameters
@@ -297,6 +326,9 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
         FormGrasp: position error (pixels) the grasps must survive.
     margin : float
         ForceGrasp: smallest angular margin, fraction of ``theta_min``.
+    tolerance : bool
+        With ``certify``, give every certified grasp its certified tolerance ``delta``
+        (independent contact regions, module notes; about 0.05 to 0.5 s per grasp).
 
     Returns
     -------
@@ -346,5 +378,23 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     seconds = time.perf_counter() - start
     start = time.perf_counter()
     reports = tuple(_certified(g, quality) for g in grasps) if certify else ()
+    tolerances = tuple(_tolerance(outline, regions, g, r) for g, r in zip(grasps, reports)) if tolerance else ()
     return Synthesis(stem, proc.fingers, proc, mu, theta_min, outline, regions, cands,
-                     center, length, tuple(found), grasps, reports, seconds, time.perf_counter() - start)
+                     center, length, tuple(found), grasps, reports, seconds, time.perf_counter() - start,
+                     tolerances)
+
+
+def _tolerance(outline: Outline, regions: tuple[Region, ...], grasp: Grasp,
+               report: Report) -> IndependentRegions | None:
+    """The certified independent regions of a certified grasp (None otherwise), recorded in the
+    grasp's fields ``delta`` (pixels) and ``delta_fraction``."""
+    grasp.meta["delta"] = grasp.meta["delta_fraction"] = None
+    if not report.certified:
+        return None
+    try:
+        found = independent_grasp(outline, grasp, regions=list(regions))
+    except GraspError:  # a contact the regions cannot place (on a corner): no certified tolerance
+        return None
+    # undecided: in closure, but no sliding certified, so the certified tolerance is 0
+    grasp.meta["delta"], grasp.meta["delta_fraction"] = float(found.delta), float(found.delta_fraction)
+    return found

@@ -7,6 +7,7 @@ import pytest
 from typer.testing import CliRunner
 
 from qualgrasp.cli import app
+from qualgrasp.experiments.figures import STEMS
 from qualgrasp.experiments.study import BUILTINS
 
 runner = CliRunner()
@@ -22,8 +23,9 @@ def demo(tmp_path_factory):
 
 def test_demo_writes_figures_grasps_study_and_report(demo):
     out, output = demo
-    assert len(list((out / "figures").glob("fig*.png"))) == 6
-    assert len(list((out / "figures").glob("fig*.pdf"))) == 6
+    assert len(list((out / "figures").glob("fig*.png"))) == len(STEMS) == 7
+    assert len(list((out / "figures").glob("fig*.pdf"))) == len(STEMS)
+    assert "fig9_regions.png" in (out / "report.md").read_text()
     for name in ("overall.md", "overall.csv", "objects.csv", "robustness.csv"):
         assert (out / "study" / name).stat().st_size > 0
     report = (out / "report.md").read_text()
@@ -45,6 +47,9 @@ def test_demo_grasps_are_certified_and_recheck(demo):
     procedures = {pattern.match(r["id"]).group(2) for r in synthesised}
     assert procedures == {"form", "force2", "force3"}
     assert all(r["status"] == "closure" and r["verified"] for r in synthesised)
+    mine = [g for g in grasps if pattern.match(g["id"])]
+    assert all(g["delta_fraction"] is None or 0 <= g["delta_fraction"] < 1 for g in mine)
+    assert sum(g["delta_fraction"] is not None and g["delta_fraction"] > 0 for g in mine) > len(mine) / 2
     assert not any(r["id"].startswith("disc-form") for r in rows)  # no form closure of a disc
     check = runner.invoke(app, ["verify", str(out / "grasps" / "results.jsonl"),
                                 "--grasps", str(out / "grasps" / "grasps.jsonl")])

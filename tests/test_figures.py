@@ -16,8 +16,11 @@ from typer.testing import CliRunner
 from qualgrasp.experiments import figures, style
 from qualgrasp.cli import app
 from qualgrasp.experiments.figures import (STEMS, fig3_outline, fig4_regions, fig5_zones, fig6_two_fingers,
-                                 fig7_three_fingers, fig8_spanning, form_example, make_figures,
+                                 fig7_three_fingers, fig8_spanning, fig9_regions, form_example, make_figures,
                                  nguyen_example, spanning_examples)
+from qualgrasp.certify import force_closure
+from qualgrasp.certify.region_certify import certify_regions
+from qualgrasp.certify.regions import verify_regions
 from qualgrasp.qualitative.forcegrasp import friction_zone, nguyen_angles, positively_spans
 from qualgrasp.qualitative.objects import render
 from qualgrasp.qualitative.outline import outline_image
@@ -148,6 +151,25 @@ def test_fig8_verdicts_differ(synths, image):
     verdicts = [ax.get_xlabel() for ax in fig.axes if not ax.images]
     assert "positively span the plane" in verdicts[0] and "closure" in verdicts[0]
     assert "half-plane" in verdicts[1] and "no closure" in verdicts[1]
+    fig.canvas.draw()
+
+
+def test_fig9_certified_regions_beside_a_witness(synths, image):
+    synth = synths[3]
+    k, verdict = figures.regions_example(synth)
+    found = synth.tolerances[k]
+    assert found.status == "robust" and found.delta > 0
+    assert bool(verify_regions(found.regions, found.verdict))
+    whole = figures.feasible_tuple(synth, k)
+    assert verdict.status == "not_robust" and bool(verify_regions(whole, verdict))
+    assert force_closure(verdict.witness).status == "no_closure"
+    # no other certified grasp with not-robust whole regions has a larger tolerance
+    assert all(f.delta <= found.delta for f in synth.tolerances if f is not None and f.status == "robust"
+               and certify_regions(figures.feasible_tuple(synth, synth.tolerances.index(f))).status == "not_robust")
+    fig = fig9_regions(synth, image)
+    left, right = _image_axes(fig)
+    assert f"{found.delta:.1f} px" in left.get_title() and f"{found.delta_fraction:.3f}" in left.get_title()
+    assert "not robust" in right.get_title() and "Farkas" in right.get_title()
     fig.canvas.draw()
 
 
