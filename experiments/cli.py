@@ -15,7 +15,7 @@ from rich.table import Table
 from ..certify.checks import OptionError, count_in, output_folder
 from . import figures
 from .demo import demo_steps, run_demo
-from .silhouettes import available_silhouettes, write_silhouettes
+from .silhouettes import available_silhouettes, available_wings, write_silhouettes
 from .silhouettes import silhouettes as bundled
 from .study import BUILTINS, SETTINGS, compare, workload
 from .style import check_formats
@@ -49,7 +49,7 @@ def register(app: typer.Typer) -> None:
 def demo_command(out: Path = typer.Option(Path("qualgrasp-demo"), "--out", help="Output folder.")) -> None:
     """Run the main job on the built-in objects and say what was written where.
 
-    The paper's figures 3 to 8; FormGrasp and ForceGrasp on the built-in camera images, certified
+    The paper's figures 3 to 9; FormGrasp and ForceGrasp on the built-in camera images, certified
     and every certificate re-checked; the comparison study (quick setting); a Markdown report.
     Exit code 1 when a certificate failed its re-check, 2 when the output folder is unusable.
     """
@@ -84,7 +84,8 @@ def demo_command(out: Path = typer.Option(Path("qualgrasp-demo"), "--out", help=
 def figures_command(out: Path = typer.Option(Path("qualgrasp-figures"), "--out", help="Output folder."),
                     formats: str = typer.Option("pdf,png", "--formats",
                                                 help="Comma-separated file formats, e.g. pdf,png,svg.")) -> None:
-    """Draw the paper's figures 3 to 8 from the toolkit's own computations and say where they went."""
+    """Draw the paper's figures 3 to 8 and figure 9 (certified regions) from the toolkit's own
+    computations and say where they went."""
 
     try:
         kinds = check_formats([f.strip() for f in formats.split(",") if f.strip()])
@@ -108,6 +109,9 @@ def compare_command(
                                                                 "disc and figure3."),
         silhouettes: int = typer.Option(0, "--silhouettes", help="Add this many bundled cell silhouettes "
                                                                  "and the horse, rendered in memory."),
+        wings: int = typer.Option(0, "--wings", help="Add this many bundled mosquito wing silhouettes (ktch, "
+                                                     "Apache-2.0); the study's 61 real objects are --silhouettes 24 "
+                                                     "--wings 36."),
         setting: str = typer.Option("quick", "--setting", help="Size of the work: quick or full."),
         workers: int = typer.Option(2, "--workers", help="Processes."),
         trials: int | None = typer.Option(None, "--trials", help="Robustness trials per object, kind and "
@@ -123,6 +127,7 @@ def compare_command(
     available = available_silhouettes()
     try:
         count_in(silhouettes, "--silhouettes", 0, available - 1, what="(the bundled cell outlines)")
+        count_in(wings, "--wings", 0, available_wings(), what="(the bundled wing outlines)")
         count_in(workers, "--workers", 1, 256, what="processes")
         if trials is not None:
             count_in(trials, "--trials", 1, 1000)
@@ -131,9 +136,9 @@ def compare_command(
     _folder(out)
     images: list = sorted(p for p in folder.iterdir() if p.suffix.lower() in _IMAGE_SUFFIXES) if folder else []
     images += list(BUILTINS) if builtins else []
-    images += bundled(silhouettes) if silhouettes else []
+    images += bundled(silhouettes, with_horse=bool(silhouettes), wings=wings) if silhouettes or wings else []
     if not images:
-        raise typer.BadParameter("no images: give a FOLDER of images, --builtins or --silhouettes N")
+        raise typer.BadParameter("no images: give a FOLDER of images, --builtins, --silhouettes N or --wings N")
     settings = replace(SETTINGS[setting], workers=workers,
                        **({} if trials is None else {"trials": trials}))
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
@@ -142,10 +147,11 @@ def compare_command(
         result = compare(images, out, settings=settings,
                          progress=lambda message: bar.update(task, advance=1, description=message))
     table = Table(title=f"{len(result.objects)} objects, {result.seconds:.0f} s; eps: certified L1, "
-                        "robust: fraction still certified under vision errors", box=None,
+                        "robust: fraction still certified under vision errors; tol: median certified "
+                        "tolerance of the best grasp (fraction of the size)", box=None,
                   padding=(0, 1, 0, 0), pad_edge=False)
     for col in ("route", "grasps", "cert", "eps med", "eps best", "best/base", "s/obj", "robust",
-                "paired"):
+                "paired", "tol"):
         table.add_column(col, no_wrap=True)
 
     def fmt(value, spec=".3f"):
@@ -153,7 +159,8 @@ def compare_command(
 
     for r in result.routes:
         table.add_row(r.route, str(r.grasps), fmt(r.certified_fraction), fmt(r.eps_median), fmt(r.eps_best),
-                      fmt(r.ratio_best), fmt(r.seconds_median), fmt(r.robustness), fmt(r.robustness_paired))
+                      fmt(r.ratio_best), fmt(r.seconds_median), fmt(r.robustness), fmt(r.robustness_paired),
+                      fmt(r.delta_median))
     console.print(table)
     for name, reason in result.skipped:
         console.print(f"skipped {escape(name)}: {escape(reason)}", soft_wrap=True)
@@ -164,17 +171,19 @@ def compare_command(
 def silhouettes_command(out: Path = typer.Option(Path("qualgrasp-silhouettes"), "--out", help="Output folder."),
                         n: int = typer.Option(24, "--n", help="Number of cell outlines."),
                         horse: bool = typer.Option(True, "--horse/--no-horse",
-                                                   help="Also write scikit-image's horse.")) -> None:
-    """Write the bundled real silhouettes (cell outlines from geomstats, shipped with qualgrasp; scikit-image's
-    horse) as 512 x 512 PNG images."""
+                                                   help="Also write scikit-image's horse."),
+                        wings: int = typer.Option(0, "--wings", help="Number of mosquito wing outlines.")) -> None:
+    """Write the bundled real silhouettes (cell outlines from geomstats and mosquito wings from ktch,
+    shipped with qualgrasp; scikit-image's horse) as 512 x 512 PNG images."""
 
     try:
         count_in(n, "--n", 0, available_silhouettes() - 1, what="(the bundled cell outlines)")
+        count_in(wings, "--wings", 0, available_wings(), what="(the bundled wing outlines)")
     except OptionError as err:
         _fail(str(err))
     _folder(out)
     try:
-        paths = write_silhouettes(out, n, with_horse=horse)
+        paths = write_silhouettes(out, n, with_horse=horse, wings=wings)
     except (OSError, ValueError) as exc:
         _fail(str(exc))
     console.print(f"wrote {len(paths)} images into {out}", soft_wrap=True)

@@ -1,4 +1,5 @@
-"""Real object silhouettes for the comparison study: cell outlines and scikit-image's horse.
+"""Real object silhouettes for the comparison study: cell outlines, mosquito wings and
+scikit-image's horse.
 
 Sources and licences
 --------------------
@@ -10,6 +11,15 @@ Sources and licences
   ``experiments/data/cells.npz`` with the licence notice ``experiments/data/LICENSE-geomstats.md``;
   :func:`write_cell_data` regenerates the file from geomstats' text files (geomstats is not a
   dependency).
+* **Wings.** Outlines of 126 mosquito wings (11 genera, coded ``AE``, ``CX``, ``PS``, ...; 100
+  points each, in a common normalised frame) from ktch 0.11.1 (``ktch/datasets/data/
+  outline_mosquito_wings``, Apache License 2.0, Koji Noshita), shipped unchanged in
+  ``experiments/data/wings.npz`` with the licence ``experiments/data/LICENSE-ktch.md``;
+  :func:`write_wing_data` regenerates it from ktch's CSV files (ktch is not a dependency). Each
+  outline is interpolated by a periodic cubic spline through its 100 points (:data:`WING_POINTS`
+  points; a wing's margin is smooth, and its polygon's vertices would otherwise read as corners).
+  Selection (:func:`select_wings`): the valid, not thin outlines (steps 2 and 4 below), shared
+  among the genera in decreasing order of size as in step 5, ranked by solidity within a genus.
 * **Horse.** scikit-image's ``skimage.data.horse()`` (bundled with scikit-image, offline; BSD
   licence), a binary silhouette; its outline is the mask's outer pixel contour
   (:func:`cv2.findContours`), resampled and smoothed like the cells' (Gaussian of 1 pixel).
@@ -53,11 +63,14 @@ import numpy as np
 import shapely
 from qualgrasp.qualitative.objects import normalise, place, render_polygon
 from scipy import ndimage
+from scipy.interpolate import splev, splprep
 from shapely.geometry import Polygon
 from skimage import data
 
-__all__ = ["MIN_EXTENT", "THIN", "SMOOTHING", "SIZE", "Silhouette", "available_silhouettes", "parse_cells", "write_cell_data", "read_cells",
-           "smooth_outline", "select_cells", "horse", "silhouettes", "write_silhouettes"]
+__all__ = ["MIN_EXTENT", "THIN", "SMOOTHING", "SIZE", "WING_POINTS", "Silhouette", "available_silhouettes",
+           "available_wings", "parse_cells", "write_cell_data", "read_cells", "smooth_outline", "select_cells",
+           "parse_wings", "write_wing_data", "read_wings", "wing_outline", "select_wings", "horse", "silhouettes",
+           "write_silhouettes"]
 
 MIN_EXTENT = 50
 """Smallest bounding-box side of a kept cell outline, source pixels."""
@@ -71,6 +84,9 @@ SMOOTHING = 1.5
 SIZE = 512
 """Side of the rendered images, pixels."""
 
+WING_POINTS = 400
+"""Points of a wing outline after spline interpolation."""
+
 _GROUPS = (("dlm8", "control"), ("dlm8", "cytd"), ("dlm8", "jasp"),
            ("dunn", "control"), ("dunn", "cytd"), ("dunn", "jasp"))
 
@@ -82,7 +98,8 @@ class Silhouette:
     Attributes
     ----------
     name : str
-        ``cell-NNN-<line>-<treatment>`` (``NNN`` the index in ``cells.txt``) or ``horse``.
+        ``cell-NNN-<line>-<treatment>`` (``NNN`` the index in ``cells.txt``),
+        ``wing-NNN-<genus>`` (``NNN`` the specimen) or ``horse``.
     template : shapely.geometry.Polygon
         The outline with a unit minimum bounding circle centred at the origin, positively oriented
         (:func:`qualgrasp.qualitative.objects.normalise`); :func:`qualgrasp.qualitative.objects.place` puts it into an
@@ -91,12 +108,15 @@ class Silhouette:
         Where it comes from (package and file).
     solidity : float
         Area over convex-hull area.
+    kind : str
+        What the object is: ``cell``, ``wing`` or ``animal``.
     """
 
     name: str
     template: Polygon
     source: str
     solidity: float
+    kind: str = "cell"
 
     def polygon(self, size: int = SIZE, rotation: float = 0.0,
                 offset: tuple[float, float] = (0.0, 0.0)) -> Polygon:
@@ -241,21 +261,113 @@ def horse() -> Silhouette:
     poly = Polygon(smooth_outline(xy, 1.0))
     if not poly.is_valid:  # keep the largest simple piece
         poly = max(getattr(shapely.make_valid(poly), "geoms", []), key=lambda g: g.area)
-    return Silhouette("horse", normalise(poly), "skimage.data.horse (BSD-3-Clause)", _solidity(poly))
+    return Silhouette("horse", normalise(poly), "skimage.data.horse (BSD-3-Clause)", _solidity(poly), "animal")
+
+
+def parse_wings(folder: str | Path) -> tuple[np.ndarray, np.ndarray]:
+    """ktch's mosquito wing outlines in ``folder`` (``data_outline_mosquito_wings.csv``: columns
+    specimen_id, coord_id, x, y; ``meta_outline_mosquito_wings.csv``: specimen_id, genus):
+    ``(126, 100, 2)`` outlines and the genus code of each specimen.
+
+    Raises
+    ------
+    ValueError
+        The files do not have that layout.
+    """
+    folder = Path(folder)
+    rows = np.loadtxt(folder / "data_outline_mosquito_wings.csv", delimiter=",", skiprows=1)
+    specimens = np.unique(rows[:, 0]).astype(int)
+    points = len(rows) // len(specimens)
+    if len(rows) != len(specimens) * points or not (rows[:, 0].reshape(-1, points) == specimens[:, None]).all():
+        raise ValueError(f"{folder}: rows are not {points} points per specimen, in order")
+    meta = [line.split(",") for line in (folder / "meta_outline_mosquito_wings.csv").read_text().split("\n")[1:]
+            if line.strip()]
+    genus = {int(k): g.strip() for k, g in meta}
+    return rows[:, 2:4].reshape(len(specimens), points, 2), np.array([genus[int(k)] for k in specimens])
+
+
+def write_wing_data(folder: str | Path, path: str | Path) -> int:
+    """Write ktch's wing outlines (:func:`parse_wings`) to ``path`` (``.npz``: ``outlines``
+    float32, ``genus``), as shipped; return how many."""
+    outlines, genus = parse_wings(folder)
+    np.savez_compressed(path, outlines=outlines.astype(np.float32), genus=genus)
+    return len(outlines)
+
+
+def read_wings() -> list[tuple[int, np.ndarray, str]]:
+    """The shipped wing outlines: ``(specimen, (100, 2) float outline, genus)``, in order."""
+    with _data("wings.npz").open("rb") as fh, np.load(fh) as d:
+        return [(k, xy.astype(np.float64), str(g)) for k, (xy, g) in enumerate(zip(d["outlines"], d["genus"]))]
+
+
+def wing_outline(xy: np.ndarray, points: int = WING_POINTS) -> np.ndarray:
+    """A closed outline through the points ``xy`` (``(m, 2)``, closing point not repeated):
+    periodic cubic spline interpolation, ``points`` points evenly spaced in the spline's
+    parameter."""
+    tck, _ = splprep([xy[:, 0], xy[:, 1]], s=0, per=True)
+    x, y = splev(np.linspace(0.0, 1.0, points, endpoint=False), tck)
+    return np.column_stack([x, y])
+
+
+def _valid_wings() -> dict[str, list[tuple[int, Polygon]]]:
+    """Kept wings (valid, not thin) per genus, as polygons."""
+    groups: dict[str, list[tuple[int, Polygon]]] = {}
+    for k, xy, genus in read_wings():
+        poly = Polygon(wing_outline(xy))
+        if poly.is_valid and not _thin(normalise(poly)):
+            groups.setdefault(genus, []).append((k, poly))
+    return groups
+
+
+def available_wings() -> int:
+    """How many wing outlines pass the selection rule."""
+    return sum(len(v) for v in _valid_wings().values())
+
+
+def select_wings(n: int = 36) -> list[Silhouette]:
+    """A deterministic, varied subset of ``n`` wing outlines (module notes).
+
+    Raises
+    ------
+    ValueError
+        Fewer than ``n`` wings pass the rule.
+    """
+    groups = _valid_wings()
+    order = sorted(groups, key=lambda g: (-len(groups[g]), g))  # larger genera first
+    total = sum(len(v) for v in groups.values())
+    if total < n:
+        raise ValueError(f"only {total} wings pass the selection rule, {n} asked for")
+    share = dict.fromkeys(order, 0)
+    while sum(share.values()) < n:
+        for g in order:
+            if share[g] < len(groups[g]) and sum(share.values()) < n:
+                share[g] += 1
+    chosen = []
+    for g in order:
+        ranked = sorted(groups[g], key=lambda item: _solidity(item[1]))
+        picks = np.round(np.linspace(0, len(ranked) - 1, share[g])).astype(int) if share[g] else []
+        for k in picks:
+            index, poly = ranked[k]
+            chosen.append(Silhouette(f"wing-{index:03d}-{g.lower()}", normalise(poly),
+                                     "ktch outline_mosquito_wings, shipped as experiments/data/wings.npz "
+                                     "(Apache-2.0)", _solidity(poly), "wing"))
+    return chosen
 
 
 def available_silhouettes() -> int:
     """How many real silhouettes are bundled: the cells that pass the selection rule, and the
-    horse."""
+    horse (wings: :func:`available_wings`)."""
     return sum(len(v) for v in _valid_cells().values()) + 1
 
 
-def silhouettes(n: int = 24, with_horse: bool = True) -> list[Silhouette]:
-    """The study's real silhouettes: ``n`` cells (:func:`select_cells`) and the horse."""
-    return select_cells(n) + ([horse()] if with_horse else [])
+def silhouettes(n: int = 24, with_horse: bool = True, wings: int = 0) -> list[Silhouette]:
+    """The study's real silhouettes: ``n`` cells (:func:`select_cells`), the horse and ``wings``
+    mosquito wings (:func:`select_wings`). The study's real objects are ``silhouettes(24, True,
+    36)``: 61 objects of three kinds."""
+    return select_cells(n) + ([horse()] if with_horse else []) + (select_wings(wings) if wings else [])
 
 
-def write_silhouettes(out_dir: str | Path, n: int = 24, *, with_horse: bool = True,
+def write_silhouettes(out_dir: str | Path, n: int = 24, *, with_horse: bool = True, wings: int = 0,
                       size: int = SIZE) -> list[Path]:
     """Render the silhouettes as PNG images (``<name>.png``) into ``out_dir``.
 
@@ -267,18 +379,20 @@ def write_silhouettes(out_dir: str | Path, n: int = 24, *, with_horse: bool = Tr
         Number of cells.
     with_horse : bool
         Also write ``horse.png``.
+    wings : int
+        Number of mosquito wings.
     size : int
         Image side, pixels.
 
     Returns
     -------
     list of pathlib.Path
-        The files written, cells first.
+        The files written: cells, the horse, wings.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     paths = []
-    for item in silhouettes(n, with_horse):
+    for item in silhouettes(n, with_horse, wings):
         path = out / f"{item.name}.png"
         if not cv2.imwrite(str(path), item.image(size)):
             raise OSError(f"cannot write {path}")
