@@ -9,7 +9,11 @@ Every plot is written as PNG and PDF with :func:`qualgrasp.experiments.style.sav
   certified grasps, per route;
 * ``study-robustness``: fraction of planned grasps that still certify on the true object against
   the perturbation size, one row per finger count and one column per perturbation kind (size 0:
-  the unperturbed image).
+  the unperturbed image);
+* ``study-tolerance``: certified tolerance of each object's best grasp (how far every finger may
+  slide along the outline with force closure certified, fraction of the object's size; 0 when
+  none is certified), per route, one panel per finger count, beside the route's sampled
+  robustness (pooled fraction held, in the tick labels).
 
 Panels, labels and colours come from the procedure registry (:mod:`qualgrasp.qualitative.procedures`):
 one panel (or row) per registered procedure, with its baseline; colours tell the procedure, line
@@ -26,7 +30,7 @@ from ..qualitative import procedures
 from .design import KINDS, UNITS
 from .style import context, new_figure, save
 
-__all__ = ["plot_epsilon", "plot_quality_time", "plot_robustness", "plot_all"]
+__all__ = ["plot_epsilon", "plot_quality_time", "plot_robustness", "plot_tolerance", "plot_all"]
 
 _METHOD = {"qualitative": ("-", "o", "qualitative"), "baseline": ("--", "^", "baseline")}
 _FORMATS = ("png", "pdf")
@@ -141,8 +145,48 @@ def plot_robustness(out: Path, robust: list[dict], mu: dict | None = None) -> li
         return save(fig, out, "study-robustness", _FORMATS)
 
 
+def _held(robust: list[dict], procedure: str, method: str) -> float | None:
+    """Pooled fraction held over every perturbation (not ``none``) of one route."""
+    rows = [r for r in robust if r["procedure"] == procedure and r["method"] == method and r["kind"] != "none"]
+    planned = sum(r["planned"] for r in rows)
+    return sum(r["held"] for r in rows) / planned if planned else None
+
+
+def plot_tolerance(out: Path, object_rows: list[dict], robust: list[dict]) -> list[Path]:
+    """Certified tolerance of each object's best grasp per route, beside its sampled robustness
+    (``study-tolerance``)."""
+    rng = np.random.default_rng(0)
+    with context():
+        procs = procedures.procedures()
+        fig = new_figure(2.8 * len(procs), 3.0)
+        axes = fig.subplots(1, len(procs), sharey=True, squeeze=False)[0]
+        for ax, p in zip(axes, procs):
+            ticks = []
+            for x, method in enumerate(("qualitative", "baseline")):
+                delta = [r["delta_best"] for r in object_rows if r["procedure"] == p.name
+                         and r["method"] == method and r.get("delta_best") is not None]
+                if delta:
+                    ax.boxplot([delta], positions=[x], widths=0.5, showfliers=False,
+                               medianprops={"color": p.colour, "linewidth": 1.6},
+                               boxprops={"color": "0.4"}, whiskerprops={"color": "0.4"},
+                               capprops={"color": "0.4"})
+                ax.scatter(_jitter(len(delta), x, rng), delta, s=9, color=p.colour, alpha=0.8,
+                           marker=_METHOD[method][1], zorder=3, linewidths=0)
+                held = _held(robust, p.name, method)
+                positive = sum(d > 0 for d in delta)
+                ticks.append(f"{method}\n{positive}/{len(delta)}: $\\delta > 0$\n"
+                             f"held {'-' if held is None else format(held, '.3f')}")
+            ax.set_xticks([0, 1], ticks)
+            ax.set_xlim(-0.6, 1.6)
+            ax.set_title(p.label(_mu(object_rows, p.name)))
+            ax.grid(axis="y", color="0.9", linewidth=0.6)
+        axes[0].set_ylabel("certified tolerance $\\delta$\n(fraction of the object's size)")
+        fig.suptitle("Certified tolerance of each object's best grasp, and sampled robustness (held)")
+        return save(fig, out, "study-tolerance", _FORMATS)
+
+
 def plot_all(out: Path, object_rows: list[dict], grasp_rows: list[dict], robust: list[dict]) -> list[Path]:
     """Every plot of the study into ``out``; the paths written."""
     mu = {p.name: _mu(object_rows, p.name) for p in procedures.procedures()}
     return (plot_epsilon(out, object_rows, grasp_rows) + plot_quality_time(out, object_rows)
-            + plot_robustness(out, robust, mu))
+            + plot_robustness(out, robust, mu) + plot_tolerance(out, object_rows, robust))

@@ -169,7 +169,8 @@ class Synthesis:
         return sum(self.certified) / len(self.reports)
 
     def summary(self) -> dict[str, Any]:
-        """Counts, certified fraction, medians of margin and L1 epsilon (certified grasps), times."""
+        """Counts, certified fraction, medians of margin and L1 epsilon (certified grasps), median
+        certified tolerance (``median_delta_fraction``, None without tolerances), times."""
         ok = [r for r, c in zip(self.reports, self.certified) if c]
         eps = [r.epsilons["L1"].hi for r in ok if r.epsilons]
         deltas = [d for d in self.deltas if d is not None]

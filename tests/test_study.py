@@ -259,7 +259,7 @@ def test_study_result_and_files(study):
     for route in ("ForceGrasp 2", "FormGrasp 4"):  # the square has no ForceGrasp triplet
         assert 0 < by_route[route].ratio_best <= 1.2
     names = {p.name for p in result.files}
-    for stem in ("study-epsilon", "study-quality-time", "study-robustness"):
+    for stem in ("study-epsilon", "study-quality-time", "study-robustness", "study-tolerance"):
         assert {f"{stem}.png", f"{stem}.pdf"} <= names
     assert all(p.is_file() and p.stat().st_size > 0 for p in result.files)
     assert set(result.robustness) == {(r.route, k) for r in result.routes
