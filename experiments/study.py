@@ -80,6 +80,7 @@ from qualgrasp.qualitative.formgrasp import ray_edges
 from qualgrasp.qualitative.independent import independent_grasp
 from qualgrasp.qualitative.objects import NAMES, render
 from qualgrasp.qualitative.outline import Outline, outline_image
+from qualgrasp.qualitative.regions import feasible_regions
 from qualgrasp.qualitative.synthesis import synthesize
 from qualgrasp.qualitative.vision import read_image, segment
 
@@ -351,19 +352,28 @@ def evaluate_object(subject: Subject, settings: Settings = QUICK) -> tuple[list[
                    certified_fraction=float(ok.mean()) if len(ok) else None, seconds=seconds,
                    candidates=candidates)
         if ok.any() and outline is not None:
-            row["delta_best"], row["delta_status"] = best_tolerance(outline, grasps[int(np.argmax(eps))])
+            row["delta_best"], row["delta_status"] = best_tolerance(outline, grasps[int(np.argmax(eps))],
+                                                                    subject.image)
         rows.append(row)
         grasp_rows += [{"object": subject.name, **_route_fields(route, settings), "certified": bool(c),
                         "eps": float(e)} for c, e in zip(ok, eps)]
     return _with_ratios(rows), grasp_rows
 
 
-def best_tolerance(outline: Outline, grasp: Grasp) -> tuple[float | None, str]:
+def best_tolerance(outline: Outline, grasp: Grasp, image: np.ndarray | None = None) -> tuple[float | None, str]:
     """Certified tolerance of a certified grasp on the outline it was planned on: ``(delta as a
     fraction of the object's size, status)`` (:data:`OBJECT_COLUMNS`). A contact on a corner or
-    off the outline's elements has no stretch to slide on: tolerance 0, status ``none: <why>``."""
+    off the outline's elements has no stretch to slide on: tolerance 0, status ``none: <why>``.
+
+    ``outline`` is the image's outline at the default scale; a qualitative grasp synthesised at a
+    coarser scale (its field ``scale``) keeps the feasible regions of that scale (as
+    :func:`qualgrasp.qualitative.synthesis.synthesize` does), read from ``image``."""
+    scale = grasp.meta.get("scale")
+    regions = None
+    if image is not None and scale is not None and scale != outline.scale:
+        regions = feasible_regions(outline_image(image, scale=scale, largest=True))
     try:
-        found = independent_grasp(outline, grasp)
+        found = independent_grasp(outline, grasp, regions=regions)
     except GraspError as err:
         return 0.0, f"none: {err}"
     return float(found.delta_fraction), found.status

@@ -183,6 +183,10 @@ def synthesize_command(
                                          + ", ".join(f"{p.name} ({p.fingers} fingers, {p.model})"
                                                      for p in procedures.procedures())
                                          + "; instead of --fingers."),
+    scale: float | None = typer.Option(None, "--scale", help="Outline scale for regions and procedures "
+                                       "(Gaussian sigma as a fraction of the perimeter, 0.001 to 0.032); "
+                                       "default the finger's scale, with coarser scales tried when "
+                                       "nothing is found."),
     no_tolerance: bool = typer.Option(False, "--no-tolerance", help="Skip the certified tolerance (independent "
                                       "contact regions) of each grasp, about 0.05 to 0.5 s per grasp."),
 ) -> None:
@@ -216,7 +220,7 @@ def synthesize_command(
             output_file(plot, "--plot", suffixes=FIGURE_SUFFIXES, reads=[image, output])
         result = synthesize(image, fingers, mu, None if theta_min is None else math.radians(theta_min),
                             alpha, procedure=procedure, threshold=threshold, largest=largest,
-                            tolerance=not no_tolerance)
+                            tolerance=not no_tolerance, scale=scale)
     except (QualitativeError, ValueError) as err:
         _fail(str(err))
     try:
@@ -227,9 +231,8 @@ def synthesize_command(
         _save(synthesis_figure(result, read_image(image)), plot, 110)
     friction = "frictionless" if result.mu is None else f"mu {result.mu:.4g}"
     if not result.grasps:
-        typer.echo(f"no grasp found: {result.procedure.title} ({result.fingers} fingers, {friction}) on "
-                   f"{len(result.regions)} "
-                   f"feasible region(s) of {result.outline.string}; wrote an empty grasp set to {output}")
+        typer.echo(f"no grasp found: {result.procedure.title} ({result.fingers} fingers, {friction}): "
+                   f"{result.reason}; wrote an empty grasp set to {output}")
         return
     for grasp, report, ok, good in zip(result.grasps, result.reports, result.certified, result.resolved):
         eps = report.epsilons["L1"].hi if report.epsilons else float("nan")
@@ -241,7 +244,7 @@ def synthesize_command(
                    f"margin {report.force.margin:.4f}\teps {eps:.4f}{tol}\t{verdict}")
     s = result.summary()
     typer.echo(f"{s['grasps']} grasp(s) by {result.procedure.title} ({result.fingers} fingers, {friction}) "
-               f"-> {output}; "
+               f"at outline scale {result.scale:.4g} ({result.outline.string}) -> {output}; "
                f"{100 * s['certified_fraction']:.0f} % certified, {s['resolved']} resolved by the image; "
                f"synthesis {s['seconds']:.2f} s, certification {s['certify_seconds']:.2f} s"
                + ("" if s["median_delta_fraction"] is None else

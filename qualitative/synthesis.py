@@ -18,6 +18,21 @@ comparable across procedures -- with the id ``<name>-<tag>-0007`` (the procedure
 (``zone_depth`` for FormGrasp, ``cone_margin`` in radians for ForceGrasp). Each is then certified by :func:`qualgrasp.certify.certify_grasp`;
 a synthesised grasp that does not certify is a bug of the synthesis, and is reported, not dropped.
 
+The finger's scale
+------------------
+A finger cannot feel a bump smaller than its pad, so feasible regions and the procedures work on
+the outline at the **finger's scale** (:func:`qualgrasp.qualitative.outline.finger_scale` of the
+pad width ``finger_width``, a fraction of the object's size; never finer than the default scale
+0.004), while contacts stay on the one contour the image gives (the same samples at every scale)
+and curved regions carry the normals of the outline at the default (fine) scale, so that the
+procedure's reasoning and the certification see the same contacts and normals; a straight region
+keeps the normal of its fitted line, its points those of the contour. When the procedure finds nothing there, the next coarser
+scales of the outline's hierarchy (:func:`qualgrasp.qualitative.outline.outline_scales`) are
+tried, at most :data:`FALLBACK_SCALES` of them, and last the default scale (details finer than
+the finger; the scale reported says so) (:func:`search_scales`). ``scale`` fixes one scale (no
+fallback). :attr:`Synthesis.scale` is the scale the grasps come from, and
+:attr:`Synthesis.reason` says why nothing was found.
+
 Certified tolerance
 -------------------
 With ``tolerance`` (the default), every certified grasp also gets its **independent contact
@@ -66,12 +81,13 @@ from .errors import SynthesisError
 from .forcegrasp import MARGIN, friction
 from .formgrasp import ERROR
 from .independent import independent_grasp
-from .outline import Outline, outline_image
+from .outline import DEFAULT_SCALE, SCALE_MAX, Outline, finger_scale, outline_image, outline_scales
 from .procedures import Procedure, SearchInput
 from .regions import ALPHA, FINGER_WIDTH, MARGIN as REGION_MARGIN, Region, feasible_regions
 from .vision import ImageSource
 
-__all__ = ["MU", "POSITION", "NORMAL", "Synthesis", "synthesize", "to_grasp", "choose", "resolution"]
+__all__ = ["MU", "POSITION", "NORMAL", "FALLBACK_SCALES", "FALLBACK_STEP", "Synthesis", "synthesize", "to_grasp", "choose",
+           "resolution", "search_scales"]
 
 MU = 0.5
 """Default friction coefficient of procedures with friction."""
@@ -82,6 +98,14 @@ POSITION = 1.0
 NORMAL = 0.5
 """Error of the contour across the length a normal is estimated over, pixels: a normal estimated
 over ``l`` pixels is known to ``NORMAL / l`` radians."""
+
+FALLBACK_SCALES = 4
+"""Coarser scales of the outline's hierarchy tried, one after the other, when a procedure finds
+nothing at the finger's scale (up to :data:`qualgrasp.qualitative.outline.SCALE_MAX`)."""
+
+FALLBACK_STEP = 1.4
+"""Smallest ratio between consecutive scales tried: the starts of the hierarchy's intervals are
+taken only when at least this much coarser than the previous scale tried."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -124,6 +148,14 @@ class Synthesis:
         Per grasp, its certified independent contact regions (module notes), None when not
         computed (``tolerance=False``, no certification, or the grasp not certified); empty when
         not asked for.
+    scale : float
+        The outline's scale the regions and grasps come from (fraction of the perimeter; module
+        notes); ``outline`` is the outline at that scale.
+    scales_tried : tuple of float
+        Every scale tried, in order (the last is ``scale``).
+    reason : str or None
+        Why no grasp was found (None when some were): no feasible region at any scale tried, or
+        feasible regions on which the procedure found no grasp.
     """
 
     name: str
@@ -142,6 +174,9 @@ class Synthesis:
     seconds: float
     certify_seconds: float
     tolerances: tuple[IndependentRegions | None, ...] = ()
+    scale: float = DEFAULT_SCALE
+    scales_tried: tuple[float, ...] = ()
+    reason: str | None = None
 
     @property
     def deltas(self) -> tuple[float | None, ...]:
@@ -187,6 +222,8 @@ class Synthesis:
             "median_margin": float(np.median([r.force.margin for r in ok])) if ok else None,
             "median_eps_l1": float(np.median(eps)) if eps else None,
             "median_delta_fraction": float(np.median(deltas)) if deltas else None,
+            "scale": self.scale,
+            "reason": self.reason,
             "seconds": self.seconds,
             "certify_seconds": self.certify_seconds,
         }
@@ -289,7 +326,7 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
                threshold: float | None = None, largest: bool = False, finger_width: float = FINGER_WIDTH,
                region_margin: float = REGION_MARGIN, step: float = STEP, inset: float = INSET,
                per_region: int = PER_REGION, error: float = ERROR, margin: float = MARGIN,
-               tolerance: bool = True) -> Synthesis:
+               tolerance: bool = True, scale: float | None = None) -> Synthesis:
     """Synthesise and certify grasps of the object in an image.
 
     Parameters
@@ -330,6 +367,9 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     tolerance : bool
         With ``certify``, give every certified grasp its certified tolerance ``delta``
         (independent contact regions, module notes; about 0.05 to 0.5 s per grasp).
+    scale : float, optional
+        The outline's scale (fraction of the perimeter, in ``[0.001, 0.032]``) for regions and
+        procedures; default the finger's scale with coarser fallbacks (module notes).
 
     Returns
     -------
@@ -362,27 +402,87 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
         mu, theta_min = friction(mu, theta_min)
     if not (math.isfinite(alpha) and alpha >= 0):
         raise SynthesisError(f"alpha must be finite and >= 0, got {alpha}")
+    if scale is not None and not (math.isfinite(scale) and DEFAULT_SCALE / 4 <= scale <= SCALE_MAX):
+        raise SynthesisError(f"scale must be in [{DEFAULT_SCALE / 4:g}, {SCALE_MAX:g}] (fraction of the perimeter), "
+                             f"got {scale}")
     start = time.perf_counter()
-    outline = outline_image(image, threshold=threshold, largest=largest)
-    regions = tuple(feasible_regions(outline, alpha, finger_width, region_margin))
-    cands = candidates(outline, regions, step, inset, per_region)
-    center, length = object_frame(outline.contour)
-    found = proc.search(SearchInput(cands, outline.contour, center, length, outline.size, theta_min,
-                                    error, margin))
+    fine = outline_image(image, threshold=threshold, largest=largest)
+    center, length = object_frame(fine.contour)
+    tried: list[float] = []
+    most = 0  # most feasible regions at any scale tried, for the reason
+    for s in search_scales(image, fine, finger_width, scale, threshold=threshold, largest=largest):
+        tried.append(s)
+        outline = fine if s == fine.scale else outline_image(image, scale=s, threshold=threshold, largest=largest)
+        regions = _fine_normals(tuple(feasible_regions(outline, alpha, finger_width, region_margin)), fine, outline)
+        most = max(most, len(regions))
+        cands = candidates(outline, regions, step, inset, per_region)
+        found = proc.search(SearchInput(cands, outline.contour, center, length, outline.size, theta_min,
+                                        error, margin))
+        if found:
+            break
+    reason = None if found else _reason(proc, tried, most)
     stem = _name(image, name)
     grasps = []
     for k, g in enumerate(found):
         grasp = to_grasp(g, f"{stem}-{proc.tag}-{k:04d}", center, length, mu, proc)
         grasp.meta["resolution"] = resolution(grasp, _spans(outline, regions, g))
+        grasp.meta["scale"] = outline.scale
         grasps.append(grasp)
     grasps = tuple(grasps)
     seconds = time.perf_counter() - start
     start = time.perf_counter()
     reports = tuple(_certified(g, quality) for g in grasps) if certify else ()
-    tolerances = tuple(_tolerance(outline, regions, g, r) for g, r in zip(grasps, reports)) if tolerance else ()
+    tolerances = tuple(_tolerance(fine, regions, g, r) for g, r in zip(grasps, reports)) if tolerance else ()
     return Synthesis(stem, proc.fingers, proc, mu, theta_min, outline, regions, cands,
                      center, length, tuple(found), grasps, reports, seconds, time.perf_counter() - start,
-                     tolerances)
+                     tolerances, outline.scale, tuple(tried), reason)
+
+
+def search_scales(image: ImageSource, fine: Outline, finger_width: float, scale: float | None = None, *,
+                  threshold: float | None = None, largest: bool = False):
+    """The outline scales synthesis tries, in order (module notes): ``scale`` alone when given;
+    else the finger's scale (never finer than the default), then up to :data:`FALLBACK_SCALES`
+    coarser scales of the outline's hierarchy, each the start of an interval with another string
+    and at least :data:`FALLBACK_STEP` times the previous scale, and last the default (fine) scale. A generator: the hierarchy is computed only when the first
+    scale is not enough."""
+    if scale is not None:
+        yield scale
+        return
+    first = max(fine.scale, finger_scale(fine, finger_width))
+    yield first
+    last, count = first, 0
+    for iv in outline_scales(image, threshold=threshold, largest=largest):
+        # real outlines change string at many nearby fine scales: step by a factor at least
+        if iv.lo >= last * FALLBACK_STEP and count < FALLBACK_SCALES:
+            yield iv.lo
+            last, count = iv.lo, count + 1
+    if first > fine.scale:
+        yield fine.scale  # last resort: details finer than the finger, flagged by the scale reported
+
+
+def _fine_normals(regions: tuple[Region, ...], fine: Outline, outline: Outline) -> tuple[Region, ...]:
+    """Regions of ``outline`` (a coarser scale of ``fine``; the contour is the same at every
+    scale) with the fine outline's normals on curves and, on straight regions, the contour's own
+    points (a coarse fitted line may pass pixels away from a bumpy edge) with the line's normal."""
+    if outline is fine:
+        return regions
+    normals = np.asarray(fine.normals())
+    n = len(fine.contour)
+    out = []
+    for r in regions:
+        idx = np.arange(r.start, r.stop) % n
+        out.append(replace(r, points=fine.contour[idx]) if r.type == "/" else replace(r, normals=normals[idx]))
+    return tuple(out)
+
+
+def _reason(proc: Procedure, tried: list[float], regions: int) -> str:
+    """Why ``proc`` found nothing at the scales ``tried`` (``regions``: the most feasible regions
+    at any of them)."""
+    at = ", ".join(f"{s:.4g}" for s in tried)
+    if not regions:
+        return f"no feasible region at the scales tried ({at})"
+    return (f"{proc.title} found no grasp on up to {regions} feasible region(s) at the scales tried ({at}): "
+            + proc.failure)
 
 
 def _tolerance(outline: Outline, regions: tuple[Region, ...], grasp: Grasp,

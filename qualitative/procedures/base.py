@@ -82,6 +82,9 @@ class Procedure:
         ``meta(found) -> dict`` of extra fields recorded on each grasp.
     description : str
         One line for help texts.
+    failure : str
+        What it means that the search found nothing, for messages (the condition no candidate
+        tuple met).
     """
 
     name: str
@@ -94,6 +97,7 @@ class Procedure:
     score: Callable[[Any], float]
     meta: Callable[[Any], dict]
     description: str = ""
+    failure: str = "no candidate tuple met its condition"
 
     @property
     def friction(self) -> bool:

@@ -25,4 +25,6 @@ def _search(s: SearchInput) -> list[ForceGrasp]:
 FORCEGRASP2 = register(Procedure(
     name="forcegrasp2", title="ForceGrasp", fingers=2, model="point", tag="force2", colour="tab:blue",
     search=_search, score=lambda g: g.margin, meta=force_meta,
-    description="two fingers with friction: the grasp line inside both friction cones (Nguyen)"))
+    description="two fingers with friction: the grasp line inside both friction cones (Nguyen)",
+    failure="no pair of candidate contacts has its grasp line inside both friction "
+            "cones (Nguyen's condition, theta_min with the angular margin)"))

@@ -19,4 +19,6 @@ FORCEGRASP3 = register(Procedure(
     name="forcegrasp3", title="ForceGrasp", fingers=3, model="point", tag="force3", colour="tab:orange",
     search=_search, score=lambda g: g.margin, meta=force_meta,
     description="three fingers with friction: a common point of the friction cones, normals "
-                "spanning the plane (Ponce and Faverjon)"))
+                "spanning the plane (Ponce and Faverjon)",
+    failure="no three candidate contacts have normals that positively span the plane "
+            "and friction cones with a common point"))

@@ -16,4 +16,6 @@ def _search(s: SearchInput) -> list[FormGrasp]:
 FORMGRASP = register(Procedure(
     name="formgrasp", title="FormGrasp", fingers=4, model="frictionless", tag="form", colour="tab:purple",
     search=_search, score=lambda g: -g.depth, meta=lambda g: {"zone_depth": g.depth},
-    description="four frictionless fingers until the zone of freedom is empty (Reuleaux, Nielsen)"))
+    description="four frictionless fingers until the zone of freedom is empty (Reuleaux, Nielsen)",
+    failure="the zones of freedom of no candidate tuple close within four "
+            "frictionless contacts"))

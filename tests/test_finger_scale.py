@@ -1,0 +1,107 @@
+"""Synthesis at the finger's scale (issue 15, parts 2 and 3): regions and procedures on the
+outline at the pad's scale, contacts and normals of the fine contour, coarser scales when nothing
+is found, the scale reported, and why nothing was found."""
+
+import cv2
+import numpy as np
+import pytest
+from shapely.geometry import Point
+from typer.testing import CliRunner
+
+from qualgrasp.certify import force_closure
+from qualgrasp.cli import app
+from qualgrasp.experiments.silhouettes import select_cells
+from qualgrasp.qualitative.errors import SynthesisError
+from qualgrasp.qualitative.objects import render, render_polygon, shape
+from qualgrasp.qualitative.outline import DEFAULT_SCALE, finger_scale, outline_image
+from qualgrasp.qualitative.regions import FINGER_WIDTH
+from qualgrasp.qualitative.synthesis import FALLBACK_STEP, synthesize
+
+
+def _bumpy_square():
+    """The square with six semicircular bumps and dents of 5 to 7 % of its side (about half a
+    finger pad), read as angles at the default scale (as in tests/test_outline_scales.py)."""
+    square = shape("square")
+    v = np.asarray(square.exterior.coords)[:-1]
+    side = float(np.linalg.norm(v[1] - v[0]))
+    geometry = square
+    for edge, t, diameter, sign in [(0, 0.25, 0.07, +1), (0, 0.75, 0.06, -1), (1, 0.5, 0.07, -1),
+                                    (2, 0.25, 0.05, +1), (2, 0.5, 0.07, +1), (3, 0.75, 0.06, -1)]:
+        disc = Point(v[edge] + t * (v[(edge + 1) % 4] - v[edge])).buffer(diameter * side / 2, quad_segs=32)
+        geometry = geometry.union(disc) if sign > 0 else geometry.difference(disc)
+    return render_polygon(geometry)
+
+
+def test_bumps_smaller_than_the_finger_are_ignored():
+    clean = synthesize(render("square"), 2, quality=False, tolerance=False)
+    bumpy = _bumpy_square()
+    fine = outline_image(bumpy)
+    assert fine.string != "/>/>/>/>"  # at the default scale the bumps are read as angles
+    s = synthesize(bumpy, 2, quality=False, tolerance=False)
+    assert s.outline.string == "/>/>/>/>" and s.scale == pytest.approx(finger_scale(fine, FINGER_WIDTH))
+    assert len(s.grasps) == len(clean.grasps) > 0 and all(s.certified)
+
+
+def test_contacts_are_on_the_fine_contour_with_its_normals():
+    cell = select_cells(24)
+    image = next(c for c in cell if c.name == "cell-057-dlm8-control").image()
+    s = synthesize(image, 2, quality=False, tolerance=False, largest=True)
+    assert s.grasps and all(s.certified) and s.scale > DEFAULT_SCALE
+    fine = outline_image(image, largest=True)
+    normals = np.asarray(fine.normals())
+    curved = 0
+    for found in s.found:
+        assert len(found.regions) == len(found.points)
+        for p, n, r in zip(found.points, found.normals, found.regions):
+            d = np.linalg.norm(fine.contour - p, axis=1)
+            assert d.min() < 1.0  # on the contour the image gives
+            if s.regions[r].type != "/":  # a curve's normal is the fine outline's
+                curved += 1
+                assert np.dot(n, normals[int(np.argmin(d))]) > np.cos(np.radians(2))
+    assert curved
+
+
+@pytest.mark.parametrize("name", ["cell-057-dlm8-control", "cell-586-dunn-jasp"])
+def test_cells_with_nothing_at_the_default_scale_get_certified_grasps(name):
+    image = next(c for c in select_cells(24) if c.name == name).image()
+    assert not synthesize(image, 2, quality=False, tolerance=False, largest=True, scale=DEFAULT_SCALE).grasps
+    s = synthesize(image, 2, quality=False, tolerance=False, largest=True)
+    assert s.grasps and all(s.certified)
+    assert all(force_closure(g).status == "closure" for g in s.grasps)
+    tried = s.scales_tried
+    assert tried[-1] == s.scale and all(b >= a * FALLBACK_STEP for a, b in zip(tried, tried[1:]) if b > a)
+
+
+def test_a_given_scale_is_the_only_one_tried():
+    s = synthesize(render("polygon"), 2, quality=False, tolerance=False, scale=0.01)
+    assert s.scales_tried == (0.01,) and s.scale == 0.01 and s.outline.scale == 0.01
+    with pytest.raises(SynthesisError, match="scale"):
+        synthesize(render("polygon"), 2, scale=0.5)
+
+
+def test_why_nothing_was_found():
+    disc = synthesize(render("disc"), procedure="formgrasp", quality=False, tolerance=False)
+    assert not disc.grasps and "zones of freedom" in disc.reason and "FormGrasp" in disc.reason
+    square = synthesize(render("square"), procedure="forcegrasp3", quality=False, tolerance=False)
+    assert not square.grasps and "positively span" in square.reason
+    blank = np.full((200, 200), 230, np.uint8)
+    cv2.circle(blank, (100, 100), 60, 30, -1)
+    two = synthesize(blank, procedure="forcegrasp2", mu=0.01, quality=False, tolerance=False)
+    assert two.grasps or "friction cones" in two.reason
+    assert synthesize(render("polygon"), 2, quality=False, tolerance=False).reason is None
+
+
+def test_synthesize_command_reports_the_scale_and_the_reason(tmp_path):
+    image = tmp_path / "disc.png"
+    cv2.imwrite(str(image), render("disc"))
+    runner = CliRunner()
+    out = runner.invoke(app, ["synthesize", str(image), "--fingers", "2", "-o", str(tmp_path / "g.jsonl")])
+    assert out.exit_code == 0 and "at outline scale" in out.output
+    out = runner.invoke(app, ["synthesize", str(image), "--fingers", "4", "-o", str(tmp_path / "g.jsonl")])
+    assert out.exit_code == 0 and "no grasp found" in out.output and "zones of freedom" in out.output
+    out = runner.invoke(app, ["synthesize", str(image), "--fingers", "2", "--scale", "0.01",
+                              "-o", str(tmp_path / "g.jsonl")])
+    assert out.exit_code == 0 and "at outline scale 0.01" in out.output
+    out = runner.invoke(app, ["synthesize", str(image), "--fingers", "2", "--scale", "1",
+                              "-o", str(tmp_path / "g.jsonl")])
+    assert out.exit_code == 2 and "scale" in out.output
