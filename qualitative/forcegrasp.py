@@ -53,7 +53,7 @@ from .candidates import GAP, Candidates, separated
 from .errors import SynthesisError
 
 __all__ = ["MARGIN", "GAP", "ForceGrasp", "friction", "nguyen_angles", "span_margin",
-           "positively_spans", "pair_grasps", "triplet_grasps", "friction_cone", "friction_zone"]
+           "positively_spans", "pair_grasps", "best_pair_angle", "triplet_grasps", "friction_cone", "friction_zone"]
 
 MARGIN = 0.25
 GRID = 40
@@ -151,6 +151,19 @@ def _check(theta_min: float, margin: float, gap: float) -> None:
         raise SynthesisError(f"theta_min must lie strictly between 0 and pi/2 radians, got {theta_min}")
     if not (0 <= margin < 1 and gap >= 0):
         raise SynthesisError(f"need 0 <= margin < 1 (a fraction of theta_min) and gap >= 0, got {margin} and {gap}")
+
+
+def best_pair_angle(cands: Candidates, size: float, *, gap: float = GAP) -> float | None:
+    """The best two-finger candidate pair for Nguyen's condition: the smallest, over pairs of
+    candidates at least ``gap * size`` apart, of the larger of their two angles to the grasp line
+    (radians); a pair is a grasp when this is below ``theta_min`` (less the margin). None when no
+    pair is far enough apart. Tells why :func:`pair_grasps` found nothing."""
+    P, N = np.asarray(cands.points), np.asarray(cands.normals)
+    A, B = np.nonzero(np.triu(separated(cands.points, gap, size), 1))
+    if not len(A):
+        return None
+    t1, t2 = nguyen_angles(P[A], N[A], P[B], N[B])
+    return float(np.maximum(t1, t2).min())
 
 
 def pair_grasps(cands: Candidates, theta_min: float, size: float, *, margin: float = MARGIN,

@@ -416,11 +416,11 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
         regions = _fine_normals(tuple(feasible_regions(outline, alpha, finger_width, region_margin)), fine, outline)
         most = max(most, len(regions))
         cands = candidates(outline, regions, step, inset, per_region)
-        found = proc.search(SearchInput(cands, outline.contour, center, length, outline.size, theta_min,
-                                        error, margin))
+        search = SearchInput(cands, outline.contour, center, length, outline.size, theta_min, error, margin)
+        found = proc.search(search)
         if found:
             break
-    reason = None if found else _reason(proc, tried, most)
+    reason = None if found else _reason(proc, tried, most, search)
     stem = _name(image, name)
     grasps = []
     for k, g in enumerate(found):
@@ -475,14 +475,16 @@ def _fine_normals(regions: tuple[Region, ...], fine: Outline, outline: Outline) 
     return tuple(out)
 
 
-def _reason(proc: Procedure, tried: list[float], regions: int) -> str:
+def _reason(proc: Procedure, tried: list[float], regions: int, search: SearchInput) -> str:
     """Why ``proc`` found nothing at the scales ``tried`` (``regions``: the most feasible regions
-    at any of them)."""
+    at any of them; ``search``: the last scale's input, for the procedure's own diagnosis)."""
     at = ", ".join(f"{s:.4g}" for s in tried)
     if not regions:
         return f"no feasible region at the scales tried ({at})"
-    return (f"{proc.title} found no grasp on up to {regions} feasible region(s) at the scales tried ({at}): "
-            + proc.failure)
+    why = proc.failure
+    if proc.diagnose is not None and len(search.candidates.points):
+        why += f" ({proc.diagnose(search)} at scale {tried[-1]:.4g})"
+    return f"{proc.title} found no grasp on up to {regions} feasible region(s) at the scales tried ({at}): {why}"
 
 
 def _tolerance(outline: Outline, regions: tuple[Region, ...], grasp: Grasp,

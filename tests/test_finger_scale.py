@@ -2,10 +2,12 @@
 outline at the pad's scale, contacts and normals of the fine contour, coarser scales when nothing
 is found, the scale reported, and why nothing was found."""
 
+import re
+
 import cv2
 import numpy as np
 import pytest
-from shapely.geometry import Point
+from shapely.geometry import Point, Polygon
 from typer.testing import CliRunner
 
 from qualgrasp.certify import force_closure
@@ -89,6 +91,20 @@ def test_why_nothing_was_found():
     two = synthesize(blank, procedure="forcegrasp2", mu=0.01, quality=False, tolerance=False)
     assert two.grasps or "friction cones" in two.reason
     assert synthesize(render("polygon"), 2, quality=False, tolerance=False).reason is None
+
+
+def test_two_fingers_on_a_triangle_say_the_best_angle():
+    """On an equilateral triangle two fingers on different edges see each other at best 30
+    degrees off their normals (the normals are 120 degrees apart), so with mu = 0.3 (theta_min
+    16.7 degrees) there is no grasp, and the reason gives that angle."""
+    a = np.radians([90, 210, 330])
+    image = render_polygon(Polygon(np.c_[256 + 150 * np.cos(a), 256 + 150 * np.sin(a)]), 512)
+    s = synthesize(image, procedure="forcegrasp2", mu=0.3, quality=False, tolerance=False)
+    assert not s.grasps
+    angle = float(re.search(r"larger angle to the grasp line is ([0-9.]+) degrees", s.reason).group(1))
+    assert angle == pytest.approx(30.0, abs=1.0)
+    assert "theta_min 16.7" in s.reason
+    assert synthesize(image, procedure="forcegrasp2", mu=1.0, quality=False, tolerance=False).grasps
 
 
 def test_synthesize_command_reports_the_scale_and_the_reason(tmp_path):

@@ -85,6 +85,9 @@ class Procedure:
     failure : str
         What it means that the search found nothing, for messages (the condition no candidate
         tuple met).
+    diagnose : callable, optional
+        ``diagnose(SearchInput) -> str``: the best near-miss of a search that found nothing, in
+        the condition's own terms (e.g. the best angle against ``theta_min``), for messages.
     """
 
     name: str
@@ -98,6 +101,7 @@ class Procedure:
     meta: Callable[[Any], dict]
     description: str = ""
     failure: str = "no candidate tuple met its condition"
+    diagnose: Callable[[SearchInput], str] | None = None
 
     @property
     def friction(self) -> bool:

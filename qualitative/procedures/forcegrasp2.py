@@ -3,7 +3,9 @@ contacts with friction; see :func:`qualgrasp.qualitative.forcegrasp.pair_grasps`
 
 from __future__ import annotations
 
-from ..forcegrasp import ForceGrasp, pair_grasps
+import math
+
+from ..forcegrasp import ForceGrasp, best_pair_angle, pair_grasps
 from .base import Procedure, SearchInput, register
 
 __all__ = ["FORCEGRASP2", "force_meta"]
@@ -22,9 +24,18 @@ def _search(s: SearchInput) -> list[ForceGrasp]:
     return pair_grasps(s.candidates, s.theta_min, s.size, margin=s.margin)
 
 
+def _diagnose(s: SearchInput) -> str:
+    best = best_pair_angle(s.candidates, s.size)
+    if best is None:
+        return "no two candidate contacts are far enough apart for two fingers"
+    limit = (1 - s.margin) * s.theta_min
+    return (f"the best pair's larger angle to the grasp line is {math.degrees(best):.1f} degrees, against "
+            f"theta_min {math.degrees(s.theta_min):.1f} less the margin ({math.degrees(limit):.1f})")
+
+
 FORCEGRASP2 = register(Procedure(
     name="forcegrasp2", title="ForceGrasp", fingers=2, model="point", tag="force2", colour="tab:blue",
-    search=_search, score=lambda g: g.margin, meta=force_meta,
+    search=_search, score=lambda g: g.margin, meta=force_meta, diagnose=_diagnose,
     description="two fingers with friction: the grasp line inside both friction cones (Nguyen)",
     failure="no pair of candidate contacts has its grasp line inside both friction "
             "cones (Nguyen's condition, theta_min with the angular margin)"))
