@@ -172,8 +172,10 @@ def synthesize_command(
     mu: float | None = typer.Option(None, "--mu", help="Friction coefficient of ForceGrasp (default 0.5)."),
     theta_min: float | None = typer.Option(None, "--theta-min", help="Friction cone half-angle in degrees, "
                                            "instead of --mu (mu = tan(theta_min))."),
-    alpha: float = typer.Option(0.5, "--alpha", help="Bounding-circle diameter threshold of curves, "
-                                "as a fraction of the object's size (its enclosing circle's diameter)."),
+    alpha: float | None = typer.Option(None, "--alpha", help="Bounding-circle diameter threshold of curves, "
+                                       "as a fraction of the object's size (its enclosing circle's diameter); "
+                                       "default 0.5, relaxed to the finger's width (0.08) when nothing is "
+                                       "found. Given, it is the only one tried."),
     plot: Path | None = typer.Option(None, "--plot", help="Save a figure of the best grasps (PNG): "
                                      "contacts, normals, friction cones, zones of freedom."),
     largest: bool = typer.Option(False, "--largest", help="With several objects, use the largest whole one."),
@@ -214,7 +216,8 @@ def synthesize_command(
         if theta_min is not None:
             number_in(theta_min, "--theta-min (theta_min, the friction cone's half-angle)", 0, 90,
                       low_open=True, high_open=True, unit="degrees")
-        number_in(alpha, "--alpha", 0, 100, unit="(fraction of the object's size)")
+        if alpha is not None:
+            number_in(alpha, "--alpha", 0, 100, unit="(fraction of the object's size)")
         output_file(output, "-o", reads=[image])
         if plot is not None:
             output_file(plot, "--plot", suffixes=FIGURE_SUFFIXES, reads=[image, output])
@@ -244,7 +247,7 @@ def synthesize_command(
                    f"margin {report.force.margin:.4f}\teps {eps:.4f}{tol}\t{verdict}")
     s = result.summary()
     typer.echo(f"{s['grasps']} grasp(s) by {result.procedure.title} ({result.fingers} fingers, {friction}) "
-               f"at outline scale {result.scale:.4g} ({result.outline.string}) -> {output}; "
+               f"at outline scale {result.scale:.4g} ({result.outline.string}){_relaxed(result)} -> {output}; "
                f"{100 * s['certified_fraction']:.0f} % certified, {s['resolved']} resolved by the image; "
                f"synthesis {s['seconds']:.2f} s, certification {s['certify_seconds']:.2f} s"
                + ("" if s["median_delta_fraction"] is None else
@@ -259,6 +262,13 @@ def synthesize_command(
         raise typer.Exit(1)
 
 
+def _relaxed(result) -> str:
+    """`` with curves as round as the finger (alpha 0.08)`` when the curvature threshold was relaxed."""
+    if not result.alphas_tried or result.alpha == result.alphas_tried[0]:
+        return ""
+    return f" with curves as round as the finger (alpha {result.alpha:g})"
+
+
 def independent_regions_command(
     image: Path = typer.Argument(..., help="Image file (PNG, JPEG, anything OpenCV reads)."),
     grasps: Path = typer.Argument(..., help="Grasp set (JSON Lines, certify's format), contacts on the object."),
@@ -270,8 +280,9 @@ def independent_regions_command(
     normal_tol: float = typer.Option(0.0, "--normal-tol", help="Tolerance on the normals, degrees."),
     budget: int = typer.Option(SEARCH_BUDGET, help="Branch-and-bound work units per region tuple tried "
                                "(curved stretches)."),
-    alpha: float = typer.Option(0.5, "--alpha", help="Feasible regions: bounding-circle diameter threshold "
-                                "of curves, fraction of the object's size."),
+    alpha: float | None = typer.Option(None, "--alpha", help="Feasible regions: bounding-circle diameter "
+                                       "threshold of curves, fraction of the object's size (default: each "
+                                       "grasp's own field alpha, else 0.5)."),
     largest: bool = typer.Option(False, "--largest", help="With several objects, use the largest whole one."),
     threshold: float | None = typer.Option(None, "--threshold", help="Grey level separating object and "
                                            "background, in the image's units (default: Otsu's)."),
@@ -289,6 +300,8 @@ def independent_regions_command(
         typer.echo(f"error: --normal-tol must be in [0, {math.degrees(0.5):.1f}] degrees", err=True)
         raise typer.Exit(2)
     try:
+        if alpha is not None:
+            number_in(alpha, "--alpha", 0, 100, unit="(fraction of the object's size)")
         summary = independent_file(image, grasps, output, symmetric=not asymmetric, tol=tol, budget=budget,
                                    normal_tol=math.radians(normal_tol), alpha=alpha, threshold=threshold,
                                    largest=largest)

@@ -53,7 +53,8 @@ from .candidates import GAP, Candidates, separated
 from .errors import SynthesisError
 
 __all__ = ["MARGIN", "GAP", "ForceGrasp", "friction", "nguyen_angles", "span_margin",
-           "positively_spans", "pair_grasps", "best_pair_angle", "triplet_grasps", "friction_cone", "friction_zone"]
+           "positively_spans", "pair_grasps", "best_pair_angle", "triplet_grasps", "best_triplet_margins",
+           "friction_cone", "friction_zone"]
 
 MARGIN = 0.25
 GRID = 40
@@ -266,16 +267,77 @@ def triplet_grasps(cands: Candidates, contour: np.ndarray, theta_min: float, siz
         Ordered by region triplet.
     """
     _check(theta_min, margin, gap)
+    P, N = np.asarray(cands.points), np.asarray(cands.normals)
+    found = []
+    for triple, best in _triplets(cands, contour, theta_min, size, margin, gap, grid):
+        if best is None or best[1] < margin * theta_min:
+            continue
+        idx, score, x = best
+        ang = _angle(N[idx], x - P[idx])
+        found.append(ForceGrasp(tuple(int(i) for i in idx), P[idx], N[idx],
+                                tuple(int(cands.region[i]) for i in idx), tuple(float(v) for v in ang),
+                                float(score), x.copy(), theta_min))
+    return found
+
+
+def best_triplet_margins(cands: Candidates, contour: np.ndarray, theta_min: float, size: float, *,
+                         gap: float = GAP, grid: int = GRID) -> tuple[float | None, float | None]:
+    """Why :func:`triplet_grasps` found nothing, in numbers (radians): ``(normals, best)``.
+
+    ``normals`` is the largest spanning margin ``(pi - G) / 2`` of the normals of any three
+    candidates at least ``gap * size`` apart (``G`` their largest angular gap; positive when they
+    positively span the plane), ``best`` the largest margin of any triplet (the smallest of its
+    cone, force and normal spanning margins at its best meeting point, as :func:`triplet_grasps`
+    scores them; negative when no triplet's friction cones have a common point inside its
+    contact triangle). A triplet is a grasp when ``best`` reaches the margin. None where no three
+    candidates are far enough apart.
+
+    Examples
+    --------
+    The three normals of an equilateral triangle span the plane with a margin of 30 degrees:
+
+    >>> import numpy as np
+    >>> from qualgrasp.qualitative.candidates import Candidates
+    >>> a = np.radians([90, 210, 330])
+    >>> n = -np.c_[np.cos(a), np.sin(a)]
+    >>> c = Candidates(-50 * n, n, np.arange(3), np.full(3, 10.0))
+    >>> normals, best = best_triplet_margins(c, -100 * n, np.radians(30), 200)
+    >>> round(float(np.degrees(normals)), 1), bool(best > 0)
+    (30.0, True)
+    """
+    far = separated(cands.points, gap, size)
+    scores = [best[1] for _, best in _triplets(cands, contour, theta_min, size, -1.0, gap, grid)
+              if best is not None]
+    return _best_spread(np.asarray(cands.normals), far), (max(scores) if scores else None)
+
+
+def _best_spread(N: np.ndarray, far: np.ndarray) -> float | None:
+    """Largest spanning margin of the normals of three pairwise ``far`` candidates (None: no such three)."""
+    best = None
+    for i in range(len(N) - 2):
+        rest = np.flatnonzero(far[i, i + 1:]) + i + 1
+        j, k = (rest[t] for t in np.triu_indices(len(rest), 1))
+        j, k = j[far[j, k]], k[far[j, k]]
+        if len(j):
+            m = float(span_margin(np.stack([np.broadcast_to(N[i], N[j].shape), N[j], N[k]], axis=1)).max())
+            best = m if best is None else max(best, m)
+    return best
+
+
+def _triplets(cands: Candidates, contour: np.ndarray, theta_min: float, size: float, margin: float,
+              gap: float, grid: int):
+    """Every region triplet with its best ``(contacts, margin, meeting point)`` (None when it has
+    no admissible contacts); a region used more than once keeps the point triples whose normals
+    span with ``margin``."""
     if grid < 2:
         raise SynthesisError(f"grid must be at least 2, got {grid}")
     P, N = np.asarray(cands.points), np.asarray(cands.normals)
     X = _grid(np.asarray(contour, dtype=float), size, grid)
     if not len(P) or not len(X):
-        return []
+        return
     far = separated(cands.points, gap, size)
     regions = np.unique(cands.region)
     curved = {int(r): len(np.unique(np.round(N[cands.of_region(r)], 9), axis=0)) > 1 for r in regions}
-    found = []
     for triple in itertools.combinations_with_replacement(regions, 3):
         if len(set(triple)) < 3 and not all(curved[int(r)] for r in triple if triple.count(r) > 1):
             continue  # two contacts on one straight region share their normal: never spanning
@@ -285,16 +347,9 @@ def triplet_grasps(cands: Candidates, contour: np.ndarray, theta_min: float, siz
             # the normals' spanning margin bounds the score whatever the meeting point
             combos = combos[:, span_margin(np.moveaxis(N[combos], 0, 1)) >= margin * theta_min]
             if not combos.shape[1]:
+                yield triple, None
                 continue
-        best = _search(triple, combos, X, size / grid, cands, far, theta_min)
-        if best is None or best[1] < margin * theta_min:
-            continue
-        idx, score, x = best
-        ang = _angle(N[idx], x - P[idx])
-        found.append(ForceGrasp(tuple(int(i) for i in idx), P[idx], N[idx],
-                                tuple(int(cands.region[i]) for i in idx), tuple(float(v) for v in ang),
-                                float(score), x.copy(), theta_min))
-    return found
+        yield triple, _search(triple, combos, X, size / grid, cands, far, theta_min)
 
 
 def _search(triple, combos, X, step, cands, far, theta_min, keep: int = 8):

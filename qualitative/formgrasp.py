@@ -52,7 +52,7 @@ from .candidates import GAP, Candidates, separated
 from .errors import SynthesisError
 from .zones import Zones, free_depth, unit_wrenches, zones
 
-__all__ = ["ERROR", "FormGrasp", "form_grasps", "closure_depth4", "line_of_action_exit", "ray_edges",
+__all__ = ["ERROR", "FormGrasp", "form_grasps", "deepest_closure", "closure_depth4", "line_of_action_exit", "ray_edges",
            "zone_steps"]
 
 ERROR = 2.0
@@ -179,6 +179,38 @@ def form_grasps(cands: Candidates, contour: np.ndarray, center: np.ndarray, leng
                                tuple(int(cands.region[i]) for i in idx), s,
                                line_of_action_exit(P[s], N[s], contour), depths[-1], tuple(depths)))
     return found
+
+
+def deepest_closure(cands: Candidates, center: np.ndarray, length: float, size: float, *,
+                    gap: float = GAP) -> float:
+    """Why :func:`form_grasps` found nothing, in numbers: the depth of the emptiest zone of
+    freedom any four candidates at least ``gap * size`` apart leave (negative: the zone is empty;
+    ``+inf`` when every set of four leaves free motions). A start point gives a grasp when its
+    depth is below ``-error / length``.
+
+    Examples
+    --------
+    Four contacts on a square's sides, each off its side's centre by 15 % of the side: two
+    opposite pairs offset the same way close the zone of freedom; a pinwheel (every offset turning
+    the same way) leaves rotations one way free:
+
+    >>> import numpy as np
+    >>> from qualgrasp.qualitative.candidates import Candidates
+    >>> n = np.array([[0, 1], [-1, 0], [0, -1], [1, 0]], float)
+    >>> def square(offsets):
+    ...     a, b, c, d = offsets
+    ...     p = np.array([[a, -100], [100, b], [c, 100], [-100, d]], float)
+    ...     return deepest_closure(Candidates(p, n, np.arange(4), np.full(4, 10.0)), np.zeros(2), 141.4, 283)
+    >>> round(square([30, -30, -30, 30]), 3)
+    -0.191
+    >>> square([30, 30, -30, -30])
+    inf
+    """
+    P, N = np.asarray(cands.points), np.asarray(cands.normals)
+    if len(P) < 4:
+        return np.inf
+    _, depth = _best_completions(unit_wrenches(P, N, center, length), separated(P, gap, size))
+    return float(depth.min())
 
 
 def _det(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:

@@ -15,7 +15,9 @@ Readings (pixels of the input image, x = column, y = row):
   (so points and normals describe one curve; the raw contour differs from it by pixel noise).
 * **Limits.** A finger must stay in the feasible region it lies on (a region's points are where
   the centre of a finger pad may go), or, off every region, on its outline element; a contact on a
-  corner or a cusp is an error.
+  corner or a cusp is an error. A grasp from ``qualgrasp synthesize`` records the outline scale
+  and curvature threshold its regions were found at (fields ``scale`` and ``alpha``): its limits
+  are those regions (:func:`planned_regions`).
 * **Contacts.** Each is placed at the nearest boundary point (within 1 % of the object's size);
   the grasp itself, as given, decides ``not_robust``.
 
@@ -29,6 +31,7 @@ Farkas certificate), ``evaluations``, ``seconds`` and ``error``.
 from __future__ import annotations
 
 import json
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -40,12 +43,13 @@ from ..certify.errors import CertifyError, GraspError, GraspFileError
 from ..certify.grasp import Grasp, grasp_from_dict
 from ..certify.region_boundary import SEARCH_BUDGET, IndependentRegions, independent_regions
 from ..certify.region_data import tuple_to_dict
-from .outline import Outline, outline_image
+from .errors import QualitativeError
+from .outline import DEFAULT_SCALE, SCALE_MAX, Outline, outline_image
 from .regions import ALPHA, FINGER_WIDTH, MARGIN, Region, feasible_regions
 from .vision import ImageSource
 
-__all__ = ["ON_OUTLINE", "outline_boundary", "contact_limits", "independent_grasp", "independent_file",
-           "IndependentSummary"]
+__all__ = ["ON_OUTLINE", "outline_boundary", "contact_limits", "planned_regions", "independent_grasp",
+           "independent_file", "IndependentSummary"]
 
 #: Largest distance of a contact from the outline, fraction of the object's size.
 ON_OUTLINE = 0.01
@@ -117,6 +121,48 @@ def contact_limits(outline: Outline, regions: list[Region], points: np.ndarray, 
                                  "no finger goes there")
             return _arc_limits(cum, seg.start, seg.stop, n)
     raise GraspError(f"the contact at {list(p)} is on no outline element")  # pragma: no cover
+
+
+def planned_regions(image: ImageSource, grasp: Grasp, *, alpha: float | None = None,
+                    finger_width: float = FINGER_WIDTH, margin: float = MARGIN, threshold: float | None = None,
+                    largest: bool = False, cache: dict | None = None) -> list[Region]:
+    """The feasible regions a grasp was planned on: those of the image's outline at the grasp's
+    field ``scale`` (default :data:`~qualgrasp.qualitative.outline.DEFAULT_SCALE`) with the
+    curvature threshold ``alpha`` when given, else the grasp's field ``alpha``, else
+    :data:`~qualgrasp.qualitative.regions.ALPHA` (as
+    :func:`qualgrasp.qualitative.synthesis.synthesize` records them).
+
+    Parameters
+    ----------
+    image : str, pathlib.Path or numpy.ndarray
+        The object's image.
+    grasp : Grasp
+        A grasp on that object.
+    alpha, finger_width, margin
+        Feasible regions' parameters (:func:`~qualgrasp.qualitative.regions.feasible_regions`).
+    threshold, largest
+        As for :func:`~qualgrasp.qualitative.outline.outline_image`.
+    cache : dict, optional
+        Regions already computed, by scale and threshold (filled in).
+
+    Returns
+    -------
+    list of Region
+    """
+    scale = grasp.meta.get("scale", DEFAULT_SCALE)
+    alpha = grasp.meta.get("alpha", ALPHA) if alpha is None else alpha
+    number = (int, float)
+    if isinstance(scale, bool) or not isinstance(scale, number) or not DEFAULT_SCALE / 4 <= scale <= SCALE_MAX:
+        raise GraspError(f"field scale: expected the outline's scale in [{DEFAULT_SCALE / 4:g}, {SCALE_MAX:g}], "
+                         f"got {scale!r}")
+    if isinstance(alpha, bool) or not isinstance(alpha, number) or not 0 <= alpha < math.inf:
+        raise GraspError(f"field alpha: expected a curvature threshold >= 0, got {alpha!r}")
+    key = (float(scale), float(alpha))
+    cache = {} if cache is None else cache
+    if key not in cache:
+        outline = outline_image(image, scale=key[0], threshold=threshold, largest=largest)
+        cache[key] = feasible_regions(outline, key[1], finger_width, margin)
+    return cache[key]
 
 
 def independent_grasp(outline: Outline, grasp: Grasp, *, regions: list[Region] | None = None,
@@ -194,7 +240,7 @@ def _row(gid, line, result: IndependentRegions | None = None, error: str | None 
 
 def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str | Path, *, symmetric: bool = True,
                      tol: float | None = None, budget: int = SEARCH_BUDGET, normal_tol: float = 0.0,
-                     alpha: float = ALPHA, finger_width: float = FINGER_WIDTH, margin: float = MARGIN,
+                     alpha: float | None = None, finger_width: float = FINGER_WIDTH, margin: float = MARGIN,
                      threshold: float | None = None, largest: bool = False,
                      progress: Callable[[int], None] | None = None) -> IndependentSummary:
     """Independent contact regions of every grasp of a grasp set (JSON Lines) on an image's object.
@@ -210,7 +256,9 @@ def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str 
     symmetric, tol, budget, normal_tol
         As for :func:`independent_grasp`.
     alpha, finger_width, margin
-        Feasible regions' parameters (:func:`~qualgrasp.qualitative.regions.feasible_regions`).
+        Feasible regions' parameters (:func:`~qualgrasp.qualitative.regions.feasible_regions`);
+        each grasp's regions are those it was planned on (:func:`planned_regions`: its fields
+        ``scale`` and ``alpha``, ``alpha`` given overriding the latter).
     threshold, largest
         As for :func:`~qualgrasp.qualitative.outline.outline_image`.
     progress : callable, optional
@@ -239,7 +287,7 @@ def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str 
     except OSError as err:
         raise GraspFileError(f"cannot read {grasps_path}: {err.strerror or err}") from None
     outline = outline_image(image, threshold=threshold, largest=largest)
-    regions = feasible_regions(outline, alpha, finger_width, margin)
+    cache: dict = {}
     summary = IndependentSummary()
     rows = []
     for number, line in enumerate(text.splitlines(), start=1):
@@ -251,12 +299,14 @@ def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str 
             if isinstance(value, dict) and isinstance(value.get("id"), (str, int)) and not isinstance(value["id"], bool):
                 gid = value["id"]
             grasp = grasp_from_dict(value)
+            regions = planned_regions(image, grasp, alpha=alpha, finger_width=finger_width, margin=margin,
+                                      threshold=threshold, largest=largest, cache=cache)
             result = independent_grasp(outline, grasp, regions=regions, symmetric=symmetric, tol=tol,
                                        budget=budget, normal_tol=normal_tol)
             row = _row(gid, number, result)
         except json.JSONDecodeError as err:
             row = _row(None, number, error=f"line {number}: malformed JSON: {err.msg} (column {err.colno})")
-        except CertifyError as err:
+        except (CertifyError, QualitativeError) as err:  # a bad grasp, or no outline at its scale
             row = _row(gid, number, error=f"line {number}: {err}")
         rows.append(row)
         summary.rows += 1

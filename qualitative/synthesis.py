@@ -15,7 +15,8 @@ Every grasp found is converted to a :class:`qualgrasp.certify.Grasp` -- contacts
 comparable across procedures -- with the id ``<name>-<tag>-0007`` (the procedure's tag: ``form``,
 ``force2``, ``force3``) and the extra fields ``procedure`` (``FormGrasp`` or ``ForceGrasp``),
 ``fingers``, ``regions`` (indices into the feasible regions list) and the procedure's own fields
-(``zone_depth`` for FormGrasp, ``cone_margin`` in radians for ForceGrasp). Each is then certified by :func:`qualgrasp.certify.certify_grasp`;
+(``zone_depth`` for FormGrasp, ``cone_margin`` in radians for ForceGrasp), ``resolution``, and
+the ``scale`` and ``alpha`` of the regions it was found on (below). Each is then certified by :func:`qualgrasp.certify.certify_grasp`;
 a synthesised grasp that does not certify is a bug of the synthesis, and is reported, not dropped.
 
 The finger's scale
@@ -32,6 +33,15 @@ tried, at most :data:`FALLBACK_SCALES` of them, and last the default scale (deta
 the finger; the scale reported says so) (:func:`search_scales`). ``scale`` fixes one scale (no
 fallback). :attr:`Synthesis.scale` is the scale the grasps come from, and
 :attr:`Synthesis.reason` says why nothing was found.
+
+**Curvature threshold.** Curves are feasible first where their bounding circle under the pad is
+at least :data:`qualgrasp.qualitative.regions.ALPHA` of the object's size (flat ones, as the
+paper prefers). When no scale gives a grasp, the same scales are tried again with the threshold
+relaxed to the finger's own width: a curve is then feasible wherever the pad fits on it (its
+circle at least as wide as the pad), such as the rounded tip of a wing or of a cell's protrusion,
+which an elongated object may need for a third finger (:func:`search_attempts`). Each grasp
+records its ``scale`` and ``alpha``, and :attr:`Synthesis.alpha` is the threshold the grasps come
+from; ``alpha`` given fixes it.
 
 Certified tolerance
 -------------------
@@ -67,7 +77,7 @@ import math
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 
@@ -87,7 +97,7 @@ from .regions import ALPHA, FINGER_WIDTH, MARGIN as REGION_MARGIN, Region, feasi
 from .vision import ImageSource
 
 __all__ = ["MU", "POSITION", "NORMAL", "FALLBACK_SCALES", "FALLBACK_STEP", "Synthesis", "synthesize", "to_grasp", "choose",
-           "resolution", "search_scales"]
+           "resolution", "search_scales", "search_alphas", "search_attempts"]
 
 MU = 0.5
 """Default friction coefficient of procedures with friction."""
@@ -152,10 +162,17 @@ class Synthesis:
         The outline's scale the regions and grasps come from (fraction of the perimeter; module
         notes); ``outline`` is the outline at that scale.
     scales_tried : tuple of float
-        Every scale tried, in order (the last is ``scale``).
+        Every scale tried, in order (the last is ``scale``; a scale comes again with the next
+        curvature threshold).
     reason : str or None
         Why no grasp was found (None when some were): no feasible region at any scale tried, or
-        feasible regions on which the procedure found no grasp.
+        feasible regions on which the procedure found no grasp, with the procedure's best
+        near-miss in numbers.
+    alpha : float
+        The curvature threshold of the feasible regions the grasps come from (fraction of the
+        object's size; module notes).
+    alphas_tried : tuple of float
+        The curvature threshold of every attempt, parallel to ``scales_tried``.
     """
 
     name: str
@@ -177,6 +194,8 @@ class Synthesis:
     scale: float = DEFAULT_SCALE
     scales_tried: tuple[float, ...] = ()
     reason: str | None = None
+    alpha: float = ALPHA
+    alphas_tried: tuple[float, ...] = ()
 
     @property
     def deltas(self) -> tuple[float | None, ...]:
@@ -223,6 +242,7 @@ class Synthesis:
             "median_eps_l1": float(np.median(eps)) if eps else None,
             "median_delta_fraction": float(np.median(deltas)) if deltas else None,
             "scale": self.scale,
+            "alpha": self.alpha,
             "reason": self.reason,
             "seconds": self.seconds,
             "certify_seconds": self.certify_seconds,
@@ -321,12 +341,12 @@ def _name(image: ImageSource, name: str | None) -> str:
 
 
 def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None = None,
-               theta_min: float | None = None, alpha: float = ALPHA, *, procedure: str | None = None,
+               theta_min: float | None = None, alpha: float | None = None, *, procedure: str | None = None,
                name: str | None = None, certify: bool = True, quality: bool = True,
                threshold: float | None = None, largest: bool = False, finger_width: float = FINGER_WIDTH,
                region_margin: float = REGION_MARGIN, step: float = STEP, inset: float = INSET,
                per_region: int = PER_REGION, error: float = ERROR, margin: float = MARGIN,
-               tolerance: bool = True, scale: float | None = None) -> Synthesis:
+               tolerance: bool = True, scale: float | None = None, explain: bool = True) -> Synthesis:
     """Synthesise and certify grasps of the object in an image.
 
     Parameters
@@ -341,9 +361,11 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
         given either).
     theta_min : float, optional
         Friction cone half-angle, **radians** (``mu = tan(theta_min)``); instead of ``mu``.
-    alpha : float
+    alpha : float, optional
         Curvature threshold of feasible regions, fraction of the object's size
-        (:func:`qualgrasp.qualitative.regions.feasible_regions`).
+        (:func:`qualgrasp.qualitative.regions.feasible_regions`); default
+        :data:`~qualgrasp.qualitative.regions.ALPHA`, relaxed to ``finger_width`` when nothing is
+        found (module notes). Given, it is the only one tried.
     procedure : str, optional
         A registered procedure by name (:mod:`qualgrasp.qualitative.procedures`):
         ``forcegrasp2``, ``forcegrasp3``, ``formgrasp``.
@@ -370,6 +392,10 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     scale : float, optional
         The outline's scale (fraction of the perimeter, in ``[0.001, 0.032]``) for regions and
         procedures; default the finger's scale with coarser fallbacks (module notes).
+    explain : bool
+        When nothing is found, give the procedure's best near-miss in numbers in
+        :attr:`Synthesis.reason` (another pass over the candidates of the largest search; the
+        reason without numbers otherwise).
 
     Returns
     -------
@@ -400,7 +426,7 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
         if mu is None and theta_min is None:
             mu = MU
         mu, theta_min = friction(mu, theta_min)
-    if not (math.isfinite(alpha) and alpha >= 0):
+    if alpha is not None and not (math.isfinite(alpha) and alpha >= 0):
         raise SynthesisError(f"alpha must be finite and >= 0, got {alpha}")
     if scale is not None and not (math.isfinite(scale) and DEFAULT_SCALE / 4 <= scale <= SCALE_MAX):
         raise SynthesisError(f"scale must be in [{DEFAULT_SCALE / 4:g}, {SCALE_MAX:g}] (fraction of the perimeter), "
@@ -408,25 +434,27 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     start = time.perf_counter()
     fine = outline_image(image, threshold=threshold, largest=largest)
     center, length = object_frame(fine.contour)
-    tried: list[float] = []
-    most = 0  # most feasible regions at any scale tried, for the reason
-    for s in search_scales(image, fine, finger_width, scale, threshold=threshold, largest=largest):
-        tried.append(s)
-        outline = fine if s == fine.scale else outline_image(image, scale=s, threshold=threshold, largest=largest)
-        regions = _fine_normals(tuple(feasible_regions(outline, alpha, finger_width, region_margin)), fine, outline)
+    tried: list[tuple[float, float]] = []
+    most, richest = 0, None  # most feasible regions and the largest search, for the reason
+    for s, a, outline, regions in _attempt_regions(image, fine, finger_width, scale, alpha, region_margin,
+                                                   threshold, largest):
+        tried.append((s, a))
         most = max(most, len(regions))
         cands = candidates(outline, regions, step, inset, per_region)
         search = SearchInput(cands, outline.contour, center, length, outline.size, theta_min, error, margin)
+        if richest is None or len(cands) > len(richest[0].candidates):
+            richest = (search, s, a)
         found = proc.search(search)
         if found:
             break
-    reason = None if found else _reason(proc, tried, most, search)
+    reason = None if found else _reason(proc, tried, most, richest if explain else None)
     stem = _name(image, name)
     grasps = []
     for k, g in enumerate(found):
         grasp = to_grasp(g, f"{stem}-{proc.tag}-{k:04d}", center, length, mu, proc)
         grasp.meta["resolution"] = resolution(grasp, _spans(outline, regions, g))
         grasp.meta["scale"] = outline.scale
+        grasp.meta["alpha"] = a
         grasps.append(grasp)
     grasps = tuple(grasps)
     seconds = time.perf_counter() - start
@@ -435,7 +463,7 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     tolerances = tuple(_tolerance(fine, regions, g, r) for g, r in zip(grasps, reports)) if tolerance else ()
     return Synthesis(stem, proc.fingers, proc, mu, theta_min, outline, regions, cands,
                      center, length, tuple(found), grasps, reports, seconds, time.perf_counter() - start,
-                     tolerances, outline.scale, tuple(tried), reason)
+                     tolerances, outline.scale, tuple(t[0] for t in tried), reason, a, tuple(t[1] for t in tried))
 
 
 def search_scales(image: ImageSource, fine: Outline, finger_width: float, scale: float | None = None, *,
@@ -460,6 +488,58 @@ def search_scales(image: ImageSource, fine: Outline, finger_width: float, scale:
         yield fine.scale  # last resort: details finer than the finger, flagged by the scale reported
 
 
+def search_alphas(alpha: float | None, finger_width: float) -> tuple[float, ...]:
+    """The curvature thresholds synthesis tries, in order (module notes): ``alpha`` alone when
+    given; else :data:`qualgrasp.qualitative.regions.ALPHA`, then the finger's own width (a curve
+    is feasible where its bounding circle under the pad is at least as wide as the pad) when that
+    is lower.
+
+    Examples
+    --------
+    >>> search_alphas(None, 0.08)
+    (0.5, 0.08)
+    >>> search_alphas(0.3, 0.08)
+    (0.3,)
+    """
+    if alpha is not None:
+        return (alpha,)
+    return (ALPHA, finger_width) if finger_width < ALPHA else (ALPHA,)
+
+
+def search_attempts(image: ImageSource, fine: Outline, finger_width: float, scale: float | None = None,
+                    alpha: float | None = None, *, threshold: float | None = None,
+                    largest: bool = False) -> Iterator[tuple[float, float]]:
+    """The ``(scale, alpha)`` pairs synthesis tries, in order (module notes): every scale of
+    :func:`search_scales` at the first curvature threshold of :func:`search_alphas`, then the same
+    scales at the next threshold. A generator: the hierarchy is computed only when the first scale
+    is not enough, and once."""
+    scales: list[float] = []
+    for k, a in enumerate(search_alphas(alpha, finger_width)):
+        if k == 0:
+            for s in search_scales(image, fine, finger_width, scale, threshold=threshold, largest=largest):
+                scales.append(s)
+                yield s, a
+        else:
+            yield from ((s, a) for s in scales)
+
+
+def _attempt_regions(image: ImageSource, fine: Outline, finger_width: float, scale: float | None,
+                     alpha: float | None, margin: float, threshold: float | None, largest: bool):
+    """Per attempt of :func:`search_attempts`: ``(scale, alpha, outline, regions)``, each scale's
+    outline computed once; an attempt whose regions are those of an earlier one at the same scale
+    (no curve between the two thresholds) is skipped."""
+    outlines = {fine.scale: fine}
+    seen = set()
+    for s, a in search_attempts(image, fine, finger_width, scale, alpha, threshold=threshold, largest=largest):
+        if s not in outlines:
+            outlines[s] = outline_image(image, scale=s, threshold=threshold, largest=largest)
+        regions = _fine_normals(tuple(feasible_regions(outlines[s], a, finger_width, margin)), fine, outlines[s])
+        key = (s, tuple((r.start, r.stop) for r in regions))
+        if key not in seen:
+            seen.add(key)
+            yield s, a, outlines[s], regions
+
+
 def _fine_normals(regions: tuple[Region, ...], fine: Outline, outline: Outline) -> tuple[Region, ...]:
     """Regions of ``outline`` (a coarser scale of ``fine``; the contour is the same at every
     scale) with the fine outline's normals on curves and, on straight regions, the contour's own
@@ -475,15 +555,26 @@ def _fine_normals(regions: tuple[Region, ...], fine: Outline, outline: Outline) 
     return tuple(out)
 
 
-def _reason(proc: Procedure, tried: list[float], regions: int, search: SearchInput) -> str:
-    """Why ``proc`` found nothing at the scales ``tried`` (``regions``: the most feasible regions
-    at any of them; ``search``: the last scale's input, for the procedure's own diagnosis)."""
-    at = ", ".join(f"{s:.4g}" for s in tried)
+def _tried(tried: list[tuple[float, float]]) -> str:
+    """``'0.0066, 0.004 at alpha 0.5; 0.0066, 0.004 at alpha 0.08'``: the attempts by threshold."""
+    parts = []
+    for a in dict.fromkeys(t[1] for t in tried):
+        parts.append(", ".join(f"{s:.4g}" for s, b in tried if b == a) + f" at alpha {a:g}")
+    return "; ".join(parts)
+
+
+def _reason(proc: Procedure, tried: list[tuple[float, float]], regions: int,
+            richest: tuple[SearchInput, float, float] | None) -> str:
+    """Why ``proc`` found nothing at the ``(scale, alpha)`` attempts ``tried`` (``regions``: the
+    most feasible regions at any of them; ``richest``: the attempt with the most candidates, with
+    its scale and alpha, for the procedure's own diagnosis; None to skip it)."""
+    at = _tried(tried)
     if not regions:
         return f"no feasible region at the scales tried ({at})"
     why = proc.failure
-    if proc.diagnose is not None and len(search.candidates.points):
-        why += f" ({proc.diagnose(search)} at scale {tried[-1]:.4g})"
+    if proc.diagnose is not None and richest is not None and len(richest[0].candidates):
+        search, s, a = richest
+        why += f" ({proc.diagnose(search)}; at scale {s:.4g} and alpha {a:g})"
     return f"{proc.title} found no grasp on up to {regions} feasible region(s) at the scales tried ({at}): {why}"
 
 

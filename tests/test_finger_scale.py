@@ -1,22 +1,28 @@
 """Synthesis at the finger's scale (issue 15, parts 2 and 3): regions and procedures on the
-outline at the pad's scale, contacts and normals of the fine contour, coarser scales when nothing
-is found, the scale reported, and why nothing was found."""
+outline at the pad's scale, contacts and normals of the fine contour, coarser scales and then
+curves as round as the finger when nothing is found, the scale and threshold reported, and why
+nothing was found, in numbers."""
 
+import json
 import re
 
 import cv2
 import numpy as np
 import pytest
-from shapely.geometry import Point, Polygon
+from shapely.geometry import LineString, Point, Polygon
 from typer.testing import CliRunner
 
 from qualgrasp.certify import force_closure
 from qualgrasp.cli import app
 from qualgrasp.experiments.silhouettes import select_cells
+from qualgrasp.qualitative import procedures
+from qualgrasp.qualitative.candidates import Candidates
 from qualgrasp.qualitative.errors import SynthesisError
+from qualgrasp.qualitative.forcegrasp import best_triplet_margins, triplet_grasps
 from qualgrasp.qualitative.objects import render, render_polygon, shape
 from qualgrasp.qualitative.outline import DEFAULT_SCALE, finger_scale, outline_image
-from qualgrasp.qualitative.regions import FINGER_WIDTH
+from qualgrasp.qualitative.procedures import SearchInput
+from qualgrasp.qualitative.regions import ALPHA, FINGER_WIDTH
 from qualgrasp.qualitative.synthesis import FALLBACK_STEP, synthesize
 
 
@@ -121,3 +127,98 @@ def test_synthesize_command_reports_the_scale_and_the_reason(tmp_path):
     out = runner.invoke(app, ["synthesize", str(image), "--fingers", "2", "--scale", "1",
                               "-o", str(tmp_path / "g.jsonl")])
     assert out.exit_code == 2 and "scale" in out.output
+
+
+def _stadium():
+    """A stadium 260 px long and 60 px wide: two parallel straight sides and two half discs whose
+    bounding circle (0.23 of the size) is below ALPHA (0.5) but wider than a finger pad (0.08)."""
+    return render_polygon(LineString([(156, 256), (356, 256)]).buffer(30, quad_segs=64))
+
+
+def test_three_fingers_on_an_elongated_object_use_its_rounded_ends():
+    image = _stadium()
+    flat = synthesize(image, procedure="forcegrasp3", alpha=ALPHA, quality=False, tolerance=False)
+    assert not flat.grasps and set(flat.alphas_tried) == {ALPHA}
+    assert "normals never positively span" in flat.reason and "gap of 180.0 degrees" in flat.reason
+    s = synthesize(image, procedure="forcegrasp3", quality=False)
+    assert s.grasps and all(s.certified) and s.alpha == FINGER_WIDTH
+    assert s.alphas_tried[0] == ALPHA and s.alphas_tried[-1] == FINGER_WIDTH
+    assert len(s.alphas_tried) == len(s.scales_tried)
+    for grasp, found in zip(s.grasps, s.found):
+        assert grasp.meta["alpha"] == FINGER_WIDTH and grasp.meta["scale"] == s.scale
+        assert any(s.regions[r].type == ")" for r in found.regions)  # a finger on a rounded end
+        assert force_closure(grasp).status == "closure"
+        assert grasp.meta["delta_fraction"] > 0
+    # the flat sides come first: two fingers need no rounded end
+    assert synthesize(image, procedure="forcegrasp2", quality=False, tolerance=False).alpha == ALPHA
+
+
+def test_relaxing_is_skipped_where_no_curve_changes():
+    s = synthesize(render("square"), procedure="forcegrasp3", quality=False, tolerance=False)
+    assert not s.grasps and set(s.alphas_tried) == {ALPHA} and "alpha 0.08" not in s.reason
+
+
+def test_independent_regions_command_keeps_the_grasps_regions(tmp_path):
+    """A grasp on a relaxed region (the stadium's end) gets from ``qualgrasp independent-regions``
+    the tolerance synthesis gave it: the same regions (its fields scale and alpha)."""
+    image = tmp_path / "stadium.png"
+    cv2.imwrite(str(image), _stadium())
+    runner = CliRunner()
+    out = runner.invoke(app, ["synthesize", str(image), "--fingers", "3", "-o", str(tmp_path / "g.jsonl")])
+    assert out.exit_code == 0 and "with curves as round as the finger (alpha 0.08)" in out.output
+    rows = [json.loads(line) for line in (tmp_path / "g.jsonl").read_text().splitlines()]
+    out = runner.invoke(app, ["independent-regions", str(image), str(tmp_path / "g.jsonl"),
+                              "-o", str(tmp_path / "r.jsonl")])
+    assert out.exit_code == 0, out.output
+    again = [json.loads(line) for line in (tmp_path / "r.jsonl").read_text().splitlines()]
+    assert [r["delta"] for r in again] == pytest.approx([r["delta"] for r in rows], rel=1e-9)
+    out = runner.invoke(app, ["independent-regions", str(image), str(tmp_path / "g.jsonl"),
+                              "-o", str(tmp_path / "r.jsonl"), "--alpha", "-1"])
+    assert out.exit_code == 2 and "--alpha" in out.output
+
+
+def test_three_fingers_say_how_far_the_cones_are_from_meeting():
+    """Three sides of an equilateral triangle, one candidate near a corner of each (the normals
+    span with 30 degrees to spare): with cones of 10 degrees the forces cannot meet; the
+    diagnosis gives the spanning margin and the cones' shortfall, and agrees with the search."""
+    a = np.radians([90, 210, 330])
+    n = -np.c_[np.cos(a), np.sin(a)]  # inward normals of the sides
+    t = np.c_[-n[:, 1], n[:, 0]]
+    feet = -100 * n
+    c = Candidates(feet + 60 * t, n, np.arange(3), np.full(3, 10.0))
+    contour = np.array([-100 * n[i] + s * 173 * t[i] for i in range(3) for s in (-1, 1)])
+    theta = np.radians(10)
+    normals, best = best_triplet_margins(c, contour, theta, 200)
+    assert np.degrees(normals) == pytest.approx(30.0)
+    assert best < 0 and not triplet_grasps(c, contour, theta, 200, margin=0.0)
+    why = procedures.get("forcegrasp3").diagnose(SearchInput(c, contour, np.zeros(2), 100.0, 200.0, theta, 2.0, 0.25))
+    assert "no three contacts have friction cones with a common point inside their triangle" in why
+    # at the feet of the perpendiculars from the centre the cones meet whatever their width
+    c = Candidates(feet, n, np.arange(3), np.full(3, 10.0))
+    normals, best = best_triplet_margins(c, contour, theta, 200)
+    found = triplet_grasps(c, contour, theta, 200, margin=0.0)
+    assert found and best == pytest.approx(max(g.margin for g in found)) and best > 0.9 * theta
+
+
+def test_formgrasp_says_how_deep_its_best_zone_is():
+    disc = synthesize(render("disc"), procedure="formgrasp", quality=False, tolerance=False)
+    m = re.search(r"closes the zone by ([0-9.e-]+) .*against ([0-9.e-]+) for 2 px", disc.reason)
+    assert m and 0 < float(m.group(1)) < float(m.group(2))
+
+
+def test_independent_regions_reports_bad_scale_and_alpha_fields_per_row(tmp_path):
+    image = tmp_path / "square.png"
+    cv2.imwrite(str(image), render("square"))
+    grasps = tmp_path / "g.jsonl"
+    runner = CliRunner()
+    assert runner.invoke(app, ["synthesize", str(image), "--fingers", "2", "-o", str(grasps)]).exit_code == 0
+    good = json.loads(grasps.read_text().splitlines()[0])
+    bad = [dict(good, scale="abc"), dict(good, alpha=-1), dict(good, scale=5.0), dict(good, alpha=True)]
+    grasps.write_text("\n".join(json.dumps(g) for g in [good, *bad]) + "\n")
+    out = runner.invoke(app, ["independent-regions", str(image), str(grasps), "-o", str(tmp_path / "r.jsonl")])
+    assert out.exit_code == 1, out.output
+    rows = [json.loads(line) for line in (tmp_path / "r.jsonl").read_text().splitlines()]
+    assert rows[0]["status"] == "robust" and rows[0]["delta"] > 0
+    assert [r["status"] for r in rows[1:]] == ["error"] * 4
+    for row, field in zip(rows[1:], ["scale", "alpha", "scale", "alpha"]):
+        assert f"field {field}" in row["error"] and row["error"].startswith(f"line {row['line']}")
