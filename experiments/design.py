@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Mapping
 
 import numpy as np
+from shapely.geometry import Polygon
 
 from ..qualitative import procedures
 from ..qualitative.procedures import Procedure
@@ -139,10 +140,13 @@ SETTINGS = {"quick": QUICK, "full": FULL}
 
 @dataclass(frozen=True, eq=False)
 class Subject:
-    """An object of the study: a name and its unperturbed grey image (uint8)."""
+    """An object of the study: a name, its unperturbed grey image (uint8) and, when the image was
+    rendered from known geometry (the built-in objects, the bundled silhouettes), that geometry in
+    the image's pixels: the true object the study executes grasps on."""
 
     name: str
     image: np.ndarray
+    geometry: Polygon | None = None
 
 
 @dataclass(frozen=True)

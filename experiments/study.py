@@ -18,11 +18,15 @@ to certified grasps (vision, search, certification) for both routes.
 
 Robustness model
 ----------------
-The **true object** is the boundary perceived in the unperturbed image
-(:func:`qualgrasp.experiments.baseline.boundary`: contour and smoothed inward normals; on the built-in and
-silhouette images it lies within a few hundredths of a pixel of the exact shape, with corners
-rounded at the outline's smoothing scale, 0.4 % of the perimeter). Each perturbation changes the
-image the routes plan on; the plans are then executed on the true object:
+The **true object** is the geometry the image was rendered from, when it is known (the built-in
+objects and the bundled silhouettes, :attr:`Subject.geometry`: its exact polygon with its edges'
+normals, sharp corners included, :func:`qualgrasp.experiments.baseline.boundary_of_polygon`; the
+images show it to within a few hundredths of a pixel), else the boundary perceived in the
+unperturbed image (:func:`qualgrasp.experiments.baseline.boundary`: contour and smoothed inward
+normals, corners rounded at the outline's smoothing scale, 0.4 % of the perimeter). Each
+perturbation changes the image the routes plan on; the plans are then executed on the true
+object (``none``, the unperturbed image, measures how many planned grasps are certified on the
+true contour):
 
 * ``rotation`` (degrees) and ``translation`` (pixels): a **pose error**. The image shows the object
   rotated about its true centroid by the size (+x towards +y, clockwise as displayed, in even
@@ -72,19 +76,19 @@ from typing import Any, Callable, Iterable, Sequence
 
 import cv2
 import numpy as np
+from shapely.geometry import Polygon
 
 from qualgrasp.certify import Contact, Grasp
 from qualgrasp.certify.errors import GraspError
 from qualgrasp.qualitative.errors import QualitativeError
 from qualgrasp.qualitative.formgrasp import ray_edges
-from qualgrasp.qualitative.independent import independent_grasp
-from qualgrasp.qualitative.objects import NAMES, render
+from qualgrasp.qualitative.independent import independent_grasp, planned_regions
+from qualgrasp.qualitative.objects import NAMES, render, shape
 from qualgrasp.qualitative.outline import Outline, outline_image
-from qualgrasp.qualitative.regions import feasible_regions
 from qualgrasp.qualitative.synthesis import synthesize
 from qualgrasp.qualitative.vision import read_image, segment
 
-from .baseline import Boundary, Budget, baseline, boundary, screen_grasps
+from .baseline import Boundary, Budget, baseline, boundary, boundary_of_polygon, screen_grasps
 from .design import (BUILTINS, DETERMINISTIC, FULL, GRASP_COLUMNS, KINDS, OBJECT_COLUMNS,
                      OVERALL_COLUMNS, QUICK, ROBUSTNESS_COLUMNS, ROUTES, SETTINGS, UNITS, Route,
                      RouteSummary, Settings, StudyResult, Subject, routes)
@@ -148,9 +152,9 @@ def _subject(k: int, item: Any) -> Subject:
     if isinstance(item, Subject):
         return item
     if isinstance(item, Silhouette):
-        return Subject(item.name, item.image())
+        return Subject(item.name, item.image(), item.polygon())
     if isinstance(item, str) and item in NAMES:
-        return Subject(item, render(item))
+        return Subject(item, render(item), Polygon(shape(item).exterior))
     if isinstance(item, (str, Path)):
         return Subject(Path(item).stem, _as_uint8(read_image(item)))
     if isinstance(item, tuple):
@@ -309,7 +313,7 @@ def _plan(image: np.ndarray, route: Route, settings: Settings, name: str, thresh
         return (found.grasps, np.array(found.certified, dtype=bool), np.array(found.epsilons),
                 found.seconds, found.candidates, found.boundary.points)
     s = synthesize(image, procedure=proc.name, mu=mu, name=name, certify=final, quality=final,
-                   threshold=threshold, largest=True, tolerance=False)
+                   threshold=threshold, largest=True, tolerance=False, explain=False)
     if final:
         ok = np.array(s.certified, dtype=bool)
         eps = np.array([r.eps_l1 for r in s.reports])
@@ -365,14 +369,11 @@ def best_tolerance(outline: Outline, grasp: Grasp, image: np.ndarray | None = No
     fraction of the object's size, status)`` (:data:`OBJECT_COLUMNS`). A contact on a corner or
     off the outline's elements has no stretch to slide on: tolerance 0, status ``none: <why>``.
 
-    ``outline`` is the image's outline at the default scale; a qualitative grasp synthesised at a
-    coarser scale (its field ``scale``) keeps the feasible regions of that scale (as
+    ``outline`` is the image's outline at the default scale; a qualitative grasp keeps the
+    feasible regions it was planned on (its fields ``scale`` and ``alpha``, as
     :func:`qualgrasp.qualitative.synthesis.synthesize` does), read from ``image``."""
-    scale = grasp.meta.get("scale")
-    regions = None
-    if image is not None and scale is not None and scale != outline.scale:
-        regions = feasible_regions(outline_image(image, scale=scale, largest=True))
     try:
+        regions = None if image is None else planned_regions(image, grasp, largest=True)
         found = independent_grasp(outline, grasp, regions=regions)
     except GraspError as err:
         return 0.0, f"none: {err}"
@@ -434,7 +435,7 @@ def robustness_trial(subject: Subject, truth: Boundary, level: float, kind: str,
 
 
 def _nominal(subject: Subject, settings: Settings):
-    truth = boundary(subject.image)
+    truth = boundary(subject.image) if subject.geometry is None else boundary_of_polygon(subject.geometry)
     level = segment(subject.image).level
     return subject.name, evaluate_object(subject, settings), truth, level
 
