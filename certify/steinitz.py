@@ -32,7 +32,7 @@ from .grasp import Contact, Grasp
 from .quality import epsilon, epsilon_of_points
 from .problem import grasp_system
 
-__all__ = ["Efficiency", "polygon_frame", "boundary_contacts", "boundary_epsilon",
+__all__ = ["Efficiency", "polygon_frame", "edge_samples", "boundary_contacts", "boundary_epsilon",
            "steinitz_bound", "efficiency"]
 
 
@@ -62,26 +62,51 @@ def polygon_frame(vertices) -> tuple[np.ndarray, float]:
     return c, float(np.max(np.linalg.norm(V - c, axis=1)))
 
 
+def edge_samples(vertices, spacing: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Points every ``spacing`` (at most) along each edge of a simple polygon, both ends of every
+    edge included, with the edge's inward unit normal whatever the vertex order.
+
+    Returns
+    -------
+    points, normals : numpy.ndarray
+        ``(k, 2)``.
+    edge : numpy.ndarray
+        ``(k,)`` index of each point's edge (from vertex ``edge`` to the next; zero-length edges
+        are skipped).
+    s : numpy.ndarray
+        ``(k,)`` position along the edge, 0 at its first vertex, 1 at its last.
+
+    Examples
+    --------
+    >>> points, normals, edge, s = edge_samples([(0, 0), (2, 0), (2, 1), (0, 1)], 1.0)
+    >>> points[:4].tolist(), s[:4].tolist()
+    ([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [2.0, 0.0]], [0.0, 0.5, 1.0, 0.0])
+    >>> normals[3].tolist()  # the right side's, pointing in
+    [-1.0, 0.0]
+    """
+    V = _polygon(vertices)
+    sign = 1.0 if _signed_area(V) > 0 else -1.0
+    E = np.roll(V, -1, axis=0) - V
+    L = np.linalg.norm(E, axis=1)
+    keep = np.flatnonzero(L > 0)
+    count = np.maximum(1, np.ceil(L[keep] / spacing).astype(int))
+    edge = np.repeat(keep, count + 1)
+    s = np.concatenate([np.linspace(0.0, 1.0, c + 1) for c in count])
+    t = E[edge] / L[edge, None]
+    normals = sign * np.column_stack([-t[:, 1], t[:, 0]])  # interior on the left of a positive-area polygon
+    return V[edge] + s[:, None] * E[edge], normals, edge, s
+
+
 def boundary_contacts(vertices, spacing: float, *, model: str = "point",
                       mu: float = 0.5) -> list[Contact]:
     """Contacts every ``spacing`` along each edge of a simple polygon, with inward normals
-    whatever the vertex order. Each edge's end points are included with that edge's normal (the
-    limit of its interior points), so a vertex appears once per adjacent edge."""
-    V = _polygon(vertices)
-    sign = 1.0 if _signed_area(V) > 0 else -1.0
-    contacts = []
-    for a, b in zip(V, np.roll(V, -1, axis=0)):
-        edge = b - a
-        length = float(np.linalg.norm(edge))
-        if length == 0:
-            continue
-        t = edge / length
-        n = sign * np.array([-t[1], t[0]])  # interior on the left of a positive-area polygon
-        count = max(1, int(np.ceil(length / spacing)))
-        for s in np.linspace(0.0, 1.0, count + 1):
-            p = a + s * edge
-            contacts.append(Contact(p, n) if model == "frictionless" else Contact(p, n, model, mu))
-    return contacts
+    whatever the vertex order (:func:`edge_samples`). Each edge's end points are included with
+    that edge's normal (the limit of its interior points), so a vertex appears once per adjacent
+    edge."""
+    points, normals, _, _ = edge_samples(vertices, spacing)
+    if model == "frictionless":
+        return [Contact(p, n) for p, n in zip(points, normals)]
+    return [Contact(p, n, model, mu) for p, n in zip(points, normals)]
 
 
 def boundary_epsilon(vertices, *, spacing: float | None = None, model: str = "point",

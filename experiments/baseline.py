@@ -50,6 +50,7 @@ from shapely.geometry import Polygon
 
 from qualgrasp.certify import Contact, Grasp, Report, certify_grasp
 from qualgrasp.certify.fastpath import planar_screen
+from qualgrasp.certify.steinitz import edge_samples
 from qualgrasp.qualitative.candidates import object_frame
 from qualgrasp.qualitative.errors import QualitativeError
 from qualgrasp.qualitative.outline import DEFAULT_SCALE, Outline, outline_contour, resample
@@ -98,14 +99,16 @@ class Budget:
 
 @dataclass(frozen=True, eq=False)
 class Boundary:
-    """An object's boundary as perceived: contour, inward normals and reference frame.
+    """An object's boundary: contour, inward normals and reference frame; as perceived
+    (:func:`boundary`, :func:`boundary_of`) or exact (:func:`boundary_of_polygon`).
 
     Attributes
     ----------
     points : numpy.ndarray
-        ``(n, 2)`` contour, evenly spaced by arc length, positively oriented, pixels.
+        ``(n, 2)`` contour, positively oriented, pixels (as perceived: evenly spaced by arc
+        length).
     normals : numpy.ndarray
-        ``(n, 2)`` inward unit normals of the smoothed contour.
+        ``(n, 2)`` inward unit normals at the points (as perceived: of the smoothed contour).
     center : numpy.ndarray
         ``(2,)`` area centroid, pixels.
     length : float
@@ -187,20 +190,14 @@ def boundary_of_polygon(polygon: Polygon, spacing: float = 0.25) -> Boundary:
     >>> len(b.points), b.center.tolist(), round(b.size, 3)
     (12, [2.0, 1.0], 4.472)
     """
-    ring = np.asarray(shapely.geometry.polygon.orient(Polygon(polygon.exterior), 1.0).exterior.coords)[:-1]
-    edges = np.roll(ring, -1, axis=0) - ring
-    lengths = np.hypot(edges[:, 0], edges[:, 1])
-    keep = lengths > 0
-    ring, edges, lengths = ring[keep], edges[keep], lengths[keep]
-    inward = np.column_stack([-edges[:, 1], edges[:, 0]]) / lengths[:, None]
-    pieces = np.maximum(1, np.ceil(lengths / spacing).astype(int))
-    edge = np.repeat(np.arange(len(ring)), pieces)
-    u = np.concatenate([np.arange(k) / k for k in pieces])
-    points = ring[edge] + u[:, None] * edges[edge]
-    normals = inward[edge].copy()
-    corner = u == 0  # a vertex: between its two edges
-    normals[corner] += inward[edge[corner] - 1]
-    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    ring = np.asarray(polygon.exterior.coords)[:-1]
+    if not polygon.exterior.is_ccw:  # positive orientation: the interior on the left
+        ring = ring[::-1]
+    points, normals, edge, s = edge_samples(ring, spacing)
+    first = np.flatnonzero(s == 0)  # the vertices: between their edge and the one before
+    normals[first] += normals[np.roll(first, 1)]
+    keep = s < 1  # each vertex once, as the start of its edge
+    points, normals = points[keep], normals[keep] / np.linalg.norm(normals[keep], axis=1, keepdims=True)
     center, length = object_frame(points)
     size = 2.0 * shapely.minimum_bounding_radius(Polygon(ring))
     return Boundary(points, normals, center, length, float(size))

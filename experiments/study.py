@@ -373,7 +373,7 @@ def best_tolerance(outline: Outline, grasp: Grasp, image: np.ndarray | None = No
     feasible regions it was planned on (its fields ``scale`` and ``alpha``, as
     :func:`qualgrasp.qualitative.synthesis.synthesize` does), read from ``image``."""
     try:
-        regions = None if image is None else planned_regions(image, grasp, largest=True)
+        regions = None if image is None else planned_regions(image, grasp, largest=True, outline=outline)
         found = independent_grasp(outline, grasp, regions=regions)
     except GraspError as err:
         return 0.0, f"none: {err}"

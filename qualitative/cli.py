@@ -19,7 +19,7 @@ from .grasp_plot import synthesis_figure
 from .independent import independent_file
 from .outline import DEFAULT_SCALE, SCALE_MAX, outline_image, outline_scales, outline_to_dict
 from .plot import outline_figure
-from .regions import feasible_regions, regions_to_dict
+from .regions import ALPHA_MAX, feasible_regions, regions_to_dict
 from .st0 import evaluate_file
 from .synthesis import synthesize
 from .vision import read_image
@@ -143,7 +143,7 @@ def regions_command(
 
     try:
         _threshold(threshold)
-        number_in(alpha, "--alpha", 0, 100, unit="(fraction of the object's size)")
+        number_in(alpha, "--alpha", 0, ALPHA_MAX, unit="(fraction of the object's size)")
         number_in(finger_width, "--finger-width", 1e-3, 1, unit="(fraction of the object's size)")
         number_in(margin, "--margin", 0, 0.5, unit="(fraction of the object's size)", high_open=True)
         if plot is not None:
@@ -217,7 +217,7 @@ def synthesize_command(
             number_in(theta_min, "--theta-min (theta_min, the friction cone's half-angle)", 0, 90,
                       low_open=True, high_open=True, unit="degrees")
         if alpha is not None:
-            number_in(alpha, "--alpha", 0, 100, unit="(fraction of the object's size)")
+            number_in(alpha, "--alpha", 0, ALPHA_MAX, unit="(fraction of the object's size)")
         output_file(output, "-o", reads=[image])
         if plot is not None:
             output_file(plot, "--plot", suffixes=FIGURE_SUFFIXES, reads=[image, output])
@@ -247,7 +247,8 @@ def synthesize_command(
                    f"margin {report.force.margin:.4f}\teps {eps:.4f}{tol}\t{verdict}")
     s = result.summary()
     typer.echo(f"{s['grasps']} grasp(s) by {result.procedure.title} ({result.fingers} fingers, {friction}) "
-               f"at outline scale {result.scale:.4g} ({result.outline.string}){_relaxed(result)} -> {output}; "
+               f"at outline scale {result.scale:.4g} ({result.outline.string}), alpha {result.alpha:g}"
+               f"{_relaxed(result)} -> {output}; "
                f"{100 * s['certified_fraction']:.0f} % certified, {s['resolved']} resolved by the image; "
                f"synthesis {s['seconds']:.2f} s, certification {s['certify_seconds']:.2f} s"
                + ("" if s["median_delta_fraction"] is None else
@@ -263,10 +264,10 @@ def synthesize_command(
 
 
 def _relaxed(result) -> str:
-    """`` with curves as round as the finger (alpha 0.08)`` when the curvature threshold was relaxed."""
+    """`` (relaxed from 0.5: curves as round as the finger)`` when the curvature threshold was relaxed."""
     if not result.alphas_tried or result.alpha == result.alphas_tried[0]:
         return ""
-    return f" with curves as round as the finger (alpha {result.alpha:g})"
+    return f" (relaxed from {result.alphas_tried[0]:g}: curves as round as the finger)"
 
 
 def independent_regions_command(
@@ -301,7 +302,7 @@ def independent_regions_command(
         raise typer.Exit(2)
     try:
         if alpha is not None:
-            number_in(alpha, "--alpha", 0, 100, unit="(fraction of the object's size)")
+            number_in(alpha, "--alpha", 0, ALPHA_MAX, unit="(fraction of the object's size)")
         summary = independent_file(image, grasps, output, symmetric=not asymmetric, tol=tol, budget=budget,
                                    normal_tol=math.radians(normal_tol), alpha=alpha, threshold=threshold,
                                    largest=largest)

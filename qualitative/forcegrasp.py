@@ -289,8 +289,9 @@ def best_triplet_margins(cands: Candidates, contour: np.ndarray, theta_min: floa
     positively span the plane), ``best`` the largest margin of any triplet (the smallest of its
     cone, force and normal spanning margins at its best meeting point, as :func:`triplet_grasps`
     scores them; negative when no triplet's friction cones have a common point inside its
-    contact triangle). A triplet is a grasp when ``best`` reaches the margin. None where no three
-    candidates are far enough apart.
+    contact triangle). A triplet is a grasp when ``best`` reaches the margin. ``normals`` is None
+    when no three candidates are far enough apart, ``best`` when no triplet has admissible
+    contacts.
 
     Examples
     --------

@@ -182,11 +182,11 @@ def form_grasps(cands: Candidates, contour: np.ndarray, center: np.ndarray, leng
 
 
 def deepest_closure(cands: Candidates, center: np.ndarray, length: float, size: float, *,
-                    gap: float = GAP) -> float:
+                    gap: float = GAP) -> float | None:
     """Why :func:`form_grasps` found nothing, in numbers: the depth of the emptiest zone of
     freedom any four candidates at least ``gap * size`` apart leave (negative: the zone is empty;
-    ``+inf`` when every set of four leaves free motions). A start point gives a grasp when its
-    depth is below ``-error / length``.
+    ``+inf`` when every set of four leaves free motions; None when no four candidates are that far
+    apart). A start point gives a grasp when its depth is below ``-error / length``.
 
     Examples
     --------
@@ -207,10 +207,22 @@ def deepest_closure(cands: Candidates, center: np.ndarray, length: float, size: 
     inf
     """
     P, N = np.asarray(cands.points), np.asarray(cands.normals)
-    if len(P) < 4:
-        return np.inf
-    _, depth = _best_completions(unit_wrenches(P, N, center, length), separated(P, gap, size))
+    far = separated(P, gap, size)
+    if not _four_apart(far):
+        return None
+    _, depth = _best_completions(unit_wrenches(P, N, center, length), far)
     return float(depth.min())
+
+
+def _four_apart(far: np.ndarray) -> bool:
+    """Whether four candidates are pairwise ``far``: some ``i`` with a triangle among its far
+    neighbours (``(A @ A) * A`` is non-zero on the edges of a triangle)."""
+    for i in range(len(far)):
+        rest = np.flatnonzero(far[i, i + 1:]) + i + 1
+        A = far[np.ix_(rest, rest)].astype(np.int64)
+        if ((A @ A) * A).any():
+            return True
+    return False
 
 
 def _det(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:

@@ -31,7 +31,6 @@ Farkas certificate), ``evaluations``, ``seconds`` and ``error``.
 from __future__ import annotations
 
 import json
-import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,9 +42,10 @@ from ..certify.errors import CertifyError, GraspError, GraspFileError
 from ..certify.grasp import Grasp, grasp_from_dict
 from ..certify.region_boundary import SEARCH_BUDGET, IndependentRegions, independent_regions
 from ..certify.region_data import tuple_to_dict
+from ..certify.validation import number, show
 from .errors import QualitativeError
 from .outline import DEFAULT_SCALE, SCALE_MAX, Outline, outline_image
-from .regions import ALPHA, FINGER_WIDTH, MARGIN, Region, feasible_regions
+from .regions import ALPHA, ALPHA_MAX, FINGER_WIDTH, MARGIN, Region, feasible_regions
 from .vision import ImageSource
 
 __all__ = ["ON_OUTLINE", "outline_boundary", "contact_limits", "planned_regions", "independent_grasp",
@@ -125,7 +125,8 @@ def contact_limits(outline: Outline, regions: list[Region], points: np.ndarray, 
 
 def planned_regions(image: ImageSource, grasp: Grasp, *, alpha: float | None = None,
                     finger_width: float = FINGER_WIDTH, margin: float = MARGIN, threshold: float | None = None,
-                    largest: bool = False, cache: dict | None = None) -> list[Region]:
+                    largest: bool = False, outline: Outline | None = None,
+                    cache: dict | None = None) -> list[Region]:
     """The feasible regions a grasp was planned on: those of the image's outline at the grasp's
     field ``scale`` (default :data:`~qualgrasp.qualitative.outline.DEFAULT_SCALE`) with the
     curvature threshold ``alpha`` when given, else the grasp's field ``alpha``, else
@@ -142,25 +143,36 @@ def planned_regions(image: ImageSource, grasp: Grasp, *, alpha: float | None = N
         Feasible regions' parameters (:func:`~qualgrasp.qualitative.regions.feasible_regions`).
     threshold, largest
         As for :func:`~qualgrasp.qualitative.outline.outline_image`.
+    outline : Outline, optional
+        The image's outline at some scale, used instead of extracting it again when the grasp's
+        scale is that one.
     cache : dict, optional
-        Regions already computed, by scale and threshold (filled in).
+        Regions already found, by ``(scale, alpha)`` (filled in); for one image, ``threshold``,
+        ``largest``, ``finger_width`` and ``margin``.
 
     Returns
     -------
     list of Region
+
+    Raises
+    ------
+    GraspError
+        The grasp's field ``scale`` or ``alpha`` is not a number in range.
     """
-    scale = grasp.meta.get("scale", DEFAULT_SCALE)
-    alpha = grasp.meta.get("alpha", ALPHA) if alpha is None else alpha
-    number = (int, float)
-    if isinstance(scale, bool) or not isinstance(scale, number) or not DEFAULT_SCALE / 4 <= scale <= SCALE_MAX:
+    scale = number(grasp.meta.get("scale", DEFAULT_SCALE))
+    if scale is None or not DEFAULT_SCALE / 4 <= scale <= SCALE_MAX:
         raise GraspError(f"field scale: expected the outline's scale in [{DEFAULT_SCALE / 4:g}, {SCALE_MAX:g}], "
-                         f"got {scale!r}")
-    if isinstance(alpha, bool) or not isinstance(alpha, number) or not 0 <= alpha < math.inf:
-        raise GraspError(f"field alpha: expected a curvature threshold >= 0, got {alpha!r}")
-    key = (float(scale), float(alpha))
+                         f"got {show(grasp.meta.get('scale'))}")
+    if alpha is None:
+        alpha = number(grasp.meta.get("alpha", ALPHA))
+        if alpha is None or not 0 <= alpha <= ALPHA_MAX:
+            raise GraspError(f"field alpha: expected a curvature threshold in [0, {ALPHA_MAX:g}] (fraction of "
+                             f"the object's size), got {show(grasp.meta.get('alpha'))}")
+    key = (scale, float(alpha))
     cache = {} if cache is None else cache
     if key not in cache:
-        outline = outline_image(image, scale=key[0], threshold=threshold, largest=largest)
+        if outline is None or outline.scale != scale:
+            outline = outline_image(image, scale=scale, threshold=threshold, largest=largest)
         cache[key] = feasible_regions(outline, key[1], finger_width, margin)
     return cache[key]
 
@@ -300,7 +312,7 @@ def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str 
                 gid = value["id"]
             grasp = grasp_from_dict(value)
             regions = planned_regions(image, grasp, alpha=alpha, finger_width=finger_width, margin=margin,
-                                      threshold=threshold, largest=largest, cache=cache)
+                                      threshold=threshold, largest=largest, outline=outline, cache=cache)
             result = independent_grasp(outline, grasp, regions=regions, symmetric=symmetric, tol=tol,
                                        budget=budget, normal_tol=normal_tol)
             row = _row(gid, number, result)

@@ -42,10 +42,12 @@ from scipy import ndimage
 from .outline import Outline, outline_image
 from .vision import ImageSource
 
-__all__ = ["ALPHA", "FINGER_WIDTH", "MARGIN", "GRASPABLE", "Region", "feasible_regions",
+__all__ = ["ALPHA", "ALPHA_MAX", "FINGER_WIDTH", "MARGIN", "GRASPABLE", "Region", "feasible_regions",
            "regions_image", "regions_to_dict"]
 
 ALPHA = 0.5
+#: Largest curvature threshold the command line and grasp fields accept (fraction of the size).
+ALPHA_MAX = 100.0
 FINGER_WIDTH = 0.08
 MARGIN = 0.02
 GRASPABLE = "/)("

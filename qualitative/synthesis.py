@@ -35,7 +35,7 @@ fallback). :attr:`Synthesis.scale` is the scale the grasps come from, and
 :attr:`Synthesis.reason` says why nothing was found.
 
 **Curvature threshold.** Curves are feasible first where their bounding circle under the pad is
-at least :data:`qualgrasp.qualitative.regions.ALPHA` of the object's size (flat ones, as the
+wider than :data:`qualgrasp.qualitative.regions.ALPHA` of the object's size (flat ones, as the
 paper prefers). When no scale gives a grasp, the same scales are tried again with the threshold
 relaxed to the finger's own width: a curve is then feasible wherever the pad fits on it (its
 circle at least as wide as the pad), such as the rounded tip of a wing or of a cell's protrusion,

@@ -19,6 +19,7 @@ from qualgrasp.qualitative import procedures
 from qualgrasp.qualitative.candidates import Candidates
 from qualgrasp.qualitative.errors import SynthesisError
 from qualgrasp.qualitative.forcegrasp import best_triplet_margins, triplet_grasps
+from qualgrasp.qualitative.formgrasp import deepest_closure
 from qualgrasp.qualitative.objects import render, render_polygon, shape
 from qualgrasp.qualitative.outline import DEFAULT_SCALE, finger_scale, outline_image
 from qualgrasp.qualitative.procedures import SearchInput
@@ -165,7 +166,7 @@ def test_independent_regions_command_keeps_the_grasps_regions(tmp_path):
     cv2.imwrite(str(image), _stadium())
     runner = CliRunner()
     out = runner.invoke(app, ["synthesize", str(image), "--fingers", "3", "-o", str(tmp_path / "g.jsonl")])
-    assert out.exit_code == 0 and "with curves as round as the finger (alpha 0.08)" in out.output
+    assert out.exit_code == 0 and "alpha 0.08 (relaxed from 0.5: curves as round as the finger)" in out.output
     rows = [json.loads(line) for line in (tmp_path / "g.jsonl").read_text().splitlines()]
     out = runner.invoke(app, ["independent-regions", str(image), str(tmp_path / "g.jsonl"),
                               "-o", str(tmp_path / "r.jsonl")])
@@ -193,6 +194,12 @@ def test_three_fingers_say_how_far_the_cones_are_from_meeting():
     assert best < 0 and not triplet_grasps(c, contour, theta, 200, margin=0.0)
     why = procedures.get("forcegrasp3").diagnose(SearchInput(c, contour, np.zeros(2), 100.0, 200.0, theta, 2.0, 0.25))
     assert "no three contacts have friction cones with a common point inside their triangle" in why
+    # normals 174 degrees apart and a third across: they span, with 3 degrees to spare, not the margin
+    u = np.c_[np.cos(np.radians([0, 174, 270])), np.sin(np.radians([0, 174, 270]))]
+    three = Candidates(-100 * u, u, np.arange(3), np.full(3, 10.0))
+    why = procedures.get("forcegrasp3").diagnose(SearchInput(three, -150 * u, np.zeros(2), 100.0, 200.0,
+                                                             np.radians(26.57), 2.0, 0.25))
+    assert "span the plane without the margin" in why and "gap of 174.0 degrees" in why
     # at the feet of the perpendiculars from the centre the cones meet whatever their width
     c = Candidates(feet, n, np.arange(3), np.full(3, 10.0))
     normals, best = best_triplet_margins(c, contour, theta, 200)
@@ -204,6 +211,13 @@ def test_formgrasp_says_how_deep_its_best_zone_is():
     disc = synthesize(render("disc"), procedure="formgrasp", quality=False, tolerance=False)
     m = re.search(r"closes the zone by ([0-9.e-]+) .*against ([0-9.e-]+) for 2 px", disc.reason)
     assert m and 0 < float(m.group(1)) < float(m.group(2))
+    # four candidates, two of them closer than a finger's gap: no set of four to try
+    n = np.array([[0, 1], [-1, 0], [0, -1], [1, 0]], float)
+    p = np.array([[30, -100], [100, -30], [-30, 100], [-29, 100]], float)
+    c = Candidates(p, n, np.arange(4), np.full(4, 10.0))
+    assert deepest_closure(c, np.zeros(2), 141.4, 283) is None
+    why = procedures.get("formgrasp").diagnose(SearchInput(c, p, np.zeros(2), 141.4, 283.0, None, 2.0, 0.25))
+    assert why == "no four candidate contacts are far enough apart for four fingers"
 
 
 def test_independent_regions_reports_bad_scale_and_alpha_fields_per_row(tmp_path):
@@ -213,12 +227,14 @@ def test_independent_regions_reports_bad_scale_and_alpha_fields_per_row(tmp_path
     runner = CliRunner()
     assert runner.invoke(app, ["synthesize", str(image), "--fingers", "2", "-o", str(grasps)]).exit_code == 0
     good = json.loads(grasps.read_text().splitlines()[0])
-    bad = [dict(good, scale="abc"), dict(good, alpha=-1), dict(good, scale=5.0), dict(good, alpha=True)]
+    bad = [dict(good, scale="abc"), dict(good, alpha=-1), dict(good, scale=5.0), dict(good, alpha=True),
+           dict(good, alpha=10 ** 400), dict(good, alpha=1e308)]
     grasps.write_text("\n".join(json.dumps(g) for g in [good, *bad]) + "\n")
     out = runner.invoke(app, ["independent-regions", str(image), str(grasps), "-o", str(tmp_path / "r.jsonl")])
     assert out.exit_code == 1, out.output
     rows = [json.loads(line) for line in (tmp_path / "r.jsonl").read_text().splitlines()]
     assert rows[0]["status"] == "robust" and rows[0]["delta"] > 0
-    assert [r["status"] for r in rows[1:]] == ["error"] * 4
-    for row, field in zip(rows[1:], ["scale", "alpha", "scale", "alpha"]):
+    assert [r["status"] for r in rows[1:]] == ["error"] * len(bad)
+    for row, field in zip(rows[1:], ["scale", "alpha", "scale", "alpha", "alpha", "alpha"]):
         assert f"field {field}" in row["error"] and row["error"].startswith(f"line {row['line']}")
+        assert len(row["error"]) < 200

@@ -13,7 +13,7 @@ from shapely.geometry import Polygon
 
 from qualgrasp.certify import Contact, Grasp, certify_grasp
 from qualgrasp.certify.quality import epsilon
-from qualgrasp.experiments.baseline import Boundary, Budget, baseline, boundary, search
+from qualgrasp.experiments.baseline import Boundary, Budget, baseline, boundary, boundary_of_polygon, search
 from qualgrasp.experiments.silhouettes import horse, select_cells, write_silhouettes
 from qualgrasp.experiments.study import (GRASP_COLUMNS, OBJECT_COLUMNS, OVERALL_COLUMNS, ROBUSTNESS_COLUMNS,
                                ROUTES, Settings, compare, execute, perturb, robustness_trial,
@@ -179,6 +179,37 @@ def test_execution_on_the_perceived_disc():
         assert outcome == "contact"
         assert np.linalg.norm(done.points[0] - (c + radius * u)) < 0.1
         assert done.normals[0] == pytest.approx(-u, abs=0.01)
+
+
+def test_exact_boundary_of_a_polygon():
+    """Every vertex kept, points on the exterior, normals of the edges pointing in (a vertex: the
+    bisector), whatever the polygon's orientation; the perceived boundary lies within a tenth of
+    a pixel of it in the median."""
+    poly = shape("polygon")
+    for ring in (poly, Polygon(list(poly.exterior.coords)[::-1])):
+        b = boundary_of_polygon(ring)
+        on = shapely.distance(poly.exterior, shapely.points(b.points))
+        assert on.max() < 1e-9
+        assert shapely.distance(shapely.points(np.asarray(poly.exterior.coords)), shapely.MultiPoint(b.points)).max() < 1e-9
+        inside = shapely.contains_xy(poly, *(b.points + 0.05 * b.normals).T)
+        assert inside.all() and np.allclose(np.linalg.norm(b.normals, axis=1), 1.0)
+        gaps = np.linalg.norm(np.diff(b.points, axis=0), axis=1)
+        assert gaps.max() <= 0.25 + 1e-9
+    seen = boundary(render("polygon"))
+    assert np.median(shapely.distance(poly.exterior, shapely.points(seen.points))) < 0.1
+
+
+def test_subjects_of_known_geometry_are_executed_on_it(cells):
+    subject, = subjects([cells[0]])
+    assert subject.geometry.equals(cells[0].polygon())
+    assert subjects(["nut"])[0].geometry.equals(Polygon(shape("nut").exterior))  # fingers stay outside
+    assert subjects([("x", render("nut"))])[0].geometry is None
+    # the qualitative grasps of the polygon hold on its exact geometry, sharp corners and all
+    subject = subjects(["polygon"])[0]
+    rows = robustness_trial(subject, boundary_of_polygon(subject.geometry), segment(subject.image).level,
+                            "none", 0.0, 0, Settings(budget=TINY, workers=1))
+    qualitative = [r for r in rows if r["method"] == "qualitative"]
+    assert all(r["held"] == r["planned"] > 0 for r in qualitative), qualitative
 
 
 # --- perturbations and robustness ---------------------------------------------------------------

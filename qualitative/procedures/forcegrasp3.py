@@ -22,10 +22,13 @@ def _diagnose(s: SearchInput) -> str:
     need = s.margin * s.theta_min
     if normals is None:
         return "no three candidate contacts are far enough apart for three fingers"
+    gap, limit = 180 - 2 * math.degrees(normals), 180 - 2 * math.degrees(need)
+    if normals <= 0:
+        return (f"the normals never positively span the plane: the best three leave a gap of {gap:.1f} "
+                f"degrees between them, against at most {limit:.1f} (180 less twice the margin)")
     if normals < need:
-        return (f"the normals never positively span the plane: the best three leave a gap of "
-                f"{180 - 2 * math.degrees(normals):.1f} degrees between them, against at most "
-                f"{180 - 2 * math.degrees(need):.1f} (180 less twice the margin)")
+        return (f"the normals span the plane without the margin: the best three leave a gap of {gap:.1f} "
+                f"degrees between them, against at most {limit:.1f} (180 less twice the margin)")
     if best is None or best < 0:
         told = "" if best is None else f" (short by {-math.degrees(best):.1f} degrees)"
         return ("normals span the plane, but no three contacts have friction cones with a common point "

@@ -25,6 +25,8 @@ def _diagnose(s: SearchInput) -> str:
                 f"{180 - 2 * math.degrees(normals):.1f} degrees between them)")
     depth = deepest_closure(s.candidates, s.center, s.length, s.size)
     need = s.error / s.length
+    if depth is None:
+        return "no four candidate contacts are far enough apart for four fingers"
     if not np.isfinite(depth):
         return "rotations stay free: every set of four candidate contacts leaves a zone of free centres"
     return (f"the deepest set of four closes the zone by {-depth:.2g} (the sine of the angle its constraints "
