@@ -9,7 +9,15 @@ hinge on a region's exact extent. The samples run from inset to inset, both ends
 too short for the inset on both sides gives its middle point. A closed region (a disc's single
 convex curve) has no ends.
 
-Units: pixels of the input image, x = column, y = row; normals are inward unit vectors.
+Each candidate also carries its **normal spread**: the largest angle between its normal and the
+contour's own normals at the image's resolution (:meth:`Outline.pixel_normals`) within ``window``
+pixels of arc either side, the position error a grasp must survive (:data:`ERROR`). A clean edge
+or curve has a spread of a few degrees; where the contour is lumpy below the finger's scale (a
+cell's membrane), a finger landing a pixel or two off its point meets a normal tens of degrees
+away, which no grasp planned from the image can count on (``smooth``).
+
+Units: pixels of the input image, x = column, y = row; normals are inward unit vectors; angles in
+radians.
 """
 
 from __future__ import annotations
@@ -24,13 +32,16 @@ from .errors import SynthesisError
 from .outline import Outline
 from .regions import Region
 
-__all__ = ["STEP", "INSET", "PER_REGION", "GAP", "Candidates", "candidates", "object_frame", "separated"]
+__all__ = ["STEP", "INSET", "PER_REGION", "GAP", "ERROR", "Candidates", "candidates", "object_frame",
+           "separated"]
 
 STEP = 0.03
 INSET = 0.02
 PER_REGION = 16
 #: Smallest distance between two fingers, fraction of the object's size.
 GAP = 0.08
+#: Position error a grasp must survive, pixels (the normal spread's window; FormGrasp's depth).
+ERROR = 2.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -48,15 +59,27 @@ class Candidates:
     clearance : numpy.ndarray
         ``(m,)`` arc length from the point to the nearer end of its region, pixels (``inf`` on a
         closed region).
+    spread : numpy.ndarray or None
+        ``(m,)`` normal spread of each point, radians (module notes); None when not known.
     """
 
     points: np.ndarray
     normals: np.ndarray
     region: np.ndarray
     clearance: np.ndarray
+    spread: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.points)
+
+    def smooth(self, limit: float) -> "Candidates":
+        """The candidates whose normal spread is at most ``limit`` radians (all of them when the
+        spread is not known)."""
+        if self.spread is None:
+            return self
+        keep = self.spread <= limit
+        return Candidates(*(_frozen(a[keep], a.dtype) for a in (self.points, self.normals, self.region,
+                                                                 self.clearance, self.spread)))
 
     def of_region(self, r: int) -> np.ndarray:
         """Indices of the candidates on region ``r``."""
@@ -70,7 +93,7 @@ def _frozen(array, dtype=np.float64) -> np.ndarray:
 
 
 def candidates(outline: Outline, regions: Sequence[Region], step: float = STEP,
-               inset: float = INSET, per_region: int = PER_REGION) -> Candidates:
+               inset: float = INSET, per_region: int = PER_REGION, window: float = ERROR) -> Candidates:
     """Sample candidate contacts on feasible regions.
 
     Parameters
@@ -87,14 +110,18 @@ def candidates(outline: Outline, regions: Sequence[Region], step: float = STEP,
     per_region : int
         Largest number of candidates on one region (the spacing grows on longer regions), which
         bounds the cost of the searches (FormGrasp examines every set of four candidates).
+    window : float
+        Arc length either side of a point over which its normal spread is taken, pixels.
 
     Returns
     -------
     Candidates
         In region order, along each region.
     """
-    if not (step > 0 and inset >= 0 and math.isfinite(step) and math.isfinite(inset) and per_region >= 1):
-        raise SynthesisError(f"need step > 0, inset >= 0 and per_region >= 1, got {step}, {inset}, {per_region}")
+    if not (step > 0 and inset >= 0 and math.isfinite(step) and math.isfinite(inset) and per_region >= 1
+            and 0 <= window < math.inf):
+        raise SynthesisError(f"need step > 0, inset >= 0, per_region >= 1 and window >= 0, got {step}, {inset}, "
+                             f"{per_region} and {window}")
     h = outline.spacing
     full = len(outline.contour)
     rows = []
@@ -116,13 +143,23 @@ def candidates(outline: Outline, regions: Sequence[Region], step: float = STEP,
             arc = keep + np.linspace(0.0, usable, count) if count > 1 else np.array([length / 2])
             pick = np.clip(np.round(arc / h).astype(int), 0, k - 1)
             clear = np.minimum(pick, k - 1 - pick) * h
-        rows.append((region.points[pick], region.normals[pick], np.full(len(pick), r), clear))
+        rows.append((region.points[pick], region.normals[pick], np.full(len(pick), r), clear,
+                     (region.start + pick) % full))
     if not rows:
         empty = np.zeros((0, 2))
-        return Candidates(_frozen(empty), _frozen(empty), _frozen([], np.intp), _frozen([]))
-    points, normals, region, clear = (np.concatenate(parts) for parts in zip(*rows))
+        return Candidates(_frozen(empty), _frozen(empty), _frozen([], np.intp), _frozen([]), _frozen([]))
+    points, normals, region, clear, sample = (np.concatenate(parts) for parts in zip(*rows))
     normals = normals / np.linalg.norm(normals, axis=1, keepdims=True)
-    return Candidates(_frozen(points), _frozen(normals), _frozen(region, np.intp), _frozen(clear))
+    spread = _spread(outline, sample, normals, window)
+    return Candidates(_frozen(points), _frozen(normals), _frozen(region, np.intp), _frozen(clear), _frozen(spread))
+
+
+def _spread(outline: Outline, sample: np.ndarray, normals: np.ndarray, window: float) -> np.ndarray:
+    """Normal spread (module notes) of points at contour samples ``sample`` with ``normals``."""
+    w = int(math.ceil(window / outline.spacing))
+    near = (sample[:, None] + np.arange(-w, w + 1)[None]) % len(outline.contour)
+    cosine = np.einsum("mkd,md->mk", outline.pixel_normals()[near], normals)
+    return np.arccos(np.clip(cosine, -1.0, 1.0)).max(axis=1)
 
 
 def object_frame(contour: np.ndarray) -> tuple[np.ndarray, float]:

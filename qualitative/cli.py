@@ -248,7 +248,7 @@ def synthesize_command(
     s = result.summary()
     typer.echo(f"{s['grasps']} grasp(s) by {result.procedure.title} ({result.fingers} fingers, {friction}) "
                f"at outline scale {result.scale:.4g} ({result.outline.string}), alpha {result.alpha:g}"
-               f"{_relaxed(result)} -> {output}; "
+               f"{_relaxed(result)}{'' if result.smooth else ', contacts of any normal spread'} -> {output}; "
                f"{100 * s['certified_fraction']:.0f} % certified, {s['resolved']} resolved by the image; "
                f"synthesis {s['seconds']:.2f} s, certification {s['certify_seconds']:.2f} s"
                + ("" if s["median_delta_fraction"] is None else

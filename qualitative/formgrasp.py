@@ -48,15 +48,12 @@ import numpy as np
 
 from ..certify.wrench import cross
 
-from .candidates import GAP, Candidates, separated
+from .candidates import ERROR, GAP, Candidates, separated
 from .errors import SynthesisError
 from .zones import Zones, free_depth, unit_wrenches, zones
 
 __all__ = ["ERROR", "FormGrasp", "form_grasps", "deepest_closure", "closure_depth4", "line_of_action_exit", "ray_edges",
            "zone_steps"]
-
-ERROR = 2.0
-
 
 @dataclass(frozen=True, eq=False)
 class FormGrasp:

@@ -445,6 +445,13 @@ class Outline:
         t = self.tangents()
         return np.column_stack([-t[:, 1], t[:, 0]])
 
+    def pixel_normals(self, sigma: float = 1.0) -> np.ndarray:
+        """``(n, 2)`` inward unit normals of the contour smoothed over only ``sigma`` pixels (a
+        Gaussian's standard deviation): the contour's own normals at the image's resolution,
+        which :meth:`normals` averages over the outline's scale."""
+        t = _unit_tangents(ndimage.gaussian_filter1d(self.contour, sigma / self.spacing, axis=0, mode="wrap"))
+        return np.column_stack([-t[:, 1], t[:, 0]])
+
     def turning(self) -> np.ndarray:
         """``(n,)`` turning angle of the smoothed contour at every sample, radians (sum 2 pi)."""
         return _turning(self.smoothed)

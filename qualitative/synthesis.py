@@ -43,6 +43,15 @@ which an elongated object may need for a third finger (:func:`search_attempts`).
 records its ``scale`` and ``alpha``, and :attr:`Synthesis.alpha` is the threshold the grasps come
 from; ``alpha`` given fixes it.
 
+**Contacts whose normal the image pins down.** Every attempt is first searched with the
+candidates whose normal spread is at most :data:`SPREAD` (10 degrees: the contour's own normal
+stays that close within ``error`` pixels of arc either side;
+:mod:`qualgrasp.qualitative.candidates`), and only when no attempt gives a grasp again with every
+candidate. On a lumpy outline (a cell's membrane, bumps of a pixel) a contact placed a pixel or
+two off meets a normal tens of degrees away, and a frictionless finger's force turns with it.
+:attr:`Synthesis.smooth` says which pass the grasps come from; ``normal_spread=None`` searches
+every candidate at once.
+
 Certified tolerance
 -------------------
 With ``tolerance`` (the default), every certified grasp also gets its **independent contact
@@ -86,18 +95,17 @@ from ..certify.errors import GraspError
 from ..certify.quality import epsilon
 from ..certify.region_boundary import IndependentRegions
 from . import procedures as registry
-from .candidates import INSET, PER_REGION, STEP, Candidates, candidates, object_frame
+from .candidates import ERROR, INSET, PER_REGION, STEP, Candidates, candidates, object_frame
 from .errors import SynthesisError
 from .forcegrasp import MARGIN, friction
-from .formgrasp import ERROR
 from .independent import independent_grasp
 from .outline import DEFAULT_SCALE, SCALE_MAX, Outline, finger_scale, outline_image, outline_scales
 from .procedures import Procedure, SearchInput
 from .regions import ALPHA, FINGER_WIDTH, MARGIN as REGION_MARGIN, Region, feasible_regions
 from .vision import ImageSource
 
-__all__ = ["MU", "POSITION", "NORMAL", "FALLBACK_SCALES", "FALLBACK_STEP", "Synthesis", "synthesize", "to_grasp", "choose",
-           "resolution", "search_scales", "search_alphas", "search_attempts"]
+__all__ = ["MU", "POSITION", "NORMAL", "SPREAD", "FALLBACK_SCALES", "FALLBACK_STEP", "Synthesis", "synthesize",
+           "to_grasp", "choose", "resolution", "search_scales", "search_alphas", "search_attempts"]
 
 MU = 0.5
 """Default friction coefficient of procedures with friction."""
@@ -108,6 +116,11 @@ POSITION = 1.0
 NORMAL = 0.5
 """Error of the contour across the length a normal is estimated over, pixels: a normal estimated
 over ``l`` pixels is known to ``NORMAL / l`` radians."""
+
+SPREAD = math.radians(10)
+"""Largest normal spread of a contact in synthesis's first pass, radians (module notes): about
+three times that of a clean edge or curve in an image (the built-in objects' candidates: at most
+3 degrees)."""
 
 FALLBACK_SCALES = 4
 """Coarser scales of the outline's hierarchy tried, one after the other, when a procedure finds
@@ -173,6 +186,9 @@ class Synthesis:
         object's size; module notes).
     alphas_tried : tuple of float
         The curvature threshold of every attempt, parallel to ``scales_tried``.
+    smooth : bool
+        Whether the grasps' contacts all have a normal spread within ``normal_spread`` (module
+        notes); False when only contacts of any spread gave grasps, or ``normal_spread`` was None.
     """
 
     name: str
@@ -196,6 +212,7 @@ class Synthesis:
     reason: str | None = None
     alpha: float = ALPHA
     alphas_tried: tuple[float, ...] = ()
+    smooth: bool = True
 
     @property
     def deltas(self) -> tuple[float | None, ...]:
@@ -243,6 +260,7 @@ class Synthesis:
             "median_delta_fraction": float(np.median(deltas)) if deltas else None,
             "scale": self.scale,
             "alpha": self.alpha,
+            "smooth": self.smooth,
             "reason": self.reason,
             "seconds": self.seconds,
             "certify_seconds": self.certify_seconds,
@@ -346,7 +364,8 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
                threshold: float | None = None, largest: bool = False, finger_width: float = FINGER_WIDTH,
                region_margin: float = REGION_MARGIN, step: float = STEP, inset: float = INSET,
                per_region: int = PER_REGION, error: float = ERROR, margin: float = MARGIN,
-               tolerance: bool = True, scale: float | None = None, explain: bool = True) -> Synthesis:
+               tolerance: bool = True, scale: float | None = None, explain: bool = True,
+               normal_spread: float | None = SPREAD) -> Synthesis:
     """Synthesise and certify grasps of the object in an image.
 
     Parameters
@@ -383,7 +402,8 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     step, inset, per_region
         Candidate contacts (:func:`qualgrasp.qualitative.candidates.candidates`).
     error : float
-        FormGrasp: position error (pixels) the grasps must survive.
+        Position error (pixels) the grasps must survive: FormGrasp's zone depth, and the window
+        of the candidates' normal spread.
     margin : float
         ForceGrasp: smallest angular margin, fraction of ``theta_min``.
     tolerance : bool
@@ -392,6 +412,9 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     scale : float, optional
         The outline's scale (fraction of the perimeter, in ``[0.001, 0.032]``) for regions and
         procedures; default the finger's scale with coarser fallbacks (module notes).
+    normal_spread : float or None
+        Largest normal spread of a contact (radians; module notes) in the first pass over the
+        attempts; None: one pass with every candidate.
     explain : bool
         When nothing is found, give the procedure's best near-miss in numbers in
         :attr:`Synthesis.reason` (another pass over the candidates of the largest search; the
@@ -434,19 +457,34 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     start = time.perf_counter()
     fine = outline_image(image, threshold=threshold, largest=largest)
     center, length = object_frame(fine.contour)
-    tried: list[tuple[float, float]] = []
-    most, richest = 0, None  # most feasible regions and the largest search, for the reason
-    for s, a, outline, regions in _attempt_regions(image, fine, finger_width, scale, alpha, region_margin,
-                                                   threshold, largest):
-        tried.append((s, a))
-        most = max(most, len(regions))
-        cands = candidates(outline, regions, step, inset, per_region)
-        search = SearchInput(cands, outline.contour, center, length, outline.size, theta_min, error, margin)
-        if richest is None or len(cands) > len(richest[0].candidates):
-            richest = (search, s, a)
-        found = proc.search(search)
-        if found:
+    tried: list[tuple[float, float, bool]] = []
+    most, richest, found = 0, None, []
+    attempts: list[tuple] = []  # (scale, alpha, outline, regions, candidates), kept for the second pass
+    for rough in (False, True):
+        if rough and (found or normal_spread is None):
             break
+        source = iter(attempts) if rough else _attempt_regions(image, fine, finger_width, scale, alpha,
+                                                                region_margin, threshold, largest)
+        for item in source:
+            if rough:
+                s, a, outline, regions, every = item
+                if normal_spread is None or len(every.smooth(normal_spread)) == len(every):
+                    continue  # every contact is smooth: the first pass searched these already
+                cands = every
+            else:
+                s, a, outline, regions = item
+                every = candidates(outline, regions, step, inset, per_region, error)
+                attempts.append((s, a, outline, regions, every))
+                cands = every if normal_spread is None else every.smooth(normal_spread)
+            tried.append((s, a, rough))
+            most = max(most, len(regions))
+            search = SearchInput(cands, outline.contour, center, length, outline.size, theta_min, error, margin)
+            if richest is None or len(cands) > len(richest[0].candidates):
+                richest = (search, s, a)
+            found = proc.search(search)
+            if found:
+                break
+    smooth = normal_spread is not None and not (found and tried[-1][2])
     reason = None if found else _reason(proc, tried, most, richest if explain else None)
     stem = _name(image, name)
     grasps = []
@@ -463,7 +501,8 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     tolerances = tuple(_tolerance(fine, regions, g, r) for g, r in zip(grasps, reports)) if tolerance else ()
     return Synthesis(stem, proc.fingers, proc, mu, theta_min, outline, regions, cands,
                      center, length, tuple(found), grasps, reports, seconds, time.perf_counter() - start,
-                     tolerances, outline.scale, tuple(t[0] for t in tried), reason, a, tuple(t[1] for t in tried))
+                     tolerances, outline.scale, tuple(t[0] for t in tried), reason, a, tuple(t[1] for t in tried),
+                     smooth)
 
 
 def search_scales(image: ImageSource, fine: Outline, finger_width: float, scale: float | None = None, *,
@@ -555,17 +594,19 @@ def _fine_normals(regions: tuple[Region, ...], fine: Outline, outline: Outline) 
     return tuple(out)
 
 
-def _tried(tried: list[tuple[float, float]]) -> str:
-    """``'0.0066, 0.004 at alpha 0.5; 0.0066, 0.004 at alpha 0.08'``: the attempts by threshold."""
+def _tried(tried: list[tuple[float, float, bool]]) -> str:
+    """``'0.0066, 0.004 at alpha 0.5; 0.0066 at alpha 0.08; 0.0066 at alpha 0.5 with contacts of any
+    normal spread'``: the attempts by threshold and pass."""
     parts = []
-    for a in dict.fromkeys(t[1] for t in tried):
-        parts.append(", ".join(f"{s:.4g}" for s, b in tried if b == a) + f" at alpha {a:g}")
+    for a, rough in dict.fromkeys((t[1], t[2]) for t in tried):
+        parts.append(", ".join(f"{s:.4g}" for s, b, r in tried if (b, r) == (a, rough)) + f" at alpha {a:g}"
+                     + (" with contacts of any normal spread" if rough else ""))
     return "; ".join(parts)
 
 
-def _reason(proc: Procedure, tried: list[tuple[float, float]], regions: int,
+def _reason(proc: Procedure, tried: list[tuple[float, float, bool]], regions: int,
             richest: tuple[SearchInput, float, float] | None) -> str:
-    """Why ``proc`` found nothing at the ``(scale, alpha)`` attempts ``tried`` (``regions``: the
+    """Why ``proc`` found nothing at the ``(scale, alpha, rough)`` attempts ``tried`` (``regions``: the
     most feasible regions at any of them; ``richest``: the attempt with the most candidates, with
     its scale and alpha, for the procedure's own diagnosis; None to skip it)."""
     at = _tried(tried)

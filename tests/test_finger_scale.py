@@ -16,14 +16,16 @@ from qualgrasp.certify import force_closure
 from qualgrasp.cli import app
 from qualgrasp.experiments.silhouettes import select_cells
 from qualgrasp.qualitative import procedures
-from qualgrasp.qualitative.candidates import Candidates
+from qualgrasp.experiments.baseline import boundary_of_polygon, screen_grasps
+from qualgrasp.experiments.study import execute
+from qualgrasp.qualitative.candidates import Candidates, candidates
 from qualgrasp.qualitative.errors import SynthesisError
 from qualgrasp.qualitative.forcegrasp import best_triplet_margins, triplet_grasps
 from qualgrasp.qualitative.formgrasp import deepest_closure
 from qualgrasp.qualitative.objects import render, render_polygon, shape
 from qualgrasp.qualitative.outline import DEFAULT_SCALE, finger_scale, outline_image
 from qualgrasp.qualitative.procedures import SearchInput
-from qualgrasp.qualitative.regions import ALPHA, FINGER_WIDTH
+from qualgrasp.qualitative.regions import ALPHA, FINGER_WIDTH, feasible_regions
 from qualgrasp.qualitative.synthesis import FALLBACK_STEP, synthesize
 
 
@@ -238,3 +240,65 @@ def test_independent_regions_reports_bad_scale_and_alpha_fields_per_row(tmp_path
     for row, field in zip(rows[1:], ["scale", "alpha", "scale", "alpha", "alpha", "alpha"]):
         assert f"field {field}" in row["error"] and row["error"].startswith(f"line {row['line']}")
         assert len(row["error"]) < 200
+
+
+def _lumpy_square():
+    """The square 200 px wide with its bottom edge a square wave of 1.5 px amplitude every 6 px:
+    a straight edge at the finger's scale whose normal, at the pixel's scale, turns by 90
+    degrees every 3 px."""
+    x = np.linspace(356, 156, 201)
+    bottom = np.c_[x, 356 + 1.5 * np.sign(np.sin(2 * np.pi * (x - 156) / 6))]
+    return Polygon(np.vstack([[156, 156], [356, 156], [356, 356], bottom[1:-1], [156, 356]]))
+
+
+def test_candidate_normal_spread():
+    for name in ("polygon", "disc", "figure3"):
+        outline = outline_image(render(name))
+        c = candidates(outline, feasible_regions(outline, FINGER_WIDTH))
+        assert len(c) and np.degrees(c.spread).max() < 5  # clean edges and curves
+    image = render_polygon(_lumpy_square())
+    outline = outline_image(image, scale=finger_scale(outline_image(image), FINGER_WIDTH))
+    assert outline.string == "/>/>/>/>"  # the lumps are below the finger's scale
+    c = candidates(outline, feasible_regions(outline))
+    bottom = np.abs(c.points[:, 1] - 356) < 3
+    assert bottom.any() and np.degrees(c.spread[bottom]).min() > 30 and np.degrees(c.spread[~bottom]).max() < 5
+    smooth = c.smooth(np.radians(10))
+    assert len(smooth) == (~bottom).sum() and not (np.abs(smooth.points[:, 1] - 356) < 3).any()
+
+
+def test_contacts_avoid_a_lumpy_edge_and_hold_on_the_true_polygon():
+    """Two fingers on the lumpy square: the first pass leaves the lumpy edge out and its grasp
+    holds on the exact polygon; searching every candidate at once also pinches the lumpy edge,
+    and that grasp does not hold where the finger really lands."""
+    poly = _lumpy_square()
+    image, truth = render_polygon(poly), boundary_of_polygon(poly)
+    s = synthesize(image, procedure="forcegrasp2", quality=False, tolerance=False)
+    assert s.grasps and s.smooth and all(s.certified)
+    assert not any(abs(c.p[1] - 356) < 3 for g in s.grasps for c in g.contacts)
+    assert all(screen_grasps([execute(g, truth, 0.1, s.outline.contour)[0]])[0][0] for g in s.grasps)
+    every = synthesize(image, procedure="forcegrasp2", quality=False, tolerance=False, normal_spread=None)
+    lumpy = [g for g in every.grasps if any(abs(c.p[1] - 356) < 3 for c in g.contacts)]
+    assert lumpy and not every.smooth
+    assert not any(screen_grasps([execute(g, truth, 0.1, every.outline.contour)[0]])[0][0] for g in lumpy)
+
+
+def test_lumpy_contacts_are_the_last_resort():
+    """A disc whose whole outline is lumpy below the finger's scale: no smooth contact exists, so
+    the second pass takes every candidate and says so."""
+    angles = np.linspace(0, 2 * np.pi, 721)[:-1]
+    r = 100 + 1.5 * np.sign(np.sin(angles * 120))
+    image = render_polygon(Polygon(np.c_[256 + r * np.cos(angles), 256 + r * np.sin(angles)]))
+    s = synthesize(image, procedure="forcegrasp2", quality=False, tolerance=False)
+    assert s.grasps and not s.smooth and all(s.certified)
+    assert np.degrees(s.candidates.spread).min() > 10
+    out = synthesize(image, procedure="forcegrasp2", mu=0.01, quality=False, tolerance=False)
+    assert not out.grasps and "with contacts of any normal spread" in out.reason
+
+
+def test_synthesize_command_says_when_contacts_are_lumpy(tmp_path):
+    angles = np.linspace(0, 2 * np.pi, 721)[:-1]
+    r = 100 + 1.5 * np.sign(np.sin(angles * 120))
+    image = tmp_path / "lumpy.png"
+    cv2.imwrite(str(image), render_polygon(Polygon(np.c_[256 + r * np.cos(angles), 256 + r * np.sin(angles)])))
+    out = CliRunner().invoke(app, ["synthesize", str(image), "--fingers", "2", "-o", str(tmp_path / "g.jsonl")])
+    assert out.exit_code == 0 and ", contacts of any normal spread ->" in out.output
