@@ -176,7 +176,7 @@ class Synthesis:
         notes); ``outline`` is the outline at that scale.
     scales_tried : tuple of float
         Every scale tried, in order (the last is ``scale``; a scale comes again with the next
-        curvature threshold).
+        curvature threshold, and in the second pass with every candidate).
     reason : str or None
         Why no grasp was found (None when some were): no feasible region at any scale tried, or
         feasible regions on which the procedure found no grasp, with the procedure's best
@@ -451,6 +451,8 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
         mu, theta_min = friction(mu, theta_min)
     if alpha is not None and not (math.isfinite(alpha) and alpha >= 0):
         raise SynthesisError(f"alpha must be finite and >= 0, got {alpha}")
+    if normal_spread is not None and not 0 <= normal_spread <= math.pi:
+        raise SynthesisError(f"normal_spread must be in [0, pi] radians or None, got {normal_spread}")
     if scale is not None and not (math.isfinite(scale) and DEFAULT_SCALE / 4 <= scale <= SCALE_MAX):
         raise SynthesisError(f"scale must be in [{DEFAULT_SCALE / 4:g}, {SCALE_MAX:g}] (fraction of the perimeter), "
                              f"got {scale}")

@@ -293,6 +293,9 @@ def test_lumpy_contacts_are_the_last_resort():
     assert np.degrees(s.candidates.spread).min() > 10
     out = synthesize(image, procedure="forcegrasp2", mu=0.01, quality=False, tolerance=False)
     assert not out.grasps and "with contacts of any normal spread" in out.reason
+    for bad in (-0.1, float("nan"), 4.0):
+        with pytest.raises(SynthesisError, match="normal_spread"):
+            synthesize(image, procedure="forcegrasp2", normal_spread=bad)
 
 
 def test_synthesize_command_says_when_contacts_are_lumpy(tmp_path):
