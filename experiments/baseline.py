@@ -193,7 +193,7 @@ def boundary_of_polygon(polygon: Polygon, spacing: float = 0.25) -> Boundary:
     ring = np.asarray(polygon.exterior.coords)[:-1]
     if not polygon.exterior.is_ccw:  # positive orientation: the interior on the left
         ring = ring[::-1]
-    points, normals, edge, s = edge_samples(ring, spacing)
+    points, normals, _, s = edge_samples(ring, spacing)
     first = np.flatnonzero(s == 0)  # the vertices: between their edge and the one before
     normals[first] += normals[np.roll(first, 1)]
     keep = s < 1  # each vertex once, as the start of its edge

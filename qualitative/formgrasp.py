@@ -204,22 +204,8 @@ def deepest_closure(cands: Candidates, center: np.ndarray, length: float, size: 
     inf
     """
     P, N = np.asarray(cands.points), np.asarray(cands.normals)
-    far = separated(P, gap, size)
-    if not _four_apart(far):
-        return None
-    _, depth = _best_completions(unit_wrenches(P, N, center, length), far)
-    return float(depth.min())
-
-
-def _four_apart(far: np.ndarray) -> bool:
-    """Whether four candidates are pairwise ``far``: some ``i`` with a triangle among its far
-    neighbours (``(A @ A) * A`` is non-zero on the edges of a triangle)."""
-    for i in range(len(far)):
-        rest = np.flatnonzero(far[i, i + 1:]) + i + 1
-        A = far[np.ix_(rest, rest)].astype(np.int64)
-        if ((A @ A) * A).any():
-            return True
-    return False
+    _, depth = _best_completions(unit_wrenches(P, N, center, length), separated(P, gap, size))
+    return None if np.isnan(depth).all() else float(np.nanmin(depth))
 
 
 def _det(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
@@ -253,10 +239,11 @@ def closure_depth4(a: np.ndarray) -> np.ndarray:
 
 
 def _best_completions(a: np.ndarray, far: np.ndarray, chunk: int = 200_000) -> tuple[np.ndarray, np.ndarray]:
-    """For every candidate, the deepest closing set of four containing it, and its depth."""
+    """For every candidate, the deepest set of four containing it, and its depth (``+inf``: no
+    such set closes; NaN: no four candidates pairwise ``far`` include it)."""
     m = len(a)
     best_set = np.full((m, 4), -1, dtype=np.intp)
-    best_depth = np.full(m, np.inf)
+    best_depth = np.full(m, np.nan)
     for i in range(m - 3):
         rest = np.flatnonzero(far[i, i + 1:]) + i + 1
         if len(rest) < 3:
@@ -271,7 +258,7 @@ def _best_completions(a: np.ndarray, far: np.ndarray, chunk: int = 200_000) -> t
             for col in range(4):
                 members, first = np.unique(part[order, col], return_index=True)
                 values = d[order][first]
-                better = values < best_depth[members]
+                better = ~(values >= best_depth[members])  # also where none was seen yet (NaN)
                 best_depth[members[better]] = values[better]
                 best_set[members[better]] = part[order][first[better]]
     return best_set, best_depth

@@ -44,7 +44,7 @@ from ..certify.region_boundary import SEARCH_BUDGET, IndependentRegions, indepen
 from ..certify.region_data import tuple_to_dict
 from ..certify.validation import number, show
 from .errors import QualitativeError
-from .outline import DEFAULT_SCALE, SCALE_MAX, Outline, outline_image
+from .outline import DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_image
 from .regions import ALPHA, ALPHA_MAX, FINGER_WIDTH, MARGIN, Region, feasible_regions
 from .vision import ImageSource
 
@@ -160,8 +160,8 @@ def planned_regions(image: ImageSource, grasp: Grasp, *, alpha: float | None = N
         The grasp's field ``scale`` or ``alpha`` is not a number in range.
     """
     scale = number(grasp.meta.get("scale", DEFAULT_SCALE))
-    if scale is None or not DEFAULT_SCALE / 4 <= scale <= SCALE_MAX:
-        raise GraspError(f"field scale: expected the outline's scale in [{DEFAULT_SCALE / 4:g}, {SCALE_MAX:g}], "
+    if scale is None or not SCALE_MIN <= scale <= SCALE_MAX:
+        raise GraspError(f"field scale: expected the outline's scale in [{SCALE_MIN:g}, {SCALE_MAX:g}], "
                          f"got {show(grasp.meta.get('scale'))}")
     if alpha is None:
         alpha = number(grasp.meta.get("alpha", ALPHA))

@@ -133,6 +133,7 @@ __all__ = [
     "DEFAULT_SCALE",
     "WINDOW",
     "SCALE_MAX",
+    "SCALE_MIN",
     "Segment",
     "Outline",
     "canonical",
@@ -172,6 +173,9 @@ DEFAULT_SCALE = 0.004
 
 WINDOW = 5.0
 """Corner window (also the shortest run and the corner merging distance), in scales."""
+
+SCALE_MIN = DEFAULT_SCALE / 4
+"""Finest scale synthesis and grasp fields accept (fraction of the perimeter)."""
 
 SCALE_MAX = 0.032
 """Coarsest scale (fraction of the perimeter): 8 times the default, the coarse end of the hierarchy.

@@ -99,7 +99,7 @@ from .candidates import ERROR, INSET, PER_REGION, STEP, Candidates, candidates, 
 from .errors import SynthesisError
 from .forcegrasp import MARGIN, friction
 from .independent import independent_grasp
-from .outline import DEFAULT_SCALE, SCALE_MAX, Outline, finger_scale, outline_image, outline_scales
+from .outline import DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, finger_scale, outline_image, outline_scales
 from .procedures import Procedure, SearchInput
 from .regions import ALPHA, FINGER_WIDTH, MARGIN as REGION_MARGIN, Region, feasible_regions
 from .vision import ImageSource
@@ -453,15 +453,15 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
         raise SynthesisError(f"alpha must be finite and >= 0, got {alpha}")
     if normal_spread is not None and not 0 <= normal_spread <= math.pi:
         raise SynthesisError(f"normal_spread must be in [0, pi] radians or None, got {normal_spread}")
-    if scale is not None and not (math.isfinite(scale) and DEFAULT_SCALE / 4 <= scale <= SCALE_MAX):
-        raise SynthesisError(f"scale must be in [{DEFAULT_SCALE / 4:g}, {SCALE_MAX:g}] (fraction of the perimeter), "
+    if scale is not None and not (math.isfinite(scale) and SCALE_MIN <= scale <= SCALE_MAX):
+        raise SynthesisError(f"scale must be in [{SCALE_MIN:g}, {SCALE_MAX:g}] (fraction of the perimeter), "
                              f"got {scale}")
     start = time.perf_counter()
     fine = outline_image(image, threshold=threshold, largest=largest)
     center, length = object_frame(fine.contour)
     tried: list[tuple[float, float, bool]] = []
     most, richest, found = 0, None, []
-    attempts: list[tuple] = []  # (scale, alpha, outline, regions, candidates), kept for the second pass
+    attempts: list[tuple] = []  # (scale, alpha, outline, regions, every candidate, the first pass's), for the second
     for rough in (False, True):
         if rough and (found or normal_spread is None):
             break
@@ -469,15 +469,14 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
                                                                 region_margin, threshold, largest)
         for item in source:
             if rough:
-                s, a, outline, regions, every = item
-                if normal_spread is None or len(every.smooth(normal_spread)) == len(every):
+                s, a, outline, regions, cands, first = item
+                if len(first) == len(cands):
                     continue  # every contact is smooth: the first pass searched these already
-                cands = every
             else:
                 s, a, outline, regions = item
                 every = candidates(outline, regions, step, inset, per_region, error)
-                attempts.append((s, a, outline, regions, every))
                 cands = every if normal_spread is None else every.smooth(normal_spread)
+                attempts.append((s, a, outline, regions, every, cands))
             tried.append((s, a, rough))
             most = max(most, len(regions))
             search = SearchInput(cands, outline.contour, center, length, outline.size, theta_min, error, margin)
