@@ -53,7 +53,7 @@ from __future__ import annotations
 
 import json
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from itertools import repeat
 from pathlib import Path
@@ -65,17 +65,26 @@ from .rcc8 import RELATIONS, path_consistency
 
 #: Longest formula accepted, in characters.
 MAX_FORMULA = 10_000
-#: Most nested operators in a formula (brackets, ``!``, temporal operators, chains of ``->``,
-#: ``U``, ``S``): evaluation and printing are recursive.
+#: Most operators nested inside each other in a formula (:meth:`Formula.depth`: ``!``, the
+#: temporal operators, ``&``, ``|``, ``->``, ``U`` and ``S`` each count where one encloses the
+#: next; siblings such as ``p & q & r`` do not add up), and most brackets nested inside each
+#: other: parsing, evaluation and printing recurse once per level.
 MAX_DEPTH = 100
 #: Largest trace file read, in bytes.
 MAX_TRACE_BYTES = 64 << 20
+#: Most work of the consistency checks of one trace: each different arrangement of its frames
+#: (frames equal up to the regions' names share one check) costs 1 + its regions squared.
+MAX_ARRANGEMENT_WORK = 500_000
+#: Most work of one evaluation: frames times (10 per region pair the formula reads, which is
+#: looked up in both directions in every frame, + 1 per operator, atom or constant, which is a
+#: vectorised pass over the frames).
+MAX_EVALUATION_WORK = 400_000_000
 
 __all__ = [
     "Formula", "Const", "Atom", "Not", "And", "Or", "Implies",
     "Next", "Sometime", "Always", "Until", "Previous", "Once", "Historically", "Since",
     "parse", "read_trace", "write_trace", "evaluate_file", "evaluate_reference",
-    "MAX_FORMULA", "MAX_DEPTH", "MAX_TRACE_BYTES",
+    "MAX_FORMULA", "MAX_DEPTH", "MAX_TRACE_BYTES", "MAX_ARRANGEMENT_WORK", "MAX_EVALUATION_WORK",
 ]
 
 Frame = Mapping[tuple[str, str], str]
@@ -119,7 +128,14 @@ class Formula:
             missing in both directions, or the two directions of a pair disagree.
         """
         n = _trace_length(trace)
-        columns = {pair: _relation_codes(trace, n, pair) for pair in sorted(self.pairs())}
+        pairs = sorted(self.pairs())
+        work = n * (10 * len(pairs) + self.size())
+        if work > MAX_EVALUATION_WORK:
+            raise TraceError(f"evaluating {self.size()} operators and atoms on {len(pairs)} region pairs "
+                             f"over {n:,} frames is {work:,} units of work, more than the limit of "
+                             f"{MAX_EVALUATION_WORK:,} (frames times (10 per pair + 1 per operator or "
+                             "atom)); evaluate a shorter trace or a smaller formula")
+        columns = {pair: _relation_codes(trace, n, pair) for pair in pairs}
         return self._eval(columns, n)
 
     def holds(self, trace: Sequence[Frame]) -> bool:
@@ -131,7 +147,36 @@ class Formula:
 
     def pairs(self) -> frozenset[tuple[str, str]]:
         """The ordered region pairs that the formula's atoms mention."""
-        return frozenset().union(*(c.pairs() for c in self._children()))
+        self._check_depth()
+        pairs, stack = set(), [self]
+        while stack:
+            f = stack.pop()
+            if isinstance(f, Atom):
+                pairs |= f.pairs()
+            stack.extend(f._children())
+        return frozenset(pairs)
+
+    def depth(self) -> int:
+        """Operators nested inside each other: 0 for an atom or a constant, 1 for ``!p``, ``p &
+        q`` or ``X p`` of atoms, and so on (computed without recursion, whatever the depth)."""
+        return max(d for _, d in self._nodes())
+
+    def size(self) -> int:
+        """Number of operators, atoms and constants in the formula."""
+        return sum(1 for _ in self._nodes())
+
+    def _nodes(self):
+        """Every node of the tree with its depth, without recursion."""
+        stack = [(self, 0)]
+        while stack:
+            f, d = stack.pop()
+            yield f, d
+            stack.extend((c, d + 1) for c in f._children())
+
+    def _check_depth(self) -> None:
+        # evaluation and printing recurse once per level
+        if self.depth() > MAX_DEPTH:
+            raise FormulaError(_too_deep())
 
     def _children(self) -> tuple[Formula, ...]:
         return ()
@@ -467,29 +512,71 @@ def read_trace(path: str | Path) -> list[dict[tuple[str, str], str]]:
         raise TraceError(f"trace file {path}: expected a JSON list of frames, "
                          f"found {type(data).__name__}")
     frames = []
+    consistent = _Consistency(path)
+    read: dict[tuple, dict] = {}  # a recorded trace repeats its frames: read each text once
     for t, obj in enumerate(data):
         if not isinstance(obj, dict):
             raise TraceError(f"trace file {path}, frame {t}: expected an object mapping "
                              f'"X,Y" to a relation name, found {type(obj).__name__}')
-        frame = {}
-        for key, rel in obj.items():
-            names = tuple(part.strip() for part in key.split(","))
-            if len(names) != 2 or not all(names):
-                raise TraceError(f'trace file {path}, frame {t}: key {key!r} is not two region '
-                                 f'names joined by a comma, e.g. "F1,O"')
-            if not isinstance(rel, str) or rel not in _CODE:
-                shown = repr(rel) if isinstance(rel, (str, int, float, bool)) and len(repr(rel)) < 60 else \
-                    f"(a {type(rel).__name__})"
-                raise TraceError(f"trace file {path}, frame {t}, pair {key!r}: unknown relation "
-                                 f"{shown}; the base relations are {', '.join(RELATIONS)}")
-            if frame.get(names, rel) != rel:
-                raise TraceError(f"trace file {path}, frame {t}: pair {names} is given twice")
-            frame[names] = rel
-        if path_consistency(frame) is None:
-            raise TraceError(f"trace file {path}, frame {t}: the relations contradict RCC-8's "
-                             "composition table (no arrangement of regions has them all)")
-        frames.append(frame)
+        items = tuple(obj.items())
+        try:
+            frame = read.get(items)
+        except TypeError:  # an unhashable value (a list, ...): _frame names it
+            frame = None
+        if frame is None:
+            frame = _frame(path, t, items)
+            if not consistent(frame):
+                raise TraceError(f"trace file {path}, frame {t}: the relations contradict RCC-8's "
+                                 "composition table (no arrangement of regions has them all)")
+            read[items] = frame
+        frames.append(dict(frame))
     return frames
+
+
+def _frame(path: Path, t: int, items: tuple) -> dict[tuple[str, str], str]:
+    """Frame ``t`` read from its JSON object's items (:func:`read_trace`)."""
+    frame = {}
+    for key, rel in items:
+        names = tuple(part.strip() for part in key.split(","))
+        if len(names) != 2 or not all(names):
+            raise TraceError(f'trace file {path}, frame {t}: key {key!r} is not two region '
+                             f'names joined by a comma, e.g. "F1,O"')
+        if not isinstance(rel, str) or rel not in _CODE:
+            shown = repr(rel) if isinstance(rel, (str, int, float, bool)) and len(repr(rel)) < 60 else \
+                f"(a {type(rel).__name__})"
+            raise TraceError(f"trace file {path}, frame {t}, pair {key!r}: unknown relation "
+                             f"{shown}; the base relations are {', '.join(RELATIONS)}")
+        if frame.get(names, rel) != rel:
+            raise TraceError(f"trace file {path}, frame {t}: pair {names} is given twice")
+        frame[names] = rel
+    return frame
+
+
+class _Consistency:
+    """Whether frames are consistent under RCC-8's composition table, checked once per
+    arrangement: frames that differ only in their regions' names share the verdict. The work
+    of the checks (:data:`MAX_ARRANGEMENT_WORK`) is bounded before it is done."""
+
+    def __init__(self, path: Path):
+        self.path = path
+        self.known: dict[tuple, bool] = {}
+        self.work = 0
+
+    def __call__(self, frame: dict[tuple[str, str], str]) -> bool:
+        index: dict[str, int] = {}
+        key = tuple((index.setdefault(x, len(index)), index.setdefault(y, len(index)), rel)
+                    for (x, y), rel in frame.items())
+        verdict = self.known.get(key)
+        if verdict is None:
+            self.work += 1 + len(index) ** 2  # path consistency revises O(regions^2) pairs
+            if self.work > MAX_ARRANGEMENT_WORK:
+                raise TraceError(
+                    f"trace file {self.path}: its frames hold {len(self.known) + 1} or more different "
+                    f"arrangements, whose consistency checks exceed the limit of "
+                    f"{MAX_ARRANGEMENT_WORK:,} units (1 + regions squared per arrangement); "
+                    "split the trace or record fewer regions per frame")
+            verdict = self.known[key] = path_consistency(frame) is not None
+        return verdict
 
 
 def write_trace(trace: Sequence[Frame], path: str | Path) -> None:
@@ -664,13 +751,32 @@ class _Parser:
         self.tokens = _tokenize(text)
         self.pos = 0
         self.depth = 0
+        self.brackets = 0
 
-    def deeper(self) -> None:
-        """Count one more nested operator; refuse beyond :data:`MAX_DEPTH`."""
-        self.depth += 1
-        if self.depth > MAX_DEPTH:
-            raise FormulaError(f"the formula nests more than {MAX_DEPTH} operators (brackets, '!', "
-                               "temporal operators, or a chain of '->', U or S)")
+    def nested(self, parse: Callable[[], Formula], levels: int = 1, bracket: bool = False) -> Formula:
+        """``parse()`` inside ``levels`` more operators (or one more bracket).
+
+        Counts what encloses the current position, so siblings (``p & q & ...``) do not add up.
+        The operators counted here all become ancestors in the formula's tree, so their count
+        never exceeds the tree's depth, which :func:`parse` checks exactly once the tree is
+        built; brackets have their own count (redundant ones add no depth to the tree, but
+        nest the parser's recursion).
+        """
+        if bracket:
+            self.brackets += 1
+        else:
+            self.depth += levels
+        try:
+            if self.brackets > MAX_DEPTH:
+                raise FormulaError(f"the formula nests more than {MAX_DEPTH} brackets inside each other")
+            if self.depth > MAX_DEPTH:
+                raise FormulaError(_too_deep())
+            return parse()
+        finally:
+            if bracket:
+                self.brackets -= 1
+            else:
+                self.depth -= levels
 
     def peek(self) -> _Token:
         return self.tokens[self.pos]
@@ -699,8 +805,7 @@ class _Parser:
         left = self.disjunction()
         if self.peek().text == "->":
             self.take()
-            self.deeper()
-            return Implies(left, self.implication())
+            return Implies(left, self.nested(self.implication))
         return left
 
     def disjunction(self) -> Formula:
@@ -722,8 +827,7 @@ class _Parser:
         tok = self.peek()
         if tok.kind == "word" and tok.text in _BINARY_OPS:
             self.take()
-            self.deeper()
-            return _BINARY_OPS[tok.text](left, self.binary())
+            return _BINARY_OPS[tok.text](left, self.nested(self.binary))
         return left
 
     def unary(self, word: str | None = None, tok: _Token | None = None) -> Formula:
@@ -732,12 +836,10 @@ class _Parser:
             tok = self.peek()
             if tok.kind == "op" and tok.text == "!":
                 self.take()
-                self.deeper()
-                return Not(self.unary())
+                return Not(self.nested(self.unary))
             if tok.kind == "op" and tok.text == "(":
                 self.take()
-                self.deeper()
-                f = self.implication()
+                f = self.nested(self.implication, bracket=True)
                 self.expect(")", "')' closing the '(' at column " + str(tok.column))
                 return f
             if tok.kind == "op" and tok.text == "{":
@@ -752,14 +854,11 @@ class _Parser:
         if word in _CODE:
             return self.atom(word)
         if word in _UNARY_OPS:
-            self.deeper()
-            return _UNARY_OPS[word](self.unary())
+            return _UNARY_OPS[word](self.nested(self.unary))
         split = _split_unary(word)
         if split is not None:
             ops, rest = split
-            for _ in ops:
-                self.deeper()
-            inner = self.unary(rest) if rest else self.unary()
+            inner = self.nested(lambda: self.unary(rest) if rest else self.unary(), len(ops))
             for op in reversed(ops):
                 inner = _UNARY_OPS[op](inner)
             return inner
@@ -820,4 +919,12 @@ def parse(text: str) -> Formula:
     """
     if not isinstance(text, str):
         raise FormulaError(f"a formula must be text, not {type(text).__name__}")
-    return _Parser(text).formula()
+    formula = _Parser(text).formula()
+    if formula.depth() > MAX_DEPTH:
+        raise FormulaError(_too_deep())
+    return formula
+
+
+def _too_deep() -> str:
+    return (f"the formula nests more than {MAX_DEPTH} operators inside each other ('!', temporal "
+            "operators, &, |, ->, U or S, each inside the next)")

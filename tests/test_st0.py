@@ -239,3 +239,158 @@ def test_st0_command_exit_code_2_on_bad_input(tmp_path, formula, content, messag
     result = CliRunner().invoke(_app(), ["st0", formula, "--trace", str(path)])
     assert result.exit_code == 2
     assert message in result.stderr
+
+
+# ------------------------------------------------------------------- limits (what they measure)
+
+from qualgrasp.qualitative import st0 as st0_module  # noqa: E402
+from qualgrasp.qualitative.st0 import MAX_DEPTH  # noqa: E402
+
+
+def _chain(kind: str, levels: int) -> str:
+    """A formula nesting ``levels`` of one kind of operator (or bracket) inside each other."""
+    atom = "EC(A,B)"
+    if kind == "brackets":
+        return "(" * levels + atom + ")" * levels
+    if kind == "not":
+        return "!" * levels + atom
+    if kind == "next":
+        return "X " * levels + atom
+    if kind == "word":                      # XXX...EC(A,B): one word, read letter by letter
+        return "X" * levels + atom
+    if kind in ("->", "U", "S"):            # right-associative chains
+        return f" {kind} ".join([atom] * (levels + 1))
+    if kind == "and-or":                    # (a | (a & (a | ...))): & and | each count
+        text = atom
+        for i in range(levels // 2):
+            text = f"(DC(A,B) | EC(A,B) & {text})"
+        return text if levels % 2 == 0 else f"!{text}"
+    raise ValueError(kind)
+
+
+@pytest.mark.parametrize("kind", ["not", "next", "word", "->", "U", "S", "and-or"])
+def test_operator_nesting_at_the_limit_parses_and_past_it_is_refused(kind):
+    at = parse(_chain(kind, MAX_DEPTH))
+    assert at.depth() == MAX_DEPTH
+    trace = [{("A", "B"): "EC"}] * 3
+    assert at.evaluate(trace).shape == (3,)           # evaluation recurses per level
+    assert parse(str(at)) == at                       # and so does printing
+    with pytest.raises(FormulaError, match=f"nests more than {MAX_DEPTH} operators"):
+        parse(_chain(kind, MAX_DEPTH + 1))
+
+
+def test_bracket_nesting_at_the_limit_parses_and_past_it_is_refused():
+    assert parse(_chain("brackets", MAX_DEPTH)).depth() == 0
+    with pytest.raises(FormulaError, match=f"nests more than {MAX_DEPTH} brackets"):
+        parse(_chain("brackets", MAX_DEPTH + 1))
+
+
+def test_siblings_do_not_count_as_nesting():
+    """101 bracketed atoms side by side nest one deep: the limit caps nesting, not the number of
+    operators (the depth counter used never to go down)."""
+    for sep in (" & ", " | "):
+        f = parse(sep.join(["(EC(A,B))"] * (MAX_DEPTH + 1)))
+        assert f.depth() == 1
+    f = parse(" & ".join(["!X(EC(A,B) U DC(A,B))"] * 200))
+    assert f.depth() == 4
+
+
+deep_formulas = st.recursive(leaves, lambda kids: st.one_of(
+    *(st.builds(op, kids) for op in (Not, Next, Sometime, Always, Previous, Once, Historically)),
+    *(st.builds(op, kids, kids) for op in (Implies, Until, Since)),
+    st.builds(lambda a, b: And((a, b)), kids, kids),
+    st.builds(lambda a, b: Or((a, b)), kids, kids),
+), max_leaves=400)
+
+
+def _wrap_to_depth(f, depth, ops):
+    for op in ops[:max(0, depth - f.depth())]:
+        f = op(f) if op in (Not, Next, Sometime, Always, Previous, Once, Historically) else op(f, A)
+    return f
+
+
+@given(deep_formulas, st.lists(st.sampled_from([Not, Next, Always, Until, Since, Implies]),
+                               min_size=MAX_DEPTH, max_size=MAX_DEPTH))
+def test_every_formula_within_the_depth_limit_prints_and_parses_back(f, ops):
+    """Generated valid formulas: whatever their shape, those at most MAX_DEPTH deep parse back
+    (13 of 12,000 used to be refused), one level more is refused."""
+    f = _wrap_to_depth(f, MAX_DEPTH, ops) if f.depth() <= MAX_DEPTH else f
+    if f.depth() > MAX_DEPTH:
+        with pytest.raises(FormulaError):
+            parse(str(f))
+        return
+    assert parse(str(f)) == f
+    deeper = Not(f) if f.depth() == MAX_DEPTH else _wrap_to_depth(f, MAX_DEPTH + 1, [Not] * (MAX_DEPTH + 1))
+    with pytest.raises(FormulaError, match="nests more than"):
+        parse(str(deeper))
+
+
+def test_formula_length_at_the_limit_and_past_it():
+    text = " & ".join(["EC(A,B)"] * 1000)
+    text = text[:st0_module.MAX_FORMULA - len(" & true")].rsplit(" & ", 1)[0]
+    text = text + " " * (st0_module.MAX_FORMULA - len(text) - len(" & true")) + " & true"
+    assert len(text) == st0_module.MAX_FORMULA
+    parse(text)
+    with pytest.raises(FormulaError, match="characters"):
+        parse(text + " ")
+
+
+def test_formulas_built_in_code_deeper_than_the_limit_are_refused_not_a_recursion_error():
+    f = Const(True)
+    for _ in range(5 * MAX_DEPTH):
+        f = Not(f)
+    with pytest.raises(FormulaError, match="nests more than"):
+        f.evaluate([{("A", "B"): "EC"}])
+
+
+def test_trace_size_limit_counts_bytes(tmp_path, monkeypatch):
+    frame = '{"A,B": "EC"}'
+    text = "[" + ", ".join([frame] * 50) + "]"
+    monkeypatch.setattr(st0_module, "MAX_TRACE_BYTES", len(text.encode()))
+    path = tmp_path / "t.json"
+    path.write_text(text)
+    assert len(read_trace(path)) == 50
+    path.write_text(text + " ")
+    with pytest.raises(TraceError, match="larger than"):
+        read_trace(path)
+
+
+def _arrangements(k: int, regions: int = 3) -> list[dict]:
+    """Frames of ``k`` different arrangements (chains of ``regions`` regions, all consistent),
+    each repeated under other region names (which must not count again)."""
+    frames = []
+    for code in range(k):
+        rels = [("NTPP", "EQ", "TPP")[(code // 3 ** i) % 3] for i in range(regions - 1)]
+        for prefix in ("R", "S"):
+            frames.append({f"{prefix}{i},{prefix}{i + 1}": r for i, r in enumerate(rels)})
+    return frames
+
+
+def test_trace_arrangement_work_at_the_limit_and_past_it(tmp_path, monkeypatch):
+    """The consistency checks' work is bounded before it is done: each different arrangement
+    costs 1 + regions squared, frames equal up to their regions' names share one check."""
+    per = 1 + 4 ** 2
+    monkeypatch.setattr(st0_module, "MAX_ARRANGEMENT_WORK", 20 * per)
+    path = tmp_path / "t.json"
+    path.write_text(json.dumps(_arrangements(20, regions=4) * 3))
+    assert len(read_trace(path)) == 120
+    path.write_text(json.dumps(_arrangements(21, regions=4)))
+    with pytest.raises(TraceError, match="arrangements"):
+        read_trace(path)
+
+
+def test_frames_read_once_are_still_separate_frames(tmp_path):
+    path = tmp_path / "t.json"
+    path.write_text(json.dumps([{"A,B": "EC"}] * 3 + [{"A,B": "DC"}]))
+    trace = read_trace(path)
+    trace[0][("A", "C")] = "DC"
+    assert trace[1] == {("A", "B"): "EC"} and trace[3] == {("A", "B"): "DC"}
+
+
+def test_evaluation_work_at_the_limit_and_past_it(monkeypatch):
+    f = parse("EC(A,B) U DC(B,C)")               # 2 pairs, 3 nodes: 23 units per frame
+    trace = [{("A", "B"): "EC", ("B", "C"): "DC"}] * 10
+    monkeypatch.setattr(st0_module, "MAX_EVALUATION_WORK", 230)
+    assert f.evaluate(trace).tolist() == [True] * 10
+    with pytest.raises(TraceError, match="units of work"):
+        f.evaluate(trace + trace[:1])
