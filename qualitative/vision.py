@@ -1,6 +1,7 @@
 """From an image to the object's outer contour.
 
-Pipeline: read the image (file or array) as a grey image, blur it slightly (1 pixel) and threshold
+Pipeline: read the image (file or array) as a grey image (a file's size is checked from its
+header before it is decoded: :mod:`qualgrasp.qualitative.headers`), blur it slightly (1 pixel) and threshold
 it (Otsu by default), decide which side of the threshold is the object from the pixels on the image
 border (the background), keep exactly one connected object (8-connected; specks below 1 % of the
 largest component are noise), take its outer contour with :func:`cv2.findContours`
@@ -22,7 +23,7 @@ Conventions
   boolean masks, the array's values for float images; colour is first converted to luminance).
   A given threshold is also the level of the sub-pixel edge; by default the edge is placed
   half-way between the object's and the background's grey levels.
-* Errors: :class:`~qualgrasp.qualitative.errors.ImageError` (missing, unreadable, empty or constant image),
+* Errors: :class:`~qualgrasp.qualitative.errors.ImageError` (missing, unreadable, empty, constant or too large image),
   :class:`~qualgrasp.qualitative.errors.SegmentationError` (no object, several objects, object cut by the
   border), :class:`~qualgrasp.qualitative.errors.ContourError` (object smaller than :data:`MIN_AREA`).
 """
@@ -35,11 +36,11 @@ from typing import Union
 
 import cv2
 import numpy as np
-from PIL import Image
 from scipy import ndimage
 from skimage.filters import threshold_otsu
 
 from .errors import ContourError, ImageError, SegmentationError
+from .headers import header_size
 
 __all__ = [
     "MIN_AREA",
@@ -66,22 +67,6 @@ saying how to downsample it (memory and time stay bounded)."""
 MAX_CONTOUR = 1_000_000
 """Longest object contour described, in contour pixels: a longer one (a huge or very wiggly
 object) is refused with a message saying by how much to downsample the image."""
-
-
-def _header_size(path: Path) -> tuple[int, int] | None:
-    """``(width, height)`` from the file's header without decoding it (None when the format is
-    not known here; OpenCV's own decoder is then the check)."""
-    with path.open("rb") as fh:
-        head = fh.read(24)
-    if head.startswith(b"\x89PNG\r\n\x1a\n") and len(head) == 24:  # the IHDR chunk comes first
-        return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
-    try:
-        with Image.open(path) as im:
-            return im.size
-    except Image.DecompressionBombError:  # Pillow refuses to open it: far beyond our own limit
-        return MAX_PIXELS, MAX_PIXELS
-    except (OSError, ValueError):
-        return None
 
 
 def _check_size(size, what: str) -> None:
@@ -159,7 +144,7 @@ def read_image(src: ImageSource) -> np.ndarray:
         if not path.is_file():
             raise ImageError(f"no such image file: {path}" if not path.exists() else
                              f"{path} is not a regular file (a folder or a device)")
-        _check_size(_header_size(path), str(path))
+        _check_size(header_size(path, MAX_PIXELS), str(path))
         try:
             raw = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
         except cv2.error as err:
