@@ -14,6 +14,7 @@ from qualgrasp.qualitative.errors import ContourError, ImageError, SegmentationE
 from qualgrasp.qualitative.objects import NAMES, render, shape
 from qualgrasp.qualitative.outline import outline_image, outline_scales
 from qualgrasp.qualitative.segmentation import METHODS, grabcut_rect
+from qualgrasp.qualitative.segmentation_plot import segmentation_figure
 from qualgrasp.qualitative.synthesis import synthesize
 from qualgrasp.qualitative.vision import extract_contour, read_mask, segment
 
@@ -280,3 +281,19 @@ def test_no_false_flags_on_the_builtin_grasps(name):
         contrast = edge_contrast(image, result.outline.contour)
         for grasp in result.grasps:
             assert (_strengths(image, grasp, contrast) > 0.75).all()
+
+
+def test_segmentation_figure_shows_the_contour_and_the_weak_contacts(tmp_path):
+    image, poly = shadow()
+    result = synthesize(image, fingers=4, certify=False, tolerance=False)
+    grasp = result.grasps[0]
+    points = np.array([c.p for c in grasp.contacts])
+    strengths = _strengths(image, grasp, edge_contrast(image, result.outline.contour))
+    fig = segmentation_figure(image, result.outline.contour, points, strengths, title="shadow")
+    ax = fig.axes[0]
+    np.testing.assert_allclose(ax.lines[0].get_xydata()[:-1], result.outline.contour)
+    shown = [c.get_offsets() for c in ax.collections]
+    weak = points[strengths < WEAK_EDGE]
+    assert len(weak) and any(np.allclose(s, weak) for s in shown)
+    fig.savefig(tmp_path / "segmentation.png")
+    assert (tmp_path / "segmentation.png").stat().st_size > 10_000
