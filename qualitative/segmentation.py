@@ -30,7 +30,8 @@ mask; the choice of one object, the contour and its sub-pixel refinement are
     mixtures of the object and of the background, cut along strong edges, started from a
     rectangle that holds the object (pixels outside it are background). The default rectangle
     (:func:`grabcut_rect`) is the bounding box of the default (Otsu) segmentation's largest object
-    inside the frame, grown by :data:`GRABCUT_MARGIN` of its size on every side; when every object
+    inside the frame, grown by :data:`GRABCUT_MARGIN` of its size on every side (leaving at least
+    the image's outermost pixels out); when every object
     of that segmentation touches the border, the image less :data:`GRABCUT_MARGIN` / 2 of its
     size on every side. GrabCut runs on the rectangle grown by the same margin again (its
     background samples), so its time grows with the object, not with the image (about 0.3 s for
@@ -179,7 +180,8 @@ def grabcut_rect(mask: np.ndarray | None, shape: tuple[int, int]) -> tuple[int, 
     Returns
     -------
     (int, int, int, int)
-        ``(x, y, width, height)``, pixels (x = column, y = row), inside the image.
+        ``(x, y, width, height)``, pixels (x = column, y = row), inside the image and leaving
+        at least its outermost pixels out.
 
     Examples
     --------
@@ -198,8 +200,10 @@ def grabcut_rect(mask: np.ndarray | None, shape: tuple[int, int]) -> tuple[int, 
     ys, xs = np.nonzero(mask)
     x0, x1, y0, y1 = xs.min(), xs.max() + 1, ys.min(), ys.max() + 1
     pad = max(4, int(round(GRABCUT_MARGIN * max(x1 - x0, y1 - y0))))
-    x0, y0 = max(x0 - pad, 0), max(y0 - pad, 0)
-    x1, y1 = min(x1 + pad, cols), min(y1 + pad, rows)
+    # a frame of at least a pixel stays outside: GrabCut's first background (the object, inside
+    # the frame, does not touch the border)
+    x0, y0 = max(x0 - pad, 1), max(y0 - pad, 1)
+    x1, y1 = min(x1 + pad, cols - 1), min(y1 + pad, rows - 1)
     return int(x0), int(y0), int(x1 - x0), int(y1 - y0)
 
 

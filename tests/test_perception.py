@@ -8,6 +8,7 @@ import cv2
 import numpy as np
 import pytest
 import shapely
+from skimage import data
 
 from qualgrasp.qualitative.edges import WEAK_EDGE, edge_contrast, edge_strength
 from qualgrasp.qualitative.errors import ContourError, ImageError, SegmentationError
@@ -297,3 +298,12 @@ def test_segmentation_figure_shows_the_contour_and_the_weak_contacts(tmp_path):
     assert len(weak) and any(np.allclose(s, weak) for s in shown)
     fig.savefig(tmp_path / "segmentation.png")
     assert (tmp_path / "segmentation.png").stat().st_size > 10_000
+
+
+def test_grabcut_default_rectangle_leaves_a_frame():
+    # the horse silhouette nearly fills the image: the grown box is clipped inside the frame
+    horse = data.horse()
+    x, y, w, h = grabcut_rect(~horse, horse.shape)
+    assert x >= 1 and y >= 1 and x + w <= horse.shape[1] - 1 and y + h <= horse.shape[0] - 1
+    contour = extract_contour(horse, method="grabcut")
+    assert shapely.Polygon(contour).area == pytest.approx((~horse).sum(), rel=0.03)
