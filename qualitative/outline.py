@@ -961,7 +961,9 @@ def _items(phi: np.ndarray, half: int, samples: int, corner_angle: float, cusp_a
 
 
 def outline_image(src: ImageSource, *, scale: float = DEFAULT_SCALE, threshold: float | None = None,
-                  largest: bool = False, subpixel: bool = True, **options) -> Outline:
+                  largest: bool = False, subpixel: bool = True, method: str = "otsu",
+                  mask: ImageSource | None = None, rect: tuple[int, int, int, int] | None = None,
+                  **options) -> Outline:
     """The qualitative outline of the object in an image at one scale.
 
     Parameters
@@ -977,6 +979,14 @@ def outline_image(src: ImageSource, *, scale: float = DEFAULT_SCALE, threshold: 
         With several objects, describe the largest instead of raising.
     subpixel : bool
         Refine the contour to sub-pixel accuracy.
+    method : str
+        Segmentation method (:data:`qualgrasp.qualitative.vision.METHODS`): ``"otsu"`` (default),
+        ``"multiotsu"`` (a soft shadow), ``"adaptive"`` (uneven lighting), ``"grabcut"`` (a
+        textured background); see :func:`qualgrasp.qualitative.vision.segment`.
+    mask : str, pathlib.Path or numpy.ndarray, optional
+        A user's mask of the object (non-zero pixels), instead of a method.
+    rect : (int, int, int, int), optional
+        GrabCut's rectangle ``(x, y, width, height)``, pixels (default: around Otsu's object).
     **options
         Other extraction parameters of :func:`outline_contour`.
 
@@ -992,7 +1002,8 @@ def outline_image(src: ImageSource, *, scale: float = DEFAULT_SCALE, threshold: 
     '/}(</{)>'
     """
     scale = _check_scale(scale)
-    contour = extract_contour(src, threshold=threshold, largest=largest, subpixel=subpixel)
+    contour = extract_contour(src, threshold=threshold, largest=largest, subpixel=subpixel, method=method,
+                              mask=mask, rect=rect)
     return outline_contour(contour, scale=scale, **options)
 
 
@@ -1192,7 +1203,8 @@ def outline_contour_scales(contour: np.ndarray, *, fine: float = DEFAULT_SCALE, 
 
 
 def outline_scales(src: ImageSource, *, threshold: float | None = None, largest: bool = False,
-                   subpixel: bool = True, **options) -> tuple[ScaleInterval, ...]:
+                   subpixel: bool = True, method: str = "otsu", mask: ImageSource | None = None,
+                   rect: tuple[int, int, int, int] | None = None, **options) -> tuple[ScaleInterval, ...]:
     """The scale hierarchy of the outline of the object in an image, from fine to coarse.
 
     The image is segmented and its contour extracted once (see :func:`outline_image`); the
@@ -1208,6 +1220,8 @@ def outline_scales(src: ImageSource, *, threshold: float | None = None, largest:
         With several objects, describe the largest instead of raising.
     subpixel : bool
         Refine the contour to sub-pixel accuracy.
+    method, mask, rect
+        Segmentation, as for :func:`outline_image`.
     **options
         Range, grid and extraction parameters of :func:`outline_contour_scales`.
 
@@ -1222,7 +1236,8 @@ def outline_scales(src: ImageSource, *, threshold: float | None = None, largest:
     >>> outline_scales(render("disc"))[0].string
     ')'
     """
-    contour = extract_contour(src, threshold=threshold, largest=largest, subpixel=subpixel)
+    contour = extract_contour(src, threshold=threshold, largest=largest, subpixel=subpixel, method=method,
+                              mask=mask, rect=rect)
     return outline_contour_scales(contour, **options)
 
 
