@@ -100,9 +100,13 @@ def outline_boundary(outline: Outline) -> tuple[np.ndarray, np.ndarray]:
     return points, normals
 
 
-def _arc_limits(cum: np.ndarray, start: int, stop: int, n: int) -> tuple[float, float]:
-    """Arc lengths of samples ``start`` and ``stop - 1`` (indices past ``n`` wrap), unwrapped."""
+def _arc_limits(cum: np.ndarray, start: int, stop: int, n: int, j: int) -> tuple[float, float]:
+    """Arc lengths of samples ``start`` and ``stop - 1`` (indices past ``n`` wrap), unwrapped; a
+    stretch of the whole closed outline (a disc's) has no ends, so that of a contact at sample
+    ``j`` reaches half the perimeter either way (not to a seam at ``start``)."""
     per = cum[-1]
+    if stop - start >= n:
+        return float(cum[j] - per / 2), float(cum[j] + per / 2)
     last = stop - 1
     return float(cum[start % n] + (start // n) * per), float(cum[last % n] + (last // n) * per)
 
@@ -120,14 +124,14 @@ def contact_limits(outline: Outline, regions: list[Region], points: np.ndarray, 
                          f"(more than {ON_OUTLINE:g} of the object's size {outline.size:.3g} px)")
     for r in regions:
         if any((j - r.start) % n == q for q in range(r.stop - r.start)):
-            return _arc_limits(cum, r.start, r.stop, n)
+            return _arc_limits(cum, r.start, r.stop, n, j)
     for seg in outline.segments:
         if (j - seg.start) % n < seg.stop - seg.start:
             if seg.is_point:
                 article = "an" if seg.name[0] in "aeiou" else "a"
                 raise GraspError(f"the contact at {[round(float(v), 2) for v in p]} lies on {article} {seg.name}: "
                                  "no finger goes there")
-            return _arc_limits(cum, seg.start, seg.stop, n)
+            return _arc_limits(cum, seg.start, seg.stop, n, j)
     raise GraspError(f"the contact at {list(p)} is on no outline element")  # pragma: no cover
 
 

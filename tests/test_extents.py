@@ -178,3 +178,13 @@ def test_synthesis_records_the_slide_in_the_grasps_fields():
         assert grasp.meta["delta"] == found.delta  # kept, with its own meaning
     assert s.summary()["median_slide_fraction"] == pytest.approx(
         float(np.median([g.meta["slide_fraction"] for g in s.grasps])))
+
+
+def test_a_finger_on_a_closed_outline_slides_both_ways():
+    """The disc's feasible region is its whole outline, which has no end: a finger at the sample
+    where the outline starts slides both ways as far as any other (no seam cuts its stretch)."""
+    s = synthesize(render("disc"), procedure="forcegrasp2", quality=False)
+    found = s.tolerances[0]
+    assert found.status == "robust"
+    before, after = zip(*found.extents)
+    assert min(before) > 0.9 * max(after) > 0 and found.slide == min(before + after) > 0.1 * found.size
