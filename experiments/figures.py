@@ -652,8 +652,8 @@ def fig9_regions(synth: Synthesis | None = None, image: np.ndarray | None = None
 
     Left: a synthesised grasp with its certified independent regions (every choice of one contact
     per green stretch is in force closure; :func:`qualgrasp.qualitative.independent.independent_grasp`),
-    titled with its certified slide (how far every finger may slide either way) and each finger's
-    certified extents before and after it. Right: the same fingers anywhere on the whole feasible regions they lie on, which is not robust:
+    titled with its certified slide (how far every finger may slide either way), each finger's
+    certified extents before and after it below. Right: the same fingers anywhere on the whole feasible regions they lie on, which is not robust:
     the witness grasp (one contact per region) is not in force closure, with a Farkas certificate.
 
     Parameters
@@ -680,11 +680,9 @@ def fig9_regions(synth: Synthesis | None = None, image: np.ndarray | None = None
         plot_grasp(left, synth, k, inset=False)
         for region in found.regions.regions:
             _draw_region(left, region, style.GOOD, 7)
-        extents = ", ".join(f"{a:.1f}/{b:.1f}" for a, b in found.extents)
         left.set_title(f"{synth.grasps[k].id}: certified regions, every choice in closure\n"
                        f"every finger may slide {found.slide:.1f} px = {found.slide_fraction:.3f} of the "
-                       f"size either way\n(certified extents before/after each finger: {extents} px)",
-                       color=style.GOOD)
+                       f"size either way", color=style.GOOD)
         draw_frame(right, synth.outline, None)
         right.set_xlim(left.get_xlim())
         right.set_ylim(left.get_ylim())
@@ -705,6 +703,8 @@ def fig9_regions(synth: Synthesis | None = None, image: np.ndarray | None = None
             if image is not None:
                 style.show_image(ax, image)
             style.clean(ax)
+        extents = ", ".join(f"{i}: {a:.1f}/{b:.1f}" for i, (a, b) in enumerate(found.extents, start=1))
+        left.set_xlabel(f"certified extents before/after each finger (px): {extents}", color=style.GOOD)
         fig.legend(handles=[Line2D([], [], color=style.GOOD, lw=6, label="certified independent regions"),
                             Line2D([], [], color=style.BAD, lw=6, label="regions that are not robust"),
                             Line2D([], [], color="black", marker="X", ls="", mfc=style.BAD, ms=10,

@@ -177,8 +177,8 @@ def test_fig9_certified_regions_beside_a_witness(synths, image):
     reach = [region_extents(r, c.p) for r, c in zip(found.regions.regions, grasp.contacts)]
     assert claimed <= min(map(min, reach)) + 0.05
     assert claimed == pytest.approx(min(map(min, reach)), abs=0.05 + 1e-3 * synth.outline.size)
-    for before, after in reach:
-        assert f"{before:.1f}/{after:.1f}" in left.get_title()
+    for i, (before, after) in enumerate(reach, start=1):
+        assert f"{i}: {before:.1f}/{after:.1f}" in left.get_xlabel()
     assert "not robust" in right.get_title() and "Farkas" in right.get_title()
     fig.canvas.draw()
 
