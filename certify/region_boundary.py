@@ -21,6 +21,12 @@ stretches are rounded inward to boundary points), so that every point of the str
 Robustness only shrinks as ``delta`` grows (the regions grow), so ``delta`` is found by
 bisection, to ``tol`` (boundary units; default ``1e-3`` of the object's size). ``undecided``
 verdicts (a budget spent) count as not robust: the ``delta`` returned is certified.
+
+``delta`` is the half-width **before clipping**: a contact near the end of its limits reaches
+less far on that side (and a curved stretch reaches the boundary points around it). What the
+certificate covers is stated by the **certified extents**, per finger and side the arc length
+from the contact to the end of its certified region, and the **certified slide**, the smallest
+of them: how far every finger may slide along the boundary either way with closure certified.
 """
 
 from __future__ import annotations
@@ -220,14 +226,19 @@ class Boundary:
         return _unwrap(lo, hi, s, self.perimeter)
 
     def stretch(self, lo: float, hi: float, limits: tuple[float, float], tol_normal: float = 0.0):
-        """The region over arc lengths ``[lo, hi]`` (within ``limits``, unwrapped)."""
+        """The region over arc lengths ``[lo, hi]`` (within ``limits``, unwrapped): ``(kind, data,
+        covered)``, ``kind`` ``'straight'`` (``data`` = end points and normal) or ``'curved'``
+        (``data`` = boundary points and normals), and ``covered`` the arc-length interval
+        (unwrapped like ``lo``) from the region's first end to its last: ``(lo, hi)`` on a straight
+        run, the boundary points it was widened or rounded to on a curved stretch."""
         n = len(self.points)
         e0 = self._edge_unwrapped(lo, up=True)
         e1 = self._edge_unwrapped(hi, up=False)
         edges = range(e0, e1 + 1)
         run = self.run[e0 % n]
         if run >= 0 and all(self.run[e % n] == run for e in edges):
-            return "straight", (self.point_at(lo), self.point_at(hi), tuple(map(float, self.normals[e0 % n])))
+            return ("straight", (self.point_at(lo), self.point_at(hi), tuple(map(float, self.normals[e0 % n]))),
+                    (float(lo), float(hi)))
         # curved: whole edges, from the point at or before lo to the point at or after hi,
         # never beyond the limits (rounded inward to points)
         first = self._vertex_unwrapped(lo, down=True)
@@ -238,7 +249,12 @@ class Boundary:
         if last < first:
             last = first
         idx = [v % n for v in range(first, last + 1)]
-        return "curved", (self.points[idx], self.normals[idx])
+        return "curved", (self.points[idx], self.normals[idx]), (self._arc(first), self._arc(last))
+
+    def _arc(self, v: int) -> float:
+        """Unwrapped arc length of the unwrapped boundary point index ``v``."""
+        n = len(self.points)
+        return float(self.cum[v % n] + (v // n) * self.perimeter)
 
     def _edge_unwrapped(self, s: float, up: bool) -> int:
         """Unwrapped edge index containing ``s``; at a shared point, the edge after (``up``) or
@@ -279,15 +295,22 @@ def _unwrap(lo: float, hi: float, s: float, per: float, slack: float = 0.0) -> t
 class IndependentRegions:
     """Outcome of :func:`independent_regions`.
 
+    What the certificate covers is stated by ``extents`` and ``slide``; ``delta`` is the search's
+    parameter, the half-width of each stretch **before** it is clipped at the contact's limits
+    (a contact near the end of its limits reaches less far on that side, and a curved stretch is
+    widened to whole boundary samples), so ``delta`` alone does not say how far a finger may
+    slide.
+
     Attributes
     ----------
     status : {'robust', 'not_robust', 'undecided'}
         ``robust``: some ``delta > 0`` is certified; ``not_robust``: the grasp itself is not in
         force closure; ``undecided``: it is (or is degenerate) but no ``delta > 0`` was certified.
     delta : float
-        The certified ``delta`` (boundary units): the common one, or the smallest per-finger one.
+        The bisection parameter certified (boundary units): the common half-width, or the
+        smallest per-finger one, of the stretches ``[s - delta, s + delta]`` before clipping.
     deltas : tuple of float
-        Per finger (all equal to ``delta`` when ``symmetric``).
+        Per finger, its half-width before clipping (all equal to ``delta`` when ``symmetric``).
     delta_fraction : float
         ``delta`` over the object's size (diameter of the boundary's minimum enclosing circle).
     regions : RegionTuple or None
@@ -304,6 +327,16 @@ class IndependentRegions:
     evaluations : int
         Region tuples certified during the search.
     seconds : float
+    extents : tuple of (float, float)
+        Per finger, the **certified extents** (boundary units): the arc length along the
+        boundary from the contact back to the start of its certified region and on to its end
+        (``(before, after)``, in the boundary's order); every placement of each finger within
+        its extents is covered by the certificate. ``(0, 0)`` without certified regions.
+    slide : float
+        The **certified slide** (boundary units): the smallest extent over fingers and sides,
+        how far every finger may slide along the boundary either way with closure certified.
+    slide_fraction : float
+        ``slide`` over the object's size.
     """
 
     status: str
@@ -318,11 +351,28 @@ class IndependentRegions:
     size: float
     evaluations: int = 0
     seconds: float = 0.0
+    extents: tuple[tuple[float, float], ...] = ()
+    slide: float = 0.0
+    slide_fraction: float = 0.0
 
     @property
     def certificate(self) -> dict | None:
         """The certificate of the certified regions (None when none is certified)."""
         return None if self.verdict is None else self.verdict.certificate
+
+
+def _extents(positions, covered, slack: float) -> tuple[tuple[float, float], ...]:
+    """Per finger ``(before, after)``: from its position ``s`` to the ends of the covered
+    interval ``(start, end)``; ``(0, 0)`` when the interval misses ``s`` by more than ``slack``
+    (the certificate then covers no stretch through the contact), rounding below ``slack``
+    read as 0."""
+    out = []
+    for s, (start, end) in zip(positions, covered):
+        if not start - slack <= s <= end + slack:
+            out.append((0.0, 0.0))
+        else:
+            out.append((max(0.0, float(s - start)), max(0.0, float(end - s))))
+    return tuple(out)
 
 
 def _contacts(boundary: Boundary, contacts, models) -> list[Contact]:
@@ -392,8 +442,10 @@ def independent_regions(boundary, normals, contacts, *, limits=None, models=None
     Returns
     -------
     IndependentRegions
-        ``status``, ``delta`` (boundary units), ``deltas``, ``delta_fraction``, the certified
-        ``regions`` and their ``verdict`` (with the certificate).
+        ``status``; what the certificate covers, per finger and side (``extents``) and the
+        smallest of those (``slide``, ``slide_fraction``); the bisection's half-widths before
+        clipping (``delta``, ``deltas``, ``delta_fraction``); the certified ``regions`` and their
+        ``verdict`` (with the certificate).
 
     Raises
     ------
@@ -411,8 +463,19 @@ def independent_regions(boundary, normals, contacts, *, limits=None, models=None
     >>> inward = [(-1, 0), (-1, 0), (0, -1), (0, -1), (1, 0), (1, 0), (0, 1), (0, 1)]
     >>> g = Grasp((Contact((1, 0), (-1, 0), "point", 0.5), Contact((-1, 0), (1, 0), "point", 0.5)))
     >>> r = independent_regions(square, inward, g, tol=1e-4)
-    >>> r.status, round(r.delta, 3), round(r.delta_fraction, 3)
-    ('robust', 0.5, 0.177)
+    >>> r.status, round(r.delta, 3), round(r.delta_fraction, 3), round(r.slide, 3)
+    ('robust', 0.5, 0.177, 0.5)
+
+    Near a corner the stretch is clipped. Both fingers at height 0.8: each stretch
+    ``[0.8 - delta, 0.8 + delta]`` is clipped at the corner (height 1), so the fingers' heights
+    differ by less than 1 for ``delta`` up to 0.8; but a finger may slide up by 0.2 only (the
+    first finger's side runs upwards along the boundary, the second's downwards), and the
+    certified slide says so.
+
+    >>> g = Grasp((Contact((1, 0.8), (-1, 0), "point", 0.5), Contact((-1, 0.8), (1, 0), "point", 0.5)))
+    >>> r = independent_regions(square, inward, g, tol=1e-4)
+    >>> round(r.delta, 3), [tuple(round(v, 3) for v in e) for e in r.extents], round(r.slide, 3)
+    (0.8, [(0.8, 0.2), (0.2, 0.8)], 0.2)
     """
     t0 = time.perf_counter()
     B = Boundary.of(boundary, normals)
@@ -446,30 +509,32 @@ def independent_regions(boundary, normals, contacts, *, limits=None, models=None
     gv = force_closure(grasp)
     cache: dict = {}
 
-    def tuple_at(deltas) -> RegionTuple:
-        regions = []
+    def tuple_at(deltas) -> tuple[RegionTuple, list[tuple[float, float]]]:
+        """The region tuple of half-widths ``deltas`` and the arc-length interval each covers."""
+        regions, covered = [], []
         for c, s, (lo, hi), d in zip(cs, pos, lims, deltas):
-            kind, data = B.stretch(max(lo, s - d), min(hi, s + d), (lo, hi))
+            kind, data, span = B.stretch(max(lo, s - d), min(hi, s + d), (lo, hi))
             params = dict(c.params)
             if kind == "straight":
                 regions.append(StraightRegion(*data, c.model, **params))
             else:
                 regions.append(CurvedRegion(*data, c.model, **params))
-        return RegionTuple(regions, normal_tol, center=grasp.center, length=grasp.length, id=grasp.id)
+            covered.append(span)
+        return RegionTuple(regions, normal_tol, center=grasp.center, length=grasp.length, id=grasp.id), covered
 
     def certified(deltas) -> RegionVerdict | None:
         key = tuple(round(d, 12) for d in deltas)
         if key not in cache:
-            t = tuple_at(deltas)
+            t, covered = tuple_at(deltas)
             v = certify_regions(t, budget=budget)
-            cache[key] = (t, v) if v.status == "robust" else (t, None)
+            cache[key] = (t, v if v.status == "robust" else None, covered)
         return cache[key][1]
 
     reach = [float(max(s - lo, hi - s)) for s, (lo, hi) in zip(pos, lims)]
     if gv.status != "closure":
         status = "not_robust" if gv.status == "no_closure" else "undecided"
         return IndependentRegions(status, 0.0, (0.0,) * k, 0.0, None, None, gv, tuple(pos), tuple(lims), B.size,
-                                  0, time.perf_counter() - t0)
+                                  0, time.perf_counter() - t0, ((0.0, 0.0),) * k)
 
     def bisect(make, lo, hi):
         """Largest certified value in [lo, hi] given ``lo`` certified (or 0), by bisection."""
@@ -499,9 +564,12 @@ def independent_regions(boundary, normals, contacts, *, limits=None, models=None
                 deltas[i] = bisect(lambda d, i=i: deltas[:i] + [d] + deltas[i + 1:], deltas[i], reach[i])
     if min(deltas) <= 0:
         return IndependentRegions("undecided", 0.0, tuple(deltas), 0.0, None, None, gv, tuple(pos), tuple(lims),
-                                  B.size, len(cache), time.perf_counter() - t0)
+                                  B.size, len(cache), time.perf_counter() - t0, ((0.0, 0.0),) * k)
     v = certified(deltas)
-    t = cache[tuple(round(d, 12) for d in deltas)][0]
+    t, _, covered = cache[tuple(round(d, 12) for d in deltas)]
     deltas = [float(d) for d in deltas]
+    extents = _extents(pos, covered, 1e-9 * B.perimeter)
+    slide = min(min(e) for e in extents)
     return IndependentRegions("robust", min(deltas), tuple(deltas), min(deltas) / B.size if B.size else 0.0,
-                              t, v, gv, tuple(pos), tuple(lims), B.size, len(cache), time.perf_counter() - t0)
+                              t, v, gv, tuple(pos), tuple(lims), B.size, len(cache), time.perf_counter() - t0,
+                              extents, slide, slide / B.size if B.size else 0.0)

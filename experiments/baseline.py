@@ -32,6 +32,13 @@ random 4-tuples and improvement (16 starts, up to 4 rounds of 4 x 192), about 70
 Keep 5, separation 2. The study's ``quick`` setting uses 128 samples, 32 extended pairs, 4 000
 random tuples, 8 starts and 2 rounds.
 
+Every grasp records its field ``resolution`` (:func:`qualgrasp.qualitative.synthesis.resolution`:
+contact points known to a pixel, normals estimated over four smoothing standard deviations of the
+outline, :func:`~qualgrasp.qualitative.synthesis.normal_span`), so that the study judges it by the
+rule it judges the qualitative grasps by (:func:`qualgrasp.qualitative.synthesis.counted`): a
+certified grasp whose epsilon is not above it (a frictionless closure of a disc's pixel polygon)
+is not counted as found.
+
 Units: pixels of the image (x = column, y = row); normals are inward unit vectors; epsilon is
 unit-free (torques divided by ``length``).
 """
@@ -55,7 +62,7 @@ from qualgrasp.qualitative.candidates import object_frame
 from qualgrasp.qualitative.errors import QualitativeError
 from qualgrasp.qualitative.outline import DEFAULT_SCALE, Outline, outline_contour, resample
 from qualgrasp.qualitative.procedures import Procedure
-from qualgrasp.qualitative.synthesis import MU, choose
+from qualgrasp.qualitative.synthesis import MU, choose, normal_span, resolution
 from qualgrasp.qualitative.vision import ImageSource, extract_contour
 
 __all__ = ["MU", "Budget", "Boundary", "BaselineResult", "boundary", "boundary_of", "boundary_of_polygon", "search",
@@ -115,6 +122,10 @@ class Boundary:
         Radius about ``center`` (largest distance to the contour), pixels.
     size : float
         Diameter of the minimum enclosing circle, pixels.
+    span : float or None
+        Length over which the normals are estimated, pixels (as perceived:
+        :func:`~qualgrasp.qualitative.synthesis.normal_span` of the outline); None for an exact
+        boundary, whose normals are not estimated.
     """
 
     points: np.ndarray
@@ -122,6 +133,7 @@ class Boundary:
     center: np.ndarray
     length: float
     size: float
+    span: float | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -167,9 +179,10 @@ class BaselineResult:
 
 
 def boundary_of(outline: Outline) -> Boundary:
-    """The boundary of a qualitative outline (its contour and smoothed normals)."""
+    """The boundary of a qualitative outline (its contour and smoothed normals, estimated over
+    :func:`~qualgrasp.qualitative.synthesis.normal_span` of it)."""
     center, length = object_frame(outline.contour)
-    return Boundary(outline.contour, outline.normals(), center, length, outline.size)
+    return Boundary(outline.contour, outline.normals(), center, length, outline.size, normal_span(outline))
 
 
 def boundary_of_polygon(polygon: Polygon, spacing: float = 0.25) -> Boundary:
@@ -357,11 +370,15 @@ def search(points: np.ndarray, normals: np.ndarray, fingers: int, mu: float, cen
 SEARCHED_MODELS = ("point", "frictionless")
 
 
-def _grasp(points, normals, rows, mu: float, center, length: float, gid: str) -> Grasp:
+def _grasp(points, normals, rows, mu: float, center, length: float, gid: str, span: float | None) -> Grasp:
+    """A baseline grasp, with its field ``resolution`` when its normals were estimated over ``span``."""
     contacts = tuple(Contact(tuple(points[i]), tuple(normals[i]), "point", mu) if mu > 0
                      else Contact(tuple(points[i]), tuple(normals[i])) for i in rows)
-    return Grasp(contacts, center=tuple(float(v) for v in center), length=float(length), id=gid,
-                 meta={"procedure": "Baseline", "fingers": len(contacts)})
+    grasp = Grasp(contacts, center=tuple(float(v) for v in center), length=float(length), id=gid,
+                  meta={"procedure": "Baseline", "fingers": len(contacts)})
+    if span is not None:
+        grasp.meta["resolution"] = resolution(grasp, [span] * len(contacts))
+    return grasp
 
 
 def baseline(image: ImageSource | Boundary, procedure: int | str | Procedure, mu: float | None = MU,
@@ -404,7 +421,7 @@ def baseline(image: ImageSource | Boundary, procedure: int | str | Procedure, mu
     points, normals = bound.points[pick], bound.normals[pick]
     idx, eps, evaluated = search(points, normals, fingers, friction, bound.center, bound.length, budget)
     grasps = tuple(_grasp(points, normals, rows, friction, bound.center, bound.length,
-                          f"{name}-base{fingers}-{k:04d}") for k, rows in enumerate(idx))
+                          f"{name}-base{fingers}-{k:04d}", bound.span) for k, rows in enumerate(idx))
     reports = tuple(certify_grasp(g) for g in grasps)
     epsilons = tuple(r.eps_l1 for r in reports)
     return BaselineResult(fingers, float(mu) if proc.friction else None, grasps, reports, epsilons,

@@ -146,12 +146,14 @@ def compare_command(
         task = bar.add_task("compare", total=workload(len(images), settings))
         result = compare(images, out, settings=settings,
                          progress=lambda message: bar.update(task, advance=1, description=message))
-    table = Table(title=f"{len(result.objects)} objects, {result.seconds:.0f} s; eps: certified L1, "
-                        "robust: fraction still certified under vision errors; tol: median certified "
-                        "tolerance of the best grasp (fraction of the size)", box=None,
+    table = Table(title=f"{len(result.objects)} objects, {result.seconds:.0f} s; eps: certified L1 of the "
+                        "grasps counted, robust: fraction still certified under vision errors; slide: "
+                        "median of how far every finger of the best grasp may slide either way "
+                        "(certified, fraction of the size); below res: certified grasps not counted, "
+                        "below the image's resolution", box=None,
                   padding=(0, 1, 0, 0), pad_edge=False)
     for col in ("route", "grasps", "cert", "eps med", "eps best", "best/base", "s/obj", "robust",
-                "paired", "tol"):
+                "paired", "slide", "below res"):
         table.add_column(col, no_wrap=True)
 
     def fmt(value, spec=".3f"):
@@ -160,7 +162,7 @@ def compare_command(
     for r in result.routes:
         table.add_row(r.route, str(r.grasps), fmt(r.certified_fraction), fmt(r.eps_median), fmt(r.eps_best),
                       fmt(r.ratio_best), fmt(r.seconds_median), fmt(r.robustness), fmt(r.robustness_paired),
-                      fmt(r.delta_median))
+                      fmt(r.slide_median), str(dict(r.not_counted).get("below_resolution", 0)))
     console.print(table)
     for name, reason in result.skipped:
         console.print(f"skipped {escape(name)}: {escape(reason)}", soft_wrap=True)

@@ -16,10 +16,11 @@ from shapely.geometry import Polygon
 
 from ..qualitative import procedures
 from ..qualitative.procedures import Procedure
+from ..qualitative.synthesis import NOT_COUNTED
 from .baseline import MU, Budget
 
 __all__ = ["Route", "routes", "KINDS", "UNITS", "BUILTINS", "ROUTES", "QUICK", "FULL",
-           "SETTINGS", "OBJECT_COLUMNS", "OVERALL_COLUMNS", "ROBUSTNESS_COLUMNS", "GRASP_COLUMNS",
+           "SETTINGS", "REASONS", "OBJECT_COLUMNS", "OVERALL_COLUMNS", "ROBUSTNESS_COLUMNS", "GRASP_COLUMNS",
            "DETERMINISTIC", "Settings", "Subject", "RouteSummary", "StudyResult"]
 
 
@@ -57,39 +58,57 @@ BUILTINS = ("polygon", "nut", "disc", "figure3")
 ROUTES = tuple((r.name.rsplit(" ", 1)[0], r.fingers) for r in routes())
 """``(method title, fingers)`` of every route, as in the tables' ``route`` column."""
 
+REASONS = tuple(r.name for r in NOT_COUNTED)
+"""Why a certified grasp is not counted as found, for every route alike
+(:data:`qualgrasp.qualitative.synthesis.NOT_COUNTED`: ``below_resolution``, a certified epsilon not
+above the wrench change the image's uncertainty can cause); each is a column of the tables below."""
+
 OBJECT_COLUMNS = ("object", "route", "method", "fingers", "mu", "grasps", "certified",
                   "certified_fraction", "eps_median", "eps_best", "ratio_best", "ratio_median",
-                  "seconds", "candidates", "error", "procedure", "delta_best", "delta_status")
-"""Per object and route: grasps returned, certified, certified fraction, median and best certified
-L1 epsilon (uncertified grasps count 0), the qualitative best and median over the baseline's best
-with the same fingers (empty for the baseline), seconds (image to certified grasps), candidates
-screened (baseline), error message (route failed on the image), and the **certified tolerance**
-of the route's best grasp (largest certified epsilon, the one the route would execute): ``delta``
-of its independent contact regions on the unperturbed outline, as a fraction of the object's size
-(:func:`qualgrasp.qualitative.independent.independent_grasp`), with the status (``robust``;
-``undecided``: no sliding certified, delta 0; ``none: <why>``: a contact on a corner, where no
-finger can slide, delta 0)."""
+                  "seconds", "candidates", "error", "procedure", "delta_best", "delta_status",
+                  "counted", *REASONS, "slide_best")
+"""Per object and route: grasps returned, certified (on the image's contour), certified fraction,
+median and best certified L1 epsilon of the grasps **counted** as found (uncertified and
+not-counted grasps count 0), the qualitative best and median over the baseline's best with the
+same fingers (empty for the baseline), seconds (image to certified grasps), candidates screened
+(baseline), error message (route failed on the image); the **certified slide** of the route's best
+counted grasp (largest certified epsilon, the one the route would execute): how far every finger
+may slide along the unperturbed outline either way with closure certified (the smallest certified
+extent of its independent contact regions, fraction of the object's size;
+:func:`qualgrasp.qualitative.independent.independent_grasp`), ``slide_best``, with the status
+(``robust``; ``undecided``: no sliding certified, 0; ``none: <why>``: a contact on a corner, where
+no finger can slide, 0), ``delta_status``, and ``delta_best``, the search's half-width of the
+stretches before they are clipped at the feasible regions (not how far a finger may slide);
+``counted``, the certified grasps counted as found, and per reason of :data:`REASONS` the
+certified grasps it excludes."""
 
 OVERALL_COLUMNS = ("route", "method", "fingers", "objects", "objects_with_grasps", "grasps",
                    "certified_fraction", "eps_median", "eps_best", "ratio_best", "ratio_median",
                    "seconds_median", "seconds_total", "robustness", "robustness_paired", "procedure",
-                   "delta_median", "delta_robust")
-"""Per route over all objects: objects, objects where the route found a certified grasp, grasps,
-certified fraction (pooled), medians over objects of the per-object median and best epsilon and
-of the ratios (objects where both routes found grasps), median and total seconds, robustness
-pooled over every perturbation (not ``none``), and the same over the trials where both methods
-planned a certified grasp with the route's finger count (``paired``: the qualitative route finds
-no grasp on some objects, where the baseline's grasps may be the most fragile); the median over
-objects of the best grasp's certified tolerance (fraction of the size; objects where it was
-computed) and the share of those objects where some sliding is certified (``delta > 0``)."""
+                   "delta_median", "delta_robust", "counted", *REASONS, "slide_median", "slide_robust")
+"""Per route over all objects: objects, objects where the route found a counted grasp (certified
+and not excluded by a reason of :data:`REASONS`), grasps, certified fraction (pooled), medians over
+objects of the per-object median and best epsilon and of the ratios (objects where both routes
+found grasps), median and total seconds, robustness pooled over every perturbation (not ``none``),
+and the same over the trials where both methods planned a counted grasp with the route's finger
+count (``paired``: the qualitative route finds no grasp on some objects, where the baseline's
+grasps may be the most fragile); the median over objects of the best grasp's certified slide
+(``slide_median``, fraction of the size; objects where it was computed) and the share of those
+objects where some sliding is certified (``slide_robust``), and the same of ``delta`` before
+clipping (``delta_median``, ``delta_robust``); the grasps counted, and per reason the certified
+grasps of the unperturbed images it excludes."""
 
 ROBUSTNESS_COLUMNS = ("route", "method", "fingers", "kind", "size", "unit", "trials", "planned",
-                      "held", "fraction", "misses", "collisions", "eps_planned", "eps_executed", "procedure")
-"""Per route, perturbation kind and size: trials (object x trial), planned grasps that certified on
-the perturbed image, how many hold on the true object, their fraction, fingers that missed or
-collided, median epsilon of the planned and of the executed grasps (0 for those that fail)."""
+                      "held", "fraction", "misses", "collisions", "eps_planned", "eps_executed", "procedure",
+                      *REASONS)
+"""Per route, perturbation kind and size: trials (object x trial), planned grasps (certified on the
+perturbed image and counted), how many hold on the true object, their fraction, fingers that
+missed or collided, median epsilon of the planned and of the executed grasps (0 for those that
+fail), and per reason of :data:`REASONS` the certified grasps it kept from being planned."""
 
-GRASP_COLUMNS = ("object", "route", "method", "fingers", "certified", "eps", "procedure")
+GRASP_COLUMNS = ("object", "route", "method", "fingers", "certified", "eps", "procedure", "counted", *REASONS)
+"""Per nominal grasp: certified, its certified L1 epsilon, counted as found, and whether each
+reason of :data:`REASONS` applies."""
 
 DETERMINISTIC = ("blur", "threshold")
 """Perturbations that get one trial whatever the settings."""
@@ -151,7 +170,8 @@ class Subject:
 
 @dataclass(frozen=True)
 class RouteSummary:
-    """Headline numbers of one route (see :data:`OVERALL_COLUMNS`); None where undefined."""
+    """Headline numbers of one route (see :data:`OVERALL_COLUMNS`); None where undefined.
+    ``not_counted``: ``(reason, certified grasps it excludes)`` per reason of :data:`REASONS`."""
 
     route: str
     fingers: int
@@ -166,6 +186,9 @@ class RouteSummary:
     robustness_paired: float | None
     delta_median: float | None = None
     delta_robust: float | None = None
+    slide_median: float | None = None
+    slide_robust: float | None = None
+    not_counted: tuple[tuple[str, int], ...] = ()
 
 
 @dataclass(frozen=True)

@@ -615,11 +615,12 @@ def feasible_tuple(synth: Synthesis, k: int) -> RegionTuple:
 
 def regions_example(synth: Synthesis) -> tuple[int, RegionVerdict | None]:
     """The grasp figure 9 shows: among the grasps with certified regions, the one of largest
-    certified tolerance whose whole feasible regions are **not** robust (so that both halves of
-    the figure are about one grasp), and the verdict on those whole regions (a witness); failing
-    that, the grasp of largest tolerance and None."""
+    certified slide (the smallest certified extent over fingers and sides) whose whole feasible
+    regions are **not** robust (so that both halves of the figure are about one grasp), and the
+    verdict on those whole regions (a witness); failing that, the grasp of largest slide and
+    None."""
     ranked = sorted((k for k, f in enumerate(synth.tolerances) if f is not None and f.status == "robust"),
-                    key=lambda k: -synth.tolerances[k].delta)
+                    key=lambda k: -synth.tolerances[k].slide)
     if not ranked:
         raise ValueError("no synthesised grasp has certified regions")
     for k in ranked:
@@ -650,8 +651,9 @@ def fig9_regions(synth: Synthesis | None = None, image: np.ndarray | None = None
     is not robust, with its witness.
 
     Left: a synthesised grasp with its certified independent regions (every choice of one contact
-    per green stretch is in force closure; :func:`qualgrasp.qualitative.independent.independent_grasp`).
-    Right: the same fingers anywhere on the whole feasible regions they lie on, which is not robust:
+    per green stretch is in force closure; :func:`qualgrasp.qualitative.independent.independent_grasp`),
+    titled with its certified slide (how far every finger may slide either way), each finger's
+    certified extents before and after it below. Right: the same fingers anywhere on the whole feasible regions they lie on, which is not robust:
     the witness grasp (one contact per region) is not in force closure, with a Farkas certificate.
 
     Parameters
@@ -679,8 +681,8 @@ def fig9_regions(synth: Synthesis | None = None, image: np.ndarray | None = None
         for region in found.regions.regions:
             _draw_region(left, region, style.GOOD, 7)
         left.set_title(f"{synth.grasps[k].id}: certified regions, every choice in closure\n"
-                       f"$\\delta$ = {found.delta:.1f} px = {found.delta_fraction:.3f} of the size "
-                       f"on each side of every finger", color=style.GOOD)
+                       f"every finger may slide {found.slide:.1f} px = {found.slide_fraction:.3f} of the "
+                       f"size either way", color=style.GOOD)
         draw_frame(right, synth.outline, None)
         right.set_xlim(left.get_xlim())
         right.set_ylim(left.get_ylim())
@@ -701,6 +703,8 @@ def fig9_regions(synth: Synthesis | None = None, image: np.ndarray | None = None
             if image is not None:
                 style.show_image(ax, image)
             style.clean(ax)
+        extents = ", ".join(f"{i}: {a:.1f}/{b:.1f}" for i, (a, b) in enumerate(found.extents, start=1))
+        left.set_xlabel(f"certified extents before/after each finger (px): {extents}", color=style.GOOD)
         fig.legend(handles=[Line2D([], [], color=style.GOOD, lw=6, label="certified independent regions"),
                             Line2D([], [], color=style.BAD, lw=6, label="regions that are not robust"),
                             Line2D([], [], color="black", marker="X", ls="", mfc=style.BAD, ms=10,

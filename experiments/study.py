@@ -16,6 +16,13 @@ L1 epsilons are comparable. A grasp is **certified** when force closure is certi
 certificates re-verify) by :mod:`qualgrasp.certify`; uncertified grasps have epsilon 0. ``seconds`` is image
 to certified grasps (vision, search, certification) for both routes.
 
+Both are judged by one rule (:func:`qualgrasp.qualitative.synthesis.counted`): a certified grasp
+is **counted** as found unless a reason of :data:`REASONS` applies, today a certified epsilon not
+above the wrench change the image's uncertainty can cause (``below_resolution``: a closure of the
+pixel polygon, such as four frictionless fingers on a disc). Grasps not counted weigh 0 in the
+epsilons, are not the route's best grasp, are not planned in the robustness trials and are left
+out of the plots; the tables count them per route and reason.
+
 Robustness model
 ----------------
 The **true object** is the geometry the image was rendered from, when it is known (the built-in
@@ -85,21 +92,21 @@ from qualgrasp.qualitative.formgrasp import ray_edges
 from qualgrasp.qualitative.independent import independent_grasp, planned_regions
 from qualgrasp.qualitative.objects import NAMES, render, shape
 from qualgrasp.qualitative.outline import Outline, outline_image
-from qualgrasp.qualitative.synthesis import synthesize
+from qualgrasp.qualitative.synthesis import synthesize, unresolved_reasons
 from qualgrasp.qualitative.vision import read_image, segment
 
 from .baseline import Boundary, Budget, baseline, boundary, boundary_of_polygon, screen_grasps
 from .design import (BUILTINS, DETERMINISTIC, FULL, GRASP_COLUMNS, KINDS, OBJECT_COLUMNS,
-                     OVERALL_COLUMNS, QUICK, ROBUSTNESS_COLUMNS, ROUTES, SETTINGS, UNITS, Route,
+                     OVERALL_COLUMNS, QUICK, REASONS, ROBUSTNESS_COLUMNS, ROUTES, SETTINGS, UNITS, Route,
                      RouteSummary, Settings, StudyResult, Subject, routes)
 from .silhouettes import Silhouette
 from .study_plots import plot_all
 from .study_tables import overall_rows, robustness_rows, summarise, write_tables
 
-__all__ = ["BUILTINS", "KINDS", "UNITS", "ROUTES", "QUICK", "FULL", "SETTINGS", "OBJECT_COLUMNS",
+__all__ = ["BUILTINS", "KINDS", "UNITS", "ROUTES", "QUICK", "FULL", "SETTINGS", "REASONS", "OBJECT_COLUMNS",
            "OVERALL_COLUMNS", "ROBUSTNESS_COLUMNS", "GRASP_COLUMNS", "Settings", "Subject",
            "RouteSummary", "StudyResult", "subjects", "perturb", "execute", "evaluate_object",
-           "robustness_trial", "best_tolerance", "warm_up", "workload", "compare"]
+           "robustness_trial", "not_counted", "best_tolerance", "warm_up", "workload", "compare"]
 
 _ON = 1e-3  # a point this close to a contour (pixels) is on it
 
@@ -332,6 +339,18 @@ def _stats(eps: np.ndarray) -> tuple[float | None, float | None]:
     return (float(np.median(eps)), float(np.max(eps))) if len(eps) else (None, None)
 
 
+def not_counted(grasps: Sequence[Grasp], certified: np.ndarray, eps: np.ndarray) -> list[tuple[str, ...]]:
+    """Per grasp, why it is not counted as found although certified
+    (:func:`qualgrasp.qualitative.synthesis.unresolved_reasons`, the rule of every route; empty
+    for a grasp not certified, or certified and counted)."""
+    return [unresolved_reasons(g, float(e)) if c else () for g, c, e in zip(grasps, certified, eps)]
+
+
+def _reason_counts(why: list[tuple[str, ...]]) -> dict[str, int]:
+    """Per reason of :data:`REASONS`, the grasps it applies to."""
+    return {r: sum(r in w for w in why) for r in REASONS}
+
+
 def evaluate_object(subject: Subject, settings: Settings = QUICK) -> tuple[list[dict], list[dict]]:
     """Both routes on one unperturbed image: per-route rows (:data:`OBJECT_COLUMNS`, ratios still
     empty) and per-grasp rows (:data:`GRASP_COLUMNS`)."""
@@ -351,23 +370,30 @@ def evaluate_object(subject: Subject, settings: Settings = QUICK) -> tuple[list[
             row.update(grasps=0, certified=0, error=f"{type(err).__name__}: {err}")
             rows.append(row)
             continue
-        median, best = _stats(eps)
+        why = not_counted(grasps, ok, eps)
+        kept = ok & np.array([not w for w in why], dtype=bool)
+        found = np.where(kept, eps, 0.0)
+        median, best = _stats(found)
         row.update(grasps=len(grasps), certified=int(ok.sum()), eps_median=median, eps_best=best,
                    certified_fraction=float(ok.mean()) if len(ok) else None, seconds=seconds,
-                   candidates=candidates)
-        if ok.any() and outline is not None:
-            row["delta_best"], row["delta_status"] = best_tolerance(outline, grasps[int(np.argmax(eps))],
-                                                                    subject.image)
+                   candidates=candidates, counted=int(kept.sum()), **_reason_counts(why))
+        if kept.any() and outline is not None:
+            row["slide_best"], row["delta_best"], row["delta_status"] = best_tolerance(
+                outline, grasps[int(np.argmax(found))], subject.image)
         rows.append(row)
         grasp_rows += [{"object": subject.name, **_route_fields(route, settings), "certified": bool(c),
-                        "eps": float(e)} for c, e in zip(ok, eps)]
+                        "eps": float(e), "counted": bool(k), **{r: r in w for r in REASONS}}
+                       for c, e, k, w in zip(ok, eps, kept, why)]
     return _with_ratios(rows), grasp_rows
 
 
-def best_tolerance(outline: Outline, grasp: Grasp, image: np.ndarray | None = None) -> tuple[float | None, str]:
-    """Certified tolerance of a certified grasp on the outline it was planned on: ``(delta as a
-    fraction of the object's size, status)`` (:data:`OBJECT_COLUMNS`). A contact on a corner or
-    off the outline's elements has no stretch to slide on: tolerance 0, status ``none: <why>``.
+def best_tolerance(outline: Outline, grasp: Grasp,
+                   image: np.ndarray | None = None) -> tuple[float, float, str]:
+    """Certified tolerance of a certified grasp on the outline it was planned on: ``(slide, delta,
+    status)`` (:data:`OBJECT_COLUMNS`): the certified slide (how far every finger may slide either
+    way) and ``delta`` (the search's half-width before clipping), fractions of the object's size.
+    A contact on a corner or off the outline's elements has no stretch to slide on: both 0,
+    status ``none: <why>``.
 
     ``outline`` is the image's outline at the default scale; a qualitative grasp keeps the
     feasible regions it was planned on (its fields ``scale`` and ``alpha``, as
@@ -376,8 +402,8 @@ def best_tolerance(outline: Outline, grasp: Grasp, image: np.ndarray | None = No
         regions = None if image is None else planned_regions(image, grasp, largest=True, outline=outline)
         found = independent_grasp(outline, grasp, regions=regions)
     except GraspError as err:
-        return 0.0, f"none: {err}"
-    return float(found.delta_fraction), found.status
+        return 0.0, 0.0, f"none: {err}"
+    return float(found.slide_fraction), float(found.delta_fraction), found.status
 
 
 def _with_ratios(rows: list[dict]) -> list[dict]:
@@ -401,8 +427,9 @@ def robustness_trial(subject: Subject, truth: Boundary, level: float, kind: str,
     """Plan with every route on one perturbed image and execute on the true object.
 
     Returns one row per route: ``object, route, method, procedure, fingers, kind, size, trial, planned``
-    (grasps that certified on the perturbed image), ``held``, ``misses``, ``collisions``,
-    ``eps_planned`` and ``eps_executed`` (lists, per planned grasp) and ``error``.
+    (grasps that certified on the perturbed image and are counted as found), ``held``, ``misses``,
+    ``collisions``, ``eps_planned`` and ``eps_executed`` (lists, per planned grasp), ``error``, and
+    per reason of :data:`REASONS` the certified grasps it kept from being planned.
     """
     rng = _seed(settings, subject.name, kind, size, trial)
     signed = -size if kind == "rotation" and trial % 2 else size
@@ -411,13 +438,16 @@ def robustness_trial(subject: Subject, truth: Boundary, level: float, kind: str,
     for route in routes():
         row = {"object": subject.name, **_route_fields(route, settings), "kind": kind,
                "size": size, "trial": trial, "planned": 0, "held": 0, "misses": 0, "collisions": 0,
-               "eps_planned": [], "eps_executed": [], "error": None}
+               "eps_planned": [], "eps_executed": [], "error": None, **dict.fromkeys(REASONS, 0)}
         try:
             grasps, ok, eps, _, _, seen = _plan(image, route, settings, subject.name, threshold, False)
         except QualitativeError as err:
             row["error"] = f"{type(err).__name__}: {err}"
             rows.append(row)
             continue
+        why = not_counted(grasps, ok, eps)
+        row.update(_reason_counts(why))
+        ok = ok & np.array([not w for w in why], dtype=bool)  # the planner uses counted grasps only
         runs = [execute(g, truth, settings.standoff, seen) for g, c in zip(grasps, ok) if c]
         executed, outcomes = tuple(r[0] for r in runs), [r[1] for r in runs]
         done = [g for g in executed if g is not None]

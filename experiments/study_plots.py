@@ -2,18 +2,20 @@
 
 Every plot is written as PNG and PDF with :func:`qualgrasp.experiments.style.save`:
 
-* ``study-epsilon``: certified L1 epsilon of every certified grasp returned (the baseline returns
-  its best few per object), per route, one panel per finger count (boxes: qualitative and
-  baseline; dots: each object's best; tick labels: objects with a certified grasp);
+* ``study-epsilon``: certified L1 epsilon of every counted grasp returned (certified and not
+  excluded by a reason such as ``below_resolution``, the same rule for every route; the baseline
+  returns its best few per object), per route, one panel per finger count (boxes: qualitative and
+  baseline; dots: each object's best; tick labels: objects with a counted grasp, and the grasps
+  not counted);
 * ``study-quality-time``: each object's best certified epsilon against the time from image to
   certified grasps, per route;
 * ``study-robustness``: fraction of planned grasps that still certify on the true object against
   the perturbation size, one row per finger count and one column per perturbation kind (size 0:
   the unperturbed image);
-* ``study-tolerance``: certified tolerance of each object's best grasp (how far every finger may
-  slide along the outline with force closure certified, fraction of the object's size; 0 when
-  none is certified), per route, one panel per finger count, beside the route's sampled
-  robustness (pooled fraction held, in the tick labels).
+* ``study-tolerance``: certified slide of each object's best grasp (how far every finger may
+  slide along the outline either way with force closure certified: the smallest certified extent,
+  fraction of the object's size; 0 when none is certified), per route, one panel per finger
+  count, beside the route's sampled robustness (pooled fraction held, in the tick labels).
 
 Panels, labels and colours come from the procedure registry (:mod:`qualgrasp.qualitative.procedures`):
 one panel (or row) per registered procedure, with its baseline; colours tell the procedure, line
@@ -62,9 +64,11 @@ def plot_epsilon(out: Path, object_rows: list[dict], grasp_rows: list[dict]) -> 
             ticks = []
             for x, method in enumerate(("qualitative", "baseline")):
                 eps = [g["eps"] for g in grasp_rows
-                       if g["procedure"] == p.name and g["method"] == method and g["certified"]]
+                       if g["procedure"] == p.name and g["method"] == method and g["counted"]]
                 best = [r["eps_best"] for r in object_rows if r["procedure"] == p.name
-                        and r["method"] == method and r["eps_best"] is not None and r["certified"]]
+                        and r["method"] == method and r["eps_best"] is not None and r["counted"]]
+                dropped = sum(g["certified"] and not g["counted"] for g in grasp_rows
+                              if g["procedure"] == p.name and g["method"] == method)
                 color = p.colour
                 if eps:
                     ax.boxplot([eps], positions=[x], widths=0.5, showfliers=False,
@@ -74,13 +78,14 @@ def plot_epsilon(out: Path, object_rows: list[dict], grasp_rows: list[dict]) -> 
                 ax.scatter(_jitter(len(best), x, rng), best, s=9, color=color, alpha=0.8,
                            marker=_METHOD[method][1], zorder=3, linewidths=0)
                 total = sum(1 for r in object_rows if r["procedure"] == p.name and r["method"] == method)
-                ticks.append(f"{method}\n{len(best)}/{total} objects")
+                ticks.append(f"{method}\n{len(best)}/{total} objects"
+                             + (f"\n{dropped} not counted" if dropped else ""))
             ax.set_xticks([0, 1], ticks)
             ax.set_xlim(-0.6, 1.6)
             ax.set_title(p.label(_mu(object_rows, p.name)))
             ax.grid(axis="y", color="0.9", linewidth=0.6)
         axes[0].set_ylabel("certified L1 epsilon")
-        fig.suptitle("Grasp quality: boxes = every certified grasp returned, dots = best per object")
+        fig.suptitle("Grasp quality: boxes = every counted grasp returned, dots = best per object")
         return save(fig, out, "study-epsilon", _FORMATS)
 
 
@@ -158,7 +163,7 @@ def _held(robust: list[dict], procedure: str, method: str) -> float | None:
 
 
 def plot_tolerance(out: Path, object_rows: list[dict], robust: list[dict]) -> list[Path]:
-    """Certified tolerance of each object's best grasp per route, beside its sampled robustness
+    """Certified slide of each object's best grasp per route, beside its sampled robustness
     (``study-tolerance``)."""
     rng = np.random.default_rng(0)
     with context():
@@ -168,8 +173,8 @@ def plot_tolerance(out: Path, object_rows: list[dict], robust: list[dict]) -> li
         for ax, p in zip(axes, procs):
             ticks = []
             for x, method in enumerate(("qualitative", "baseline")):
-                delta = [r["delta_best"] for r in object_rows if r["procedure"] == p.name
-                         and r["method"] == method and r.get("delta_best") is not None]
+                delta = [r["slide_best"] for r in object_rows if r["procedure"] == p.name
+                         and r["method"] == method and r.get("slide_best") is not None]
                 if delta:
                     ax.boxplot([delta], positions=[x], widths=0.5, showfliers=False,
                                medianprops={"color": p.colour, "linewidth": 1.6},
@@ -179,14 +184,15 @@ def plot_tolerance(out: Path, object_rows: list[dict], robust: list[dict]) -> li
                            marker=_METHOD[method][1], zorder=3, linewidths=0)
                 held = _held(robust, p.name, method)
                 positive = sum(d > 0 for d in delta)
-                ticks.append(f"{method}\n{positive}/{len(delta)}: $\\delta > 0$\n"
+                ticks.append(f"{method}\n{positive}/{len(delta)}: slide > 0\n"
                              f"held {'-' if held is None else format(held, '.3f')}")
             ax.set_xticks([0, 1], ticks)
             ax.set_xlim(-0.6, 1.6)
             ax.set_title(p.label(_mu(object_rows, p.name)))
             ax.grid(axis="y", color="0.9", linewidth=0.6)
-        axes[0].set_ylabel("certified tolerance $\\delta$\n(fraction of the object's size)")
-        fig.suptitle("Certified tolerance of each object's best grasp, and sampled robustness (held)")
+        axes[0].set_ylabel("certified slide, either way\n(fraction of the object's size)")
+        fig.suptitle("How far every finger of each object's best grasp may slide (certified), and sampled "
+                     "robustness (held)")
         return save(fig, out, "study-tolerance", _FORMATS)
 
 

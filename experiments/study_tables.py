@@ -12,14 +12,15 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .design import (GRASP_COLUMNS, KINDS, OBJECT_COLUMNS, OVERALL_COLUMNS, ROBUSTNESS_COLUMNS,
+from .design import (GRASP_COLUMNS, KINDS, OBJECT_COLUMNS, OVERALL_COLUMNS, REASONS, ROBUSTNESS_COLUMNS,
                      UNITS, RouteSummary, Settings, routes)
 
 __all__ = ["robustness_rows", "overall_rows", "summarise", "write_csv", "write_markdown",
            "write_tables"]
 
 _TRIAL_COLUMNS = ("object", "route", "method", "fingers", "kind", "size", "trial", "planned",
-                  "held", "misses", "collisions", "eps_planned", "eps_executed", "error", "procedure")
+                  "held", "misses", "collisions", "eps_planned", "eps_executed", "error", "procedure",
+                  *REASONS)
 
 
 def _median(values: Sequence[float]) -> float | None:
@@ -45,6 +46,7 @@ def robustness_rows(trial_rows: list[dict], settings: Settings) -> list[dict]:
                 "misses": sum(r["misses"] for r in rows), "collisions": sum(r["collisions"] for r in rows),
                 "eps_planned": _median([e for r in rows for e in r["eps_planned"]]),
                 "eps_executed": _median([e for r in rows for e in r["eps_executed"]]),
+                **{reason: sum(r.get(reason, 0) for r in rows) for reason in REASONS},
             })
     return out
 
@@ -73,10 +75,11 @@ def overall_rows(object_rows: list[dict], grasp_rows: list[dict], trial_rows: li
         grasps = [g for g in grasp_rows if g["route"] == route]
         seconds = [r["seconds"] for r in rows if r["seconds"] is not None]
         deltas = [r["delta_best"] for r in rows if r.get("delta_best") is not None]
+        slides = [r["slide_best"] for r in rows if r.get("slide_best") is not None]
         out.append({
             "route": route, "method": r_.method, "procedure": r_.procedure.name, "fingers": r_.fingers,
             "objects": len(rows),
-            "objects_with_grasps": sum(1 for r in rows if r["certified"]),
+            "objects_with_grasps": sum(1 for r in rows if r.get("counted")),
             "grasps": len(grasps),
             "certified_fraction": sum(g["certified"] for g in grasps) / len(grasps) if grasps else None,
             "eps_median": _median([r["eps_median"] for r in rows]),
@@ -88,6 +91,10 @@ def overall_rows(object_rows: list[dict], grasp_rows: list[dict], trial_rows: li
             "robustness_paired": _pooled(trial_rows, route, KINDS, paired=True),
             "delta_median": _median(deltas),
             "delta_robust": sum(d > 0 for d in deltas) / len(deltas) if deltas else None,
+            "slide_median": _median(slides),
+            "slide_robust": sum(d > 0 for d in slides) / len(slides) if slides else None,
+            "counted": sum(r.get("counted") or 0 for r in rows),
+            **{reason: sum(r.get(reason) or 0 for r in rows) for reason in REASONS},
         })
     return out
 
@@ -97,7 +104,8 @@ def summarise(overall: list[dict], trial_rows: list[dict]):
     routes = tuple(RouteSummary(r["route"], r["fingers"], r["grasps"], r["certified_fraction"],
                                 r["eps_median"], r["eps_best"], r["ratio_best"], r["ratio_median"],
                                 r["seconds_median"], r["robustness"], r["robustness_paired"],
-                                r["delta_median"], r["delta_robust"])
+                                r["delta_median"], r["delta_robust"], r["slide_median"], r["slide_robust"],
+                                tuple((reason, r[reason]) for reason in REASONS))
                    for r in overall)
     by_kind = {(r["route"], kind): _pooled(trial_rows, r["route"], (kind,))
                for r in overall for kind in KINDS}
@@ -135,14 +143,23 @@ def write_markdown(path: Path, rows: list[dict], columns: Sequence[str], title: 
     return path
 
 
+_COUNTED = ("counted: certified grasps counted as found, by one rule for every route; "
+            + ", ".join(REASONS) + ": certified grasps not counted for that reason (below_resolution: "
+            "certified epsilon not above the wrench change the image's uncertainty can cause)")
+
 _NOTES = {
-    "objects": "Certified L1 epsilon (object centroid and radius); ratios: qualitative over the "
-               "baseline's best with the same fingers; seconds: image to certified grasps.",
+    "objects": "Certified L1 epsilon (object centroid and radius) of the counted grasps; ratios: "
+               "qualitative over the baseline's best with the same fingers; seconds: image to certified "
+               "grasps; slide_best: how far every finger of the best counted grasp may slide either way "
+               "with closure certified (fraction of the size; delta_best: the search's half-width before "
+               f"clipping); {_COUNTED}.",
     "overall": "Medians over objects; robustness: executed grasps that still certify on the true "
-               "object over planned certified grasps, pooled over every perturbation; paired: only "
-               "the trials where both methods planned a grasp with these fingers.",
-    "robustness": "fraction = held / planned (planned: grasps certified on the perturbed image; "
-                  "held: executed on the true object, still certified).",
+               "object over planned counted grasps, pooled over every perturbation; paired: only "
+               "the trials where both methods planned a grasp with these fingers; slide_median: median "
+               f"certified slide of the best grasps; {_COUNTED}.",
+    "robustness": "fraction = held / planned (planned: grasps certified on the perturbed image and "
+                  "counted; held: executed on the true object, still certified); "
+                  + ", ".join(REASONS) + ": certified grasps not planned for that reason.",
 }
 
 

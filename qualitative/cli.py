@@ -21,7 +21,7 @@ from .outline import DEFAULT_SCALE, SCALE_MAX, outline_image, outline_scales, ou
 from .plot import outline_figure
 from .regions import ALPHA_MAX, feasible_regions, regions_to_dict
 from .st0 import evaluate_file
-from .synthesis import synthesize
+from .synthesis import NOT_COUNTED, synthesize
 from .vision import read_image
 
 __all__ = ["register"]
@@ -197,11 +197,14 @@ def synthesize_command(
     Contacts are in pixels of the input image (x = column, y = row) with inward unit normals;
     center is the object's area centroid and length its radius. The file goes straight into
     'qualgrasp certify'. Prints one line per grasp (id, regions, certified margin and L1 epsilon,
-    the certified tolerance delta -- how far, in pixels and as a fraction of the object's size, every
-    finger may slide along the outline with closure still certified; also written to the grasp
-    file as delta and delta_fraction -- and whether the image resolves it: a grasp whose certified
-    epsilon is below the wrench change a pixel of error can cause is flagged) and a summary. Exit code 0 (with an empty file) when no
-    grasp exists, 1 when a synthesised grasp fails certification, 2 on unusable input or options.
+    the certified slide -- how far, in pixels and as a fraction of the object's size, every finger
+    may slide along the outline either way with closure still certified -- and each finger's
+    certified extents before/after it, pixels; written to the grasp file as slide, slide_fraction
+    and extents, with delta and delta_fraction, the search's half-width before clipping at the
+    feasible regions; and whether the image resolves it: a grasp whose certified epsilon is below
+    the wrench change a pixel of error can cause is flagged) and a summary. Exit code 0 (with an
+    empty file) when no grasp exists, 1 when a synthesised grasp fails certification, 2 on
+    unusable input or options.
     """
 
 
@@ -237,12 +240,11 @@ def synthesize_command(
         typer.echo(f"no grasp found: {result.procedure.title} ({result.fingers} fingers, {friction}): "
                    f"{result.reason}; wrote an empty grasp set to {output}")
         return
-    for grasp, report, ok, good in zip(result.grasps, result.reports, result.certified, result.resolved):
+    labels = {r.name: r.label for r in NOT_COUNTED}
+    for grasp, report, ok, why in zip(result.grasps, result.reports, result.certified, result.not_counted):
         eps = report.epsilons["L1"].hi if report.epsilons else float("nan")
-        verdict = "NOT CERTIFIED" if not ok else "verified" if good else "verified, BELOW IMAGE RESOLUTION"
-        delta = grasp.meta.get("delta")
-        tol = "" if no_tolerance else ("\tdelta -" if delta is None else
-                                       f"\tdelta {delta:.1f} px ({grasp.meta['delta_fraction']:.3f})")
+        verdict = "NOT CERTIFIED" if not ok else ", ".join(["verified"] + [labels[w] for w in why])
+        tol = "" if no_tolerance else f"\t{_slide(grasp.meta)}"
         typer.echo(f"{grasp.id}\tregions {grasp.meta['regions']}\t{report.force.status}\t"
                    f"margin {report.force.margin:.4f}\teps {eps:.4f}{tol}\t{verdict}")
     s = result.summary()
@@ -251,16 +253,26 @@ def synthesize_command(
                f"{_relaxed(result)}{'' if result.smooth else ', contacts of any normal spread'} -> {output}; "
                f"{100 * s['certified_fraction']:.0f} % certified, {s['resolved']} resolved by the image; "
                f"synthesis {s['seconds']:.2f} s, certification {s['certify_seconds']:.2f} s"
-               + ("" if s["median_delta_fraction"] is None else
-                  f"; median certified tolerance {s['median_delta_fraction']:.3f} of the object's size"))
-    if s["resolved"] < s["certified"]:
-        typer.echo(f"note: {s['certified'] - s['resolved']} certified grasp(s) are below the image's "
+               + ("" if s["median_slide_fraction"] is None else
+                  f"; median certified slide {s['median_slide_fraction']:.3f} of the object's size "
+                  "(every finger may slide that far either way)"))
+    if s["below_resolution"]:
+        typer.echo(f"note: {s['below_resolution']} certified grasp(s) are below the image's "
                    "resolution: their certified epsilon is smaller than the wrench change that a pixel "
                    "of error in the contacts and their normals can cause, so the closure may be an "
                    "artefact of the pixels; do not rely on them")
     if s["certified"] < s["grasps"]:
         typer.echo("error: some synthesised grasps did not certify (a synthesis bug: please report it)", err=True)
         raise typer.Exit(1)
+
+
+def _slide(meta: dict) -> str:
+    """``slide 2.6 px (0.012), extents 2.6/7.7 4.5/20.0 px``: the certified slide and each
+    finger's certified extents before/after it (``slide -`` when none was computed)."""
+    if meta.get("slide") is None:
+        return "slide -"
+    extents = " ".join(f"{a:.1f}/{b:.1f}" for a, b in meta["extents"])
+    return f"slide {meta['slide']:.1f} px ({meta['slide_fraction']:.3f}), extents {extents} px"
 
 
 def _relaxed(result) -> str:
@@ -291,10 +303,13 @@ def independent_regions_command(
     """How far may each finger of every grasp slide along the object's outline, the grasp
     certified in force closure wherever on its stretch each finger lands?
 
-    One row per grasp line: id, status (robust, not_robust, undecided, error), delta (pixels),
-    delta_fraction (of the object's size), deltas, the certified regions (region-set format) and
-    their certificate. A finger stays in the feasible region it lies on. Prints one line per
-    grasp. Exit code 1 when some rows are errors, 2 when the run cannot start.
+    One row per grasp line: id, status (robust, not_robust, undecided, error), slide (pixels:
+    every finger may slide at least this far either way), slide_fraction (of the object's size),
+    extents (per finger, pixels of arc from the contact to each end of its certified region),
+    delta, delta_fraction and deltas (the search's half-width of every stretch before clipping at
+    the feasible regions), the certified regions (region-set format) and their certificate. A
+    finger stays in the feasible region it lies on. Prints one line per grasp. Exit code 1 when
+    some rows are errors, 2 when the run cannot start.
     """
 
     if not (math.isfinite(normal_tol) and 0 <= normal_tol <= math.degrees(0.5)):
@@ -314,8 +329,9 @@ def independent_regions_command(
         if row["status"] == "error":
             typer.echo(f"{row['id']}\terror\t{row['error']}")
         else:
-            typer.echo(f"{row['id']}\t{row['status']}\tdelta {row['delta']:.2f} px\t"
-                       f"{100 * row['delta_fraction']:.2f} % of the size")
+            extents = " ".join(f"{a:.2f}/{b:.2f}" for a, b in row["extents"])
+            typer.echo(f"{row['id']}\t{row['status']}\tslide {row['slide']:.2f} px\t"
+                       f"{100 * row['slide_fraction']:.2f} % of the size\textents {extents} px")
     typer.echo(f"{summary.rows} grasp(s) -> {output}: " + ", ".join(f"{n} {s}" for s, n in sorted(summary.statuses.items()))
                + f"; {summary.seconds:.1f} s")
     if summary.errors:

@@ -2,7 +2,10 @@
 
 For each grasp (certify's format, contacts on the object's outline, e.g. from ``qualgrasp
 synthesize``), how far may every finger slide along the outline, and the grasp stay in force
-closure whichever point of its stretch each finger touches? :func:`independent_grasp` answers with
+closure whichever point of its stretch each finger touches? The certified stretches are stated
+by their **extents** (per finger, the arc length from the contact to each end of its certified
+region) and the **certified slide** (the smallest extent: every finger may slide at least that
+far either way). :func:`independent_grasp` answers with
 :func:`qualgrasp.certify.regions.independent_regions` on the outline's boundary
 (:func:`outline_boundary`) and limits from the feasible regions; :func:`independent_file` runs it
 on a grasp set, one results row per grasp line.
@@ -22,10 +25,15 @@ Readings (pixels of the input image, x = column, y = row):
   the grasp itself, as given, decides ``not_robust``.
 
 Results rows: ``id``, ``line``, ``status`` (``robust``, ``not_robust``, ``undecided``, ``error``),
-``delta`` (pixels), ``delta_fraction`` (of the object's size, the diameter of its minimum enclosing
-circle), ``deltas`` (per finger), ``regions`` (the certified tuple, in the region-set format of
-:mod:`qualgrasp.certify.regions`), ``certificate`` (of those regions; for ``not_robust`` the grasp's
-Farkas certificate), ``evaluations``, ``seconds`` and ``error``.
+``slide`` (pixels: the certified slide), ``slide_fraction`` (of the object's size, the diameter of
+its minimum enclosing circle), ``extents`` (per finger ``[before, after]``, pixels of arc along the
+outline, ``before`` towards the contour's start), ``delta`` (pixels: the bisection's half-width
+of every stretch before it is clipped at the finger's feasible region, so that a finger near the
+end of its region reaches less far on that side; ``slide`` says how far every finger may go),
+``delta_fraction`` (``delta`` over the size), ``deltas`` (per finger, before clipping),
+``regions`` (the certified tuple, in the region-set format of :mod:`qualgrasp.certify.regions`),
+``certificate`` (of those regions; for ``not_robust`` the grasp's Farkas certificate),
+``evaluations``, ``seconds`` and ``error``.
 """
 
 from __future__ import annotations
@@ -92,9 +100,13 @@ def outline_boundary(outline: Outline) -> tuple[np.ndarray, np.ndarray]:
     return points, normals
 
 
-def _arc_limits(cum: np.ndarray, start: int, stop: int, n: int) -> tuple[float, float]:
-    """Arc lengths of samples ``start`` and ``stop - 1`` (indices past ``n`` wrap), unwrapped."""
+def _arc_limits(cum: np.ndarray, start: int, stop: int, n: int, j: int) -> tuple[float, float]:
+    """Arc lengths of samples ``start`` and ``stop - 1`` (indices past ``n`` wrap), unwrapped; a
+    stretch of the whole closed outline (a disc's) has no ends, so that of a contact at sample
+    ``j`` reaches half the perimeter either way (not to a seam at ``start``)."""
     per = cum[-1]
+    if stop - start >= n:
+        return float(cum[j] - per / 2), float(cum[j] + per / 2)
     last = stop - 1
     return float(cum[start % n] + (start // n) * per), float(cum[last % n] + (last // n) * per)
 
@@ -112,14 +124,14 @@ def contact_limits(outline: Outline, regions: list[Region], points: np.ndarray, 
                          f"(more than {ON_OUTLINE:g} of the object's size {outline.size:.3g} px)")
     for r in regions:
         if any((j - r.start) % n == q for q in range(r.stop - r.start)):
-            return _arc_limits(cum, r.start, r.stop, n)
+            return _arc_limits(cum, r.start, r.stop, n, j)
     for seg in outline.segments:
         if (j - seg.start) % n < seg.stop - seg.start:
             if seg.is_point:
                 article = "an" if seg.name[0] in "aeiou" else "a"
                 raise GraspError(f"the contact at {[round(float(v), 2) for v in p]} lies on {article} {seg.name}: "
                                  "no finger goes there")
-            return _arc_limits(cum, seg.start, seg.stop, n)
+            return _arc_limits(cum, seg.start, seg.stop, n, j)
     raise GraspError(f"the contact at {list(p)} is on no outline element")  # pragma: no cover
 
 
@@ -211,8 +223,8 @@ def independent_grasp(outline: Outline, grasp: Grasp, *, regions: list[Region] |
     >>> image = render("square")
     >>> g = synthesize(image, fingers=2).grasps[0]
     >>> r = independent_grasp(outline_image(image), g)
-    >>> r.status, r.delta > 0
-    ('robust', True)
+    >>> r.status, r.slide > 0, r.slide == min(min(e) for e in r.extents) <= r.delta
+    ('robust', True, True)
     """
     if grasp.dim != 2:
         raise GraspError("independent regions are planar: the grasp is spatial")
@@ -240,14 +252,17 @@ class IndependentSummary:
 def _row(gid, line, result: IndependentRegions | None = None, error: str | None = None) -> dict[str, Any]:
     if result is None:
         return {"id": gid, "line": line, "status": "error", "delta": None, "delta_fraction": None, "deltas": None,
-                "regions": None, "certificate": None, "evaluations": 0, "seconds": 0.0, "error": error}
+                "regions": None, "certificate": None, "evaluations": 0, "seconds": 0.0, "error": error,
+                "slide": None, "slide_fraction": None, "extents": None}
     if result.status == "robust":
         regions, cert = tuple_to_dict(result.regions), result.verdict.certificate
     else:
         regions, cert = None, {"kind": "grasp", "force": result.grasp_verdict.certificate.to_json()}
     return {"id": gid, "line": line, "status": result.status, "delta": result.delta,
             "delta_fraction": result.delta_fraction, "deltas": list(result.deltas), "regions": regions,
-            "certificate": cert, "evaluations": result.evaluations, "seconds": result.seconds, "error": None}
+            "certificate": cert, "evaluations": result.evaluations, "seconds": result.seconds, "error": None,
+            "slide": result.slide, "slide_fraction": result.slide_fraction,
+            "extents": [list(e) for e in result.extents]}
 
 
 def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str | Path, *, symmetric: bool = True,

@@ -55,14 +55,18 @@ every candidate at once.
 Certified tolerance
 -------------------
 With ``tolerance`` (the default), every certified grasp also gets its **independent contact
-regions** (:func:`qualgrasp.qualitative.independent.independent_grasp`): the largest stretch of
-the outline, ``delta`` pixels of arc on each side of every contact and within the contact's
-feasible region, over which each finger may land anywhere and the grasp is still certified in
-force closure. ``delta`` (pixels) and ``delta_fraction`` (of the object's size) are added to the
-grasp's fields (so they reach the grasp file), and :attr:`Synthesis.tolerances` holds the regions
-with their certificates. A grasp not certified, or with a contact no stretch can be placed
-around (on a corner), has ``delta`` None; a certified grasp for which no sliding is certified
-has ``delta`` 0.
+regions** (:func:`qualgrasp.qualitative.independent.independent_grasp`): a stretch of the outline
+around every contact, within the contact's feasible region, over which each finger may land
+anywhere and the grasp is still certified in force closure. The grasp's fields (so they reach the
+grasp file) state what is certified: ``extents`` (per finger ``[before, after]``, pixels of arc
+from the contact to the ends of its certified stretch), ``slide`` (the smallest extent, pixels:
+every finger may slide at least that far either way) and ``slide_fraction`` (of the object's
+size); and the search's ``delta`` and ``delta_fraction``, the half-width of every stretch
+**before** it is clipped at the finger's feasible region (a finger near the end of its region
+reaches less far on that side: ``delta`` is not how far it may slide).
+:attr:`Synthesis.tolerances` holds the regions with their certificates. A grasp not certified, or
+with a contact no stretch can be placed around (on a corner), has these fields None; a certified
+grasp for which no sliding is certified has ``slide`` and ``delta`` 0.
 
 Image resolution
 ----------------
@@ -78,6 +82,13 @@ L)^2)`` (``r`` the lever, ``L`` the length dividing torques), and a grasp whose 
 the largest such change keeps a ball of wrenches after any such change (the hull of the moved
 generators is within that distance of the hull): it is **resolved**. A grasp whose certified
 epsilon is below it is reported as not resolved by the image, not as a good grasp.
+
+One rule for every route. :func:`unresolved_reasons` gives the reasons a certified grasp is not
+counted as found, from its own fields and its certified epsilon, whoever planned it: today one,
+``below_resolution`` (:func:`below_resolution`), the grasp's field ``resolution`` set by
+synthesis and by the study's baseline (:mod:`qualgrasp.experiments.baseline`) alike. Each reason
+is a :class:`NotCounted` of :data:`NOT_COUNTED` (a name, the label printed, a predicate), so a
+further reason is one more entry; :func:`counted` is a certified grasp with no reason.
 """
 
 from __future__ import annotations
@@ -104,8 +115,9 @@ from .procedures import Procedure, SearchInput
 from .regions import ALPHA, FINGER_WIDTH, MARGIN as REGION_MARGIN, Region, feasible_regions
 from .vision import ImageSource
 
-__all__ = ["MU", "POSITION", "NORMAL", "SPREAD", "FALLBACK_SCALES", "FALLBACK_STEP", "Synthesis", "synthesize",
-           "to_grasp", "choose", "resolution", "search_scales", "search_alphas", "search_attempts"]
+__all__ = ["MU", "POSITION", "NORMAL", "SPREAD", "FALLBACK_SCALES", "FALLBACK_STEP", "NOT_COUNTED", "NotCounted",
+           "Synthesis", "synthesize", "to_grasp", "choose", "resolution", "normal_span", "below_resolution",
+           "unresolved_reasons", "counted", "search_scales", "search_alphas", "search_attempts"]
 
 MU = 0.5
 """Default friction coefficient of procedures with friction."""
@@ -129,6 +141,72 @@ nothing at the finger's scale (up to :data:`qualgrasp.qualitative.outline.SCALE_
 FALLBACK_STEP = 1.4
 """Smallest ratio between consecutive scales tried: the starts of the hierarchy's intervals are
 taken only when at least this much coarser than the previous scale tried."""
+
+
+def below_resolution(grasp: Grasp, eps_l1: float) -> bool:
+    """Whether a grasp's certified L1 epsilon ``eps_l1`` is not above its field ``resolution``,
+    the largest wrench change the image's uncertainty can cause (:func:`resolution`; module
+    notes). False when the grasp records no ``resolution`` (not planned on an image).
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import Contact, Grasp
+    >>> g = Grasp((Contact((1, 0), (-1, 0)), Contact((-1, 0), (1, 0))), meta={"resolution": 0.02})
+    >>> below_resolution(g, 0.01), below_resolution(g, 0.05)
+    (True, False)
+    """
+    limit = grasp.meta.get("resolution")
+    return limit is not None and not eps_l1 > limit
+
+
+@dataclass(frozen=True)
+class NotCounted:
+    """A reason a certified grasp is not counted as found (module notes).
+
+    Attributes
+    ----------
+    name : str
+        Key in summaries and the study's table columns (``below_resolution``).
+    label : str
+        What ``qualgrasp synthesize`` prints after ``verified,``.
+    applies : callable
+        ``applies(grasp, eps_l1) -> bool``, from the grasp's fields and its certified L1 epsilon.
+    """
+
+    name: str
+    label: str
+    applies: Any
+
+
+NOT_COUNTED: tuple[NotCounted, ...] = (NotCounted("below_resolution", "BELOW IMAGE RESOLUTION", below_resolution),)
+"""Every reason a certified grasp is not counted as found, in the order reported."""
+
+
+def unresolved_reasons(grasp: Grasp, eps_l1: float) -> tuple[str, ...]:
+    """Names of the reasons of :data:`NOT_COUNTED` that apply to a certified grasp of certified L1
+    epsilon ``eps_l1`` (module notes), for any route that planned it.
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import Contact, Grasp
+    >>> g = Grasp((Contact((1, 0), (-1, 0)), Contact((-1, 0), (1, 0))), meta={"resolution": 0.02})
+    >>> unresolved_reasons(g, 0.01), unresolved_reasons(g, 0.05)
+    (('below_resolution',), ())
+    """
+    return tuple(r.name for r in NOT_COUNTED if r.applies(grasp, eps_l1))
+
+
+def counted(grasp: Grasp, certified: bool, eps_l1: float) -> bool:
+    """Whether a grasp counts as found: ``certified`` and no reason of :func:`unresolved_reasons`.
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import Contact, Grasp
+    >>> g = Grasp((Contact((1, 0), (-1, 0)), Contact((-1, 0), (1, 0))), meta={"resolution": 0.02})
+    >>> counted(g, True, 0.05), counted(g, True, 0.01), counted(g, False, 0.05)
+    (True, False, False)
+    """
+    return bool(certified) and not unresolved_reasons(grasp, eps_l1)
 
 
 @dataclass(frozen=True, eq=False)
@@ -216,15 +294,30 @@ class Synthesis:
 
     @property
     def deltas(self) -> tuple[float | None, ...]:
-        """Per grasp, the certified tolerance ``delta`` as a fraction of the object's size (None
-        when not computed or undecided; 0 when no sliding is certified)."""
+        """Per grasp, the search's half-width ``delta`` before clipping, as a fraction of the
+        object's size (None when not computed; module notes: not how far a finger may slide,
+        :attr:`slides` is)."""
         return tuple(g.meta.get("delta_fraction") for g in self.grasps)
 
     @property
+    def slides(self) -> tuple[float | None, ...]:
+        """Per grasp, the certified slide as a fraction of the object's size: how far every
+        finger may slide along the outline either way with closure certified (None when not
+        computed; 0 when no sliding is certified)."""
+        return tuple(g.meta.get("slide_fraction") for g in self.grasps)
+
+    @property
     def resolved(self) -> tuple[bool, ...]:
-        """Per grasp: certified, and its certified L1 epsilon above the wrench change the image's
-        uncertainty can cause (:func:`resolution`; module notes)."""
-        return tuple(c and r.eps_l1 > g.meta["resolution"] for c, r, g in
+        """Per grasp: counted as found (:func:`counted`: certified, and no reason of
+        :data:`NOT_COUNTED` applies, such as a certified L1 epsilon not above the wrench change
+        the image's uncertainty can cause; module notes)."""
+        return tuple(counted(g, c, r.eps_l1) for c, r, g in zip(self.certified, self.reports, self.grasps))
+
+    @property
+    def not_counted(self) -> tuple[tuple[str, ...], ...]:
+        """Per grasp, the reasons it is not counted although certified (:func:`unresolved_reasons`;
+        empty for a grasp not certified)."""
+        return tuple(unresolved_reasons(g, r.eps_l1) if c else () for c, r, g in
                      zip(self.certified, self.reports, self.grasps))
 
     @property
@@ -240,11 +333,14 @@ class Synthesis:
         return sum(self.certified) / len(self.reports)
 
     def summary(self) -> dict[str, Any]:
-        """Counts, certified fraction, medians of margin and L1 epsilon (certified grasps), median
-        certified tolerance (``median_delta_fraction``, None without tolerances), times."""
+        """Counts (``resolved``: counted as found; one count per reason of :data:`NOT_COUNTED`,
+        by its name), certified fraction, medians of margin and L1 epsilon (certified grasps), median
+        certified slide (``median_slide_fraction``) and median ``delta`` before clipping
+        (``median_delta_fraction``; both None without tolerances), times."""
         ok = [r for r, c in zip(self.reports, self.certified) if c]
         eps = [r.epsilons["L1"].hi for r in ok if r.epsilons]
         deltas = [d for d in self.deltas if d is not None]
+        slides = [d for d in self.slides if d is not None]
         return {
             "name": self.name,
             "procedure": self.procedure.title,
@@ -254,10 +350,12 @@ class Synthesis:
             "grasps": len(self.grasps),
             "certified": len(ok),
             "resolved": sum(self.resolved),
+            **{r.name: sum(r.name in why for why in self.not_counted) for r in NOT_COUNTED},
             "certified_fraction": self.certified_fraction,
             "median_margin": float(np.median([r.force.margin for r in ok])) if ok else None,
             "median_eps_l1": float(np.median(eps)) if eps else None,
             "median_delta_fraction": float(np.median(deltas)) if deltas else None,
+            "median_slide_fraction": float(np.median(slides)) if slides else None,
             "scale": self.scale,
             "alpha": self.alpha,
             "smooth": self.smooth,
@@ -309,15 +407,30 @@ def resolution(grasp: Grasp, spans) -> float:
     return out
 
 
-def _spans(outline: Outline, regions, found) -> list[float]:
+def normal_span(outline: Outline) -> float:
+    """Length (pixels) over which an outline's smoothed normals are estimated: four smoothing
+    standard deviations (module notes, image resolution).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from qualgrasp.qualitative.outline import outline_contour
+    >>> square = np.array([[0, 0], [100, 0], [100, 100], [0, 100]], float)
+    >>> round(normal_span(outline_contour(square)), 3)  # 4 x 0.004 x 400 px
+    6.4
+    """
+    return 4 * outline.scale * outline.perimeter
+
+
+def _spans(outline: Outline, regions, found, fine: Outline) -> list[float]:
     """Length over which each contact's normal is estimated (pixels): the fitted line of a
-    straight element, four smoothing standard deviations on a curve."""
-    sigma = outline.scale * outline.perimeter
+    straight element, four smoothing standard deviations of the fine outline on a curve (the
+    normals curved regions carry; :func:`_fine_normals`)."""
     out = []
     for r in found.regions:
         seg = outline.segments[regions[r].segment]
         out.append(float(np.linalg.norm(seg.endpoints[1] - seg.endpoints[0])) if seg.symbol == "/"
-                   else 4 * sigma)
+                   else normal_span(fine))
     return out
 
 
@@ -407,7 +520,7 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     margin : float
         ForceGrasp: smallest angular margin, fraction of ``theta_min``.
     tolerance : bool
-        With ``certify``, give every certified grasp its certified tolerance ``delta``
+        With ``certify``, give every certified grasp its certified slide and extents
         (independent contact regions, module notes; about 0.05 to 0.5 s per grasp).
     scale : float, optional
         The outline's scale (fraction of the perimeter, in ``[0.001, 0.032]``) for regions and
@@ -491,7 +604,7 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     grasps = []
     for k, g in enumerate(found):
         grasp = to_grasp(g, f"{stem}-{proc.tag}-{k:04d}", center, length, mu, proc)
-        grasp.meta["resolution"] = resolution(grasp, _spans(outline, regions, g))
+        grasp.meta["resolution"] = resolution(grasp, _spans(outline, regions, g, fine))
         grasp.meta["scale"] = outline.scale
         grasp.meta["alpha"] = a
         grasps.append(grasp)
@@ -623,14 +736,18 @@ def _reason(proc: Procedure, tried: list[tuple[float, float, bool]], regions: in
 def _tolerance(outline: Outline, regions: tuple[Region, ...], grasp: Grasp,
                report: Report) -> IndependentRegions | None:
     """The certified independent regions of a certified grasp (None otherwise), recorded in the
-    grasp's fields ``delta`` (pixels) and ``delta_fraction``."""
-    grasp.meta["delta"] = grasp.meta["delta_fraction"] = None
+    grasp's fields ``slide`` (pixels), ``slide_fraction``, ``extents`` and ``delta`` (pixels),
+    ``delta_fraction`` (module notes)."""
+    for key in ("delta", "delta_fraction", "slide", "slide_fraction", "extents"):
+        grasp.meta[key] = None
     if not report.certified:
         return None
     try:
         found = independent_grasp(outline, grasp, regions=list(regions))
     except GraspError:  # a contact the regions cannot place (on a corner): no certified tolerance
         return None
-    # undecided: in closure, but no sliding certified, so the certified tolerance is 0
-    grasp.meta["delta"], grasp.meta["delta_fraction"] = float(found.delta), float(found.delta_fraction)
+    # undecided: in closure, but no sliding certified, so the certified slide is 0
+    grasp.meta.update(delta=float(found.delta), delta_fraction=float(found.delta_fraction),
+                      slide=float(found.slide), slide_fraction=float(found.slide_fraction),
+                      extents=[[float(v) for v in e] for e in found.extents])
     return found

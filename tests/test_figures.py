@@ -2,6 +2,7 @@
 they show is what the toolkit computes."""
 
 import math
+import re
 from collections import Counter
 
 import matplotlib
@@ -13,6 +14,7 @@ from matplotlib.path import Path as MplPath
 from PIL import Image
 from typer.testing import CliRunner
 
+from extents_oracle import region_extents
 from qualgrasp.experiments import figures, style
 from qualgrasp.cli import app
 from qualgrasp.experiments.figures import (STEMS, fig3_outline, fig4_regions, fig5_zones, fig6_two_fingers,
@@ -158,17 +160,25 @@ def test_fig9_certified_regions_beside_a_witness(synths, image):
     synth = synths[3]
     k, verdict = figures.regions_example(synth)
     found = synth.tolerances[k]
-    assert found.status == "robust" and found.delta > 0
+    assert found.status == "robust" and found.slide > 0
     assert bool(verify_regions(found.regions, found.verdict))
     whole = figures.feasible_tuple(synth, k)
     assert verdict.status == "not_robust" and bool(verify_regions(whole, verdict))
     assert force_closure(verdict.witness).status == "no_closure"
-    # no other certified grasp with not-robust whole regions has a larger tolerance
-    assert all(f.delta <= found.delta for f in synth.tolerances if f is not None and f.status == "robust"
+    # no other certified grasp with not-robust whole regions has a larger certified slide
+    assert all(f.slide <= found.slide for f in synth.tolerances if f is not None and f.status == "robust"
                and certify_regions(figures.feasible_tuple(synth, synth.tolerances.index(f))).status == "not_robust")
     fig = fig9_regions(synth, image)
     left, right = _image_axes(fig)
-    assert f"{found.delta:.1f} px" in left.get_title() and f"{found.delta_fraction:.3f}" in left.get_title()
+    # what the caption claims every finger may slide, either way, is covered by the certified regions:
+    # at most the arc from each contact to either end of its region (measured here from the regions)
+    claimed = float(re.search(r"may slide ([0-9.]+) px = ([0-9.]+) of the size either way", left.get_title()).group(1))
+    grasp = synth.grasps[k]
+    reach = [region_extents(r, c.p) for r, c in zip(found.regions.regions, grasp.contacts)]
+    assert claimed <= min(map(min, reach)) + 0.05
+    assert claimed == pytest.approx(min(map(min, reach)), abs=0.05 + 1e-3 * synth.outline.size)
+    for i, (before, after) in enumerate(reach, start=1):
+        assert f"{i}: {before:.1f}/{after:.1f}" in left.get_xlabel()
     assert "not robust" in right.get_title() and "Farkas" in right.get_title()
     fig.canvas.draw()
 

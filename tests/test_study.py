@@ -244,7 +244,10 @@ def test_zero_perturbation_keeps_every_certified_grasp(name):
     for r in rows:
         assert r["held"] == r["planned"] and r["misses"] == r["collisions"] == 0, r["route"]
         assert r["eps_executed"] == pytest.approx(r["eps_planned"], rel=0.02, abs=1e-3)
-    assert sum(r["planned"] for r in rows) > 10
+    assert sum(r["planned"] for r in rows) > (5 if name == "disc" else 10)
+    if name == "disc":  # a frictionless closure of the disc's pixel polygon is not planned, but counted as such
+        four = next(r for r in rows if r["route"] == "Baseline 4")
+        assert four["planned"] == 0 and four["below_resolution"] > 0
 
 
 # --- the study's tables ---------------------------------------------------------------------------

@@ -2,6 +2,8 @@
 independent contact regions certified around it, a grasp whose contacts are displaced anywhere
 inside them holds, and the study reports the tolerance per route."""
 
+import json
+
 import cv2
 import numpy as np
 import pytest
@@ -41,12 +43,13 @@ def test_every_certified_grasp_reports_its_certified_tolerance(synthesis):
         assert ok and found is not None
         assert grasp.meta["delta"] == found.delta >= 0
         assert grasp.meta["delta_fraction"] == found.delta_fraction
+        assert grasp.meta["slide"] == found.slide == min(map(min, found.extents))
         ratio = found.delta / found.delta_fraction if found.delta_fraction else None
         if ratio is not None:  # one object size for every grasp
             size = ratio if size is None else size
             assert ratio == pytest.approx(size, rel=1e-9)
         if found.status == "robust":
-            assert found.delta > 0
+            assert found.delta > 0 and found.slide >= 0
             assert bool(verify_regions(found.regions, found.verdict))
     assert synthesis.summary()["median_delta_fraction"] == pytest.approx(
         float(np.median([d for d in synthesis.deltas if d is not None])))
@@ -80,8 +83,8 @@ def test_regions_are_where_the_grasp_is():
 
 def test_no_tolerance_skips_it():
     s = synthesize(render("polygon"), procedure="forcegrasp2", quality=False, tolerance=False)
-    assert s.tolerances == () and all("delta" not in g.meta for g in s.grasps)
-    assert s.summary()["median_delta_fraction"] is None
+    assert s.tolerances == () and all("delta" not in g.meta and "slide" not in g.meta for g in s.grasps)
+    assert s.summary()["median_delta_fraction"] is None and s.summary()["median_slide_fraction"] is None
 
 
 def test_synthesize_command_prints_and_writes_the_tolerance(tmp_path):
@@ -90,21 +93,26 @@ def test_synthesize_command_prints_and_writes_the_tolerance(tmp_path):
     out = tmp_path / "g.jsonl"
     result = CliRunner().invoke(app, ["synthesize", str(image), "--fingers", "2", "-o", str(out)])
     assert result.exit_code == 0, result.output
-    assert "delta" in result.output and "median certified tolerance" in result.output
-    assert '"delta_fraction"' in out.read_text()
+    assert "slide" in result.output and "extents" in result.output and "median certified slide" in result.output
+    written = [json.loads(line) for line in out.read_text().splitlines()]
+    assert all(g["slide"] <= min(map(min, g["extents"])) + 1e-12 and g["delta_fraction"] is not None for g in written)
+    for g in written:  # each line prints the slide and the extents it writes
+        extents = " ".join(f"{a:.1f}/{b:.1f}" for a, b in g["extents"])
+        assert f"slide {g['slide']:.1f} px ({g['slide_fraction']:.3f}), extents {extents} px" in result.output
     result = CliRunner().invoke(app, ["synthesize", str(image), "--fingers", "2", "-o", str(out), "--no-tolerance"])
-    assert result.exit_code == 0 and "delta" not in result.output
+    assert result.exit_code == 0 and "slide" not in result.output and "delta" not in result.output
 
 
 def test_the_study_reports_the_certified_tolerance_per_route():
     rows, grasp_rows = evaluate_object(subjects(["square"])[0])
     for r in rows:
-        if r["certified"]:
-            assert r["delta_best"] is not None and 0 <= r["delta_best"] < 1
+        if r["counted"]:
+            assert r["delta_best"] is not None and 0 <= r["delta_best"] < 1 and 0 <= r["slide_best"] < 1
             assert r["delta_status"] in ("robust", "undecided") or r["delta_status"].startswith("none: ")
         else:
-            assert r["delta_best"] is None
+            assert r["delta_best"] is None and r["slide_best"] is None
     overall = overall_rows(rows, grasp_rows, [])
     for o in overall:
-        mine = [r["delta_best"] for r in rows if r["route"] == o["route"] and r["delta_best"] is not None]
-        assert o["delta_median"] == (float(np.median(mine)) if mine else None)
+        for key in ("delta", "slide"):
+            mine = [r[f"{key}_best"] for r in rows if r["route"] == o["route"] and r[f"{key}_best"] is not None]
+            assert o[f"{key}_median"] == (float(np.median(mine)) if mine else None)
