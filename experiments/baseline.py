@@ -37,7 +37,9 @@ contact points known to a pixel, normals estimated over four smoothing standard 
 outline, :func:`~qualgrasp.qualitative.synthesis.normal_span`), so that the study judges it by the
 rule it judges the qualitative grasps by (:func:`qualgrasp.qualitative.synthesis.counted`): a
 certified grasp whose epsilon is not above it (a frictionless closure of a disc's pixel polygon)
-is not counted as found.
+is not counted as found. Planned on an image, every grasp also records its field
+``edge_strength`` (:func:`qualgrasp.qualitative.synthesis.set_edge_strength`), so that a grasp on
+a shadow's or a texture's boundary is not counted either, by the same rule.
 
 Units: pixels of the image (x = column, y = row); normals are inward unit vectors; epsilon is
 unit-free (torques divided by ``length``).
@@ -62,7 +64,7 @@ from qualgrasp.qualitative.candidates import object_frame
 from qualgrasp.qualitative.errors import QualitativeError
 from qualgrasp.qualitative.outline import DEFAULT_SCALE, Outline, outline_contour, resample
 from qualgrasp.qualitative.procedures import Procedure
-from qualgrasp.qualitative.synthesis import MU, choose, normal_span, resolution
+from qualgrasp.qualitative.synthesis import MU, choose, normal_span, resolution, set_edge_strength
 from qualgrasp.qualitative.vision import ImageSource, extract_contour
 
 __all__ = ["MU", "Budget", "Boundary", "BaselineResult", "boundary", "boundary_of", "boundary_of_polygon", "search",
@@ -422,6 +424,8 @@ def baseline(image: ImageSource | Boundary, procedure: int | str | Procedure, mu
     idx, eps, evaluated = search(points, normals, fingers, friction, bound.center, bound.length, budget)
     grasps = tuple(_grasp(points, normals, rows, friction, bound.center, bound.length,
                           f"{name}-base{fingers}-{k:04d}", bound.span) for k, rows in enumerate(idx))
+    if not isinstance(image, Boundary):
+        set_edge_strength(grasps, image, bound.points, bound.normals)
     reports = tuple(certify_grasp(g) for g in grasps)
     epsilons = tuple(r.eps_l1 for r in reports)
     return BaselineResult(fingers, float(mu) if proc.friction else None, grasps, reports, epsilons,

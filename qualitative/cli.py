@@ -38,6 +38,37 @@ def _threshold(threshold: float | None) -> None:
         _fail(f"--threshold must be a finite grey level, got {threshold}")
 
 
+# Segmentation options, the same for every command that reads an object from an image.
+LARGEST = typer.Option(False, "--largest", help="With several objects, use the largest whole one.")
+THRESHOLD = typer.Option(None, "--threshold", help="Grey level separating object and background, in the "
+                         "image's units (default: Otsu's).")
+SEGMENTATION = typer.Option("otsu", "--segmentation", help="How the object is told from the background: "
+                            "otsu (default: one global grey-level threshold), multiotsu (three grey classes: "
+                            "an object with its soft shadow), adaptive (against the local mean: uneven "
+                            "lighting) or grabcut (GrabCut from a rectangle around the default "
+                            "segmentation's object: a textured background).")
+MASK = typer.Option(None, "--mask", help="The object's mask: an image of the same size whose non-zero pixels "
+                    "are the object (instead of --segmentation).")
+RECT = typer.Option(None, "--rect", help="GrabCut's starting rectangle in pixels, X,Y,W,H (top-left x and y, "
+                    "width, height); default: the default segmentation's object box grown by 10 %, or the "
+                    "image less 5 % on every side when every object touches the border.")
+
+
+def _segmentation(threshold: float | None, largest: bool, method: str, mask: Path | None,
+                  rect: str | None) -> dict:
+    """The segmentation keywords of the qualitative functions from the command's options, checked."""
+    _threshold(threshold)  # the combinations are checked where they are used (vision.segment)
+    box = None
+    if rect is not None:
+        try:
+            box = tuple(int(v) for v in rect.split(","))
+        except ValueError:
+            box = ()
+        if len(box) != 4:
+            _fail(f"--rect must be four whole numbers X,Y,W,H (pixels), got {rect!r}")
+    return {"threshold": threshold, "largest": largest, "method": method, "mask": mask, "rect": box}
+
+
 def _save(figure, path: Path, dpi: int) -> None:
     """Save a figure, or exit 2 saying why it could not be written (a full disk, ...)."""
     try:
@@ -82,10 +113,11 @@ def outline_command(
     as_json: bool = typer.Option(False, "--json", help="Print a JSON object with keys string, scale and "
                                  "segments (with --scales: a JSON list of objects lo, hi, string, corners, "
                                  "convex)."),
-    largest: bool = typer.Option(False, "--largest",
-                                 help="With several objects, describe the largest whole one."),
-    threshold: float | None = typer.Option(None, "--threshold", help="Grey level separating object and "
-                                           "background, in the image's units (default: Otsu's)."),
+    largest: bool = LARGEST,
+    threshold: float | None = THRESHOLD,
+    segmentation: str = SEGMENTATION,
+    mask: Path | None = MASK,
+    rect: str | None = RECT,
 ) -> None:
     """Print the qualitative outline (canonical curvature-type string) of the object in an image.
 
@@ -96,17 +128,16 @@ def outline_command(
     bad --scale.
     """
 
-    _threshold(threshold)
+    seg = _segmentation(threshold, largest, segmentation, mask, rect)
     if scale is not None and scales:
         _fail("--scale and --scales exclude each other")
     if scale is not None and not (math.isfinite(scale) and 0 < scale <= SCALE_MAX):
         _fail(f"--scale must be a fraction of the object's perimeter in (0, {SCALE_MAX:g}], got {scale:g}")
     try:
         if scales:
-            hierarchy = outline_scales(image, threshold=threshold, largest=largest)
+            hierarchy = outline_scales(image, **seg)
         else:
-            outline = outline_image(image, scale=DEFAULT_SCALE if scale is None else scale,
-                                    threshold=threshold, largest=largest)
+            outline = outline_image(image, scale=DEFAULT_SCALE if scale is None else scale, **seg)
     except QualitativeError as err:
         _fail(str(err))
     if scales and as_json:
@@ -129,10 +160,11 @@ def regions_command(
                                  help="Distance kept from element ends, fraction of the object's size."),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON object with key regions."),
     plot: Path | None = typer.Option(None, "--plot", help="Save a figure of the outline and regions (PNG)."),
-    largest: bool = typer.Option(False, "--largest",
-                                 help="With several objects, use the largest whole one."),
-    threshold: float | None = typer.Option(None, "--threshold", help="Grey level separating object and "
-                                           "background, in the image's units (default: Otsu's)."),
+    largest: bool = LARGEST,
+    threshold: float | None = THRESHOLD,
+    segmentation: str = SEGMENTATION,
+    mask: Path | None = MASK,
+    rect: str | None = RECT,
 ) -> None:
     """Print the feasible grasp regions (paper, definitions 1 and 2) of the object in an image.
 
@@ -141,14 +173,14 @@ def regions_command(
     [x, y] in pixels of the input image (x = column, y = row). Exit code 2 on unusable input.
     """
 
+    seg = _segmentation(threshold, largest, segmentation, mask, rect)
     try:
-        _threshold(threshold)
         number_in(alpha, "--alpha", 0, ALPHA_MAX, unit="(fraction of the object's size)")
         number_in(finger_width, "--finger-width", 1e-3, 1, unit="(fraction of the object's size)")
         number_in(margin, "--margin", 0, 0.5, unit="(fraction of the object's size)", high_open=True)
         if plot is not None:
             output_file(plot, "--plot", suffixes=FIGURE_SUFFIXES, reads=[image])
-        outline = outline_image(image, threshold=threshold, largest=largest)
+        outline = outline_image(image, **seg)
         regions = feasible_regions(outline, alpha, finger_width, margin)
     except (QualitativeError, ValueError) as err:
         _fail(str(err))
@@ -178,9 +210,11 @@ def synthesize_command(
                                        "found. Given, it is the only one tried."),
     plot: Path | None = typer.Option(None, "--plot", help="Save a figure of the best grasps (PNG): "
                                      "contacts, normals, friction cones, zones of freedom."),
-    largest: bool = typer.Option(False, "--largest", help="With several objects, use the largest whole one."),
-    threshold: float | None = typer.Option(None, "--threshold", help="Grey level separating object and "
-                                           "background, in the image's units (default: Otsu's)."),
+    largest: bool = LARGEST,
+    threshold: float | None = THRESHOLD,
+    segmentation: str = SEGMENTATION,
+    mask: Path | None = MASK,
+    rect: str | None = RECT,
     procedure: str | None = typer.Option(None, "--procedure", help="A synthesis procedure by name: "
                                          + ", ".join(f"{p.name} ({p.fingers} fingers, {p.model})"
                                                      for p in procedures.procedures())
@@ -212,8 +246,8 @@ def synthesize_command(
         _fail("give --mu or --theta-min, not both")
     if fingers is None and procedure is None:
         _fail(f"give --fingers or --procedure ({', '.join(procedures.names())})")
+    seg = _segmentation(threshold, largest, segmentation, mask, rect)
     try:
-        _threshold(threshold)
         if mu is not None:
             number_in(mu, "--mu", 0, MAX_MU, low_open=True, unit="(friction coefficient)")
         if theta_min is not None:
@@ -225,8 +259,7 @@ def synthesize_command(
         if plot is not None:
             output_file(plot, "--plot", suffixes=FIGURE_SUFFIXES, reads=[image, output])
         result = synthesize(image, fingers, mu, None if theta_min is None else math.radians(theta_min),
-                            alpha, procedure=procedure, threshold=threshold, largest=largest,
-                            tolerance=not no_tolerance, scale=scale)
+                            alpha, procedure=procedure, tolerance=not no_tolerance, scale=scale, **seg)
     except (QualitativeError, ValueError) as err:
         _fail(str(err))
     try:
@@ -256,11 +289,9 @@ def synthesize_command(
                + ("" if s["median_slide_fraction"] is None else
                   f"; median certified slide {s['median_slide_fraction']:.3f} of the object's size "
                   "(every finger may slide that far either way)"))
-    if s["below_resolution"]:
-        typer.echo(f"note: {s['below_resolution']} certified grasp(s) are below the image's "
-                   "resolution: their certified epsilon is smaller than the wrench change that a pixel "
-                   "of error in the contacts and their normals can cause, so the closure may be an "
-                   "artefact of the pixels; do not rely on them")
+    for reason in NOT_COUNTED:
+        if s[reason.name]:
+            typer.echo(f"note: {s[reason.name]} certified grasp(s) {reason.note}")
     if s["certified"] < s["grasps"]:
         typer.echo("error: some synthesised grasps did not certify (a synthesis bug: please report it)", err=True)
         raise typer.Exit(1)
@@ -296,9 +327,11 @@ def independent_regions_command(
     alpha: float | None = typer.Option(None, "--alpha", help="Feasible regions: bounding-circle diameter "
                                        "threshold of curves, fraction of the object's size (default: each "
                                        "grasp's own field alpha, else 0.5)."),
-    largest: bool = typer.Option(False, "--largest", help="With several objects, use the largest whole one."),
-    threshold: float | None = typer.Option(None, "--threshold", help="Grey level separating object and "
-                                           "background, in the image's units (default: Otsu's)."),
+    largest: bool = LARGEST,
+    threshold: float | None = THRESHOLD,
+    segmentation: str = SEGMENTATION,
+    mask: Path | None = MASK,
+    rect: str | None = RECT,
 ) -> None:
     """How far may each finger of every grasp slide along the object's outline, the grasp
     certified in force closure wherever on its stretch each finger lands?
@@ -315,12 +348,12 @@ def independent_regions_command(
     if not (math.isfinite(normal_tol) and 0 <= normal_tol <= math.degrees(0.5)):
         typer.echo(f"error: --normal-tol must be in [0, {math.degrees(0.5):.1f}] degrees", err=True)
         raise typer.Exit(2)
+    seg = _segmentation(threshold, largest, segmentation, mask, rect)
     try:
         if alpha is not None:
             number_in(alpha, "--alpha", 0, ALPHA_MAX, unit="(fraction of the object's size)")
         summary = independent_file(image, grasps, output, symmetric=not asymmetric, tol=tol, budget=budget,
-                                   normal_tol=math.radians(normal_tol), alpha=alpha, threshold=threshold,
-                                   largest=largest)
+                                   normal_tol=math.radians(normal_tol), alpha=alpha, **seg)
     except (QualitativeError, CertifyError, ValueError) as err:
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(2)

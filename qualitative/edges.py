@@ -51,7 +51,8 @@ from scipy import ndimage
 from .errors import ContourError
 from .vision import ImageSource, gaussian_blur, read_image
 
-__all__ = ["EDGE_BLUR", "EDGE_REACH", "RING", "WEAK_EDGE", "edge_contrast", "edge_strength"]
+__all__ = ["EDGE_BLUR", "EDGE_REACH", "RING", "WEAK_EDGE", "SHARPNESS", "edge_contrast", "edge_strength",
+           "edge_evidence", "weak_edge"]
 
 EDGE_BLUR = 1.0
 """Standard deviation of the Gaussian blur before differentiating, pixels."""
@@ -182,3 +183,54 @@ def edge_strength(image: ImageSource | np.ndarray, points, normals, contrast: fl
     # slope along the inward normal over the contrast: positive where the grey moves towards the object's
     rate = np.gradient(profile, _STEP, axis=1) / contrast
     return rate.max(axis=1) * math.sqrt(2 * math.pi) * EDGE_BLUR
+
+
+SHARPNESS = 90
+"""Percentile of the edge strengths along the object's whole contour that measures how sharp the
+image's edges are (:func:`edge_evidence`)."""
+
+
+def edge_evidence(image: ImageSource | np.ndarray, contour, contour_normals, points, normals) -> np.ndarray:
+    """Edge strength at contact points relative to the sharpness of the image's own edges.
+
+    The strength at each contact (:func:`edge_strength`) divided by the :data:`SHARPNESS`-th
+    percentile of the strengths along the object's whole ``contour``: a contact on the object's
+    edge reads about 1 however blurred or noisy the whole image is (a blurred image is not a
+    shadow), a contact on a shadow's boundary or a texture's blotch far less than the object's
+    own edges elsewhere on the contour. Below :data:`WEAK_EDGE` a contact is on a weak edge.
+
+    Parameters
+    ----------
+    image : str, pathlib.Path or numpy.ndarray
+        The image (see :func:`qualgrasp.qualitative.vision.read_image`).
+    contour, contour_normals : array_like
+        ``(m, 2)`` the object's contour as segmented (pixels) and its inward normals.
+    points, normals : array_like
+        ``(n, 2)`` contact points and inward normals.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(n,)`` relative strengths; all 0 when no edge supports the contour anywhere.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from qualgrasp.qualitative.objects import render
+    >>> from qualgrasp.qualitative.outline import outline_image
+    >>> o = outline_image(render("square"))
+    >>> bool(edge_evidence(render("square"), o.contour, o.normals(), o.contour[:5], o.normals()[:5]).min() > WEAK_EDGE)
+    True
+    """
+    grey = read_image(image)
+    contrast = edge_contrast(grey, np.asarray(contour, dtype=np.float64))
+    sharpness = np.percentile(edge_strength(grey, contour, contour_normals, contrast), SHARPNESS)
+    if not sharpness > 0:
+        return np.zeros(len(np.asarray(points)))
+    return edge_strength(grey, points, normals, contrast) / sharpness
+
+
+def weak_edge(strengths) -> bool:
+    """Whether some contact of a grasp is on a weak edge: a strength of :func:`edge_evidence`
+    below :data:`WEAK_EDGE` (an empty or missing list: no)."""
+    return any(v < WEAK_EDGE for v in (strengths or ()))

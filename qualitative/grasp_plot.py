@@ -27,6 +27,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon as PolygonPatch, Wedge
 from shapely.geometry.base import BaseGeometry
 
+from .edges import WEAK_EDGE
 from .forcegrasp import ForceGrasp, friction_cone, friction_zone
 from .formgrasp import FormGrasp, line_of_action_exit, zone_steps
 from .plot import STYLE, draw_frame
@@ -203,8 +204,18 @@ def plot_grasp(ax: Axes, synth: Synthesis, k: int, image: np.ndarray | None = No
     else:
         _chords(ax, grasp, synth, len(grasp.points))
     plot_contacts(ax, grasp.points, grasp.normals, size)
+    weak = _weak_contacts(synth, k)
+    if len(weak):
+        ax.scatter(grasp.points[weak, 0], grasp.points[weak, 1], s=260, facecolors="none", edgecolors="tab:red",
+                   linewidths=2.2, zorder=7)
     ax.set_title(_caption(synth, k), fontsize=9)
     return ax
+
+
+def _weak_contacts(synth: Synthesis, k: int) -> np.ndarray:
+    """Indices of the contacts of grasp ``k`` on a weak edge (its field ``edge_strength``)."""
+    strengths = synth.grasps[k].meta.get("edge_strength") or ()
+    return np.flatnonzero(np.asarray(strengths, dtype=float) < WEAK_EDGE) if len(strengths) else np.zeros(0, int)
 
 
 def _draw_cone(ax: Axes, point: np.ndarray, normal: np.ndarray, theta_min: float, reach: float) -> None:
@@ -233,6 +244,9 @@ def _caption(synth: Synthesis, k: int) -> str:
         r = synth.reports[k]
         eps = r.epsilons["L1"].hi if r.epsilons else float("nan")
         text += f"\n{r.force.status}, margin {r.force.margin:.3f}, eps {eps:.3f}"
+    weak = _weak_contacts(synth, k)
+    if len(weak):  # the contacts are numbered from 1 in the figure
+        text += f"\nWEAK EDGE at contact {', '.join(str(i + 1) for i in weak)} (red ring)"
     return text
 
 

@@ -52,9 +52,9 @@ from ..certify.region_boundary import SEARCH_BUDGET, IndependentRegions, indepen
 from ..certify.region_data import tuple_to_dict
 from ..certify.validation import number, show
 from .errors import QualitativeError
-from .outline import DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_image
+from .outline import DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_contour, outline_image
 from .regions import ALPHA, ALPHA_MAX, FINGER_WIDTH, MARGIN, Region, feasible_regions
-from .vision import ImageSource
+from .vision import ImageSource, extract_contour
 
 __all__ = ["ON_OUTLINE", "outline_boundary", "contact_limits", "planned_regions", "independent_grasp",
            "independent_file", "IndependentSummary"]
@@ -137,7 +137,7 @@ def contact_limits(outline: Outline, regions: list[Region], points: np.ndarray, 
 
 def planned_regions(image: ImageSource, grasp: Grasp, *, alpha: float | None = None,
                     finger_width: float = FINGER_WIDTH, margin: float = MARGIN, threshold: float | None = None,
-                    largest: bool = False, outline: Outline | None = None,
+                    largest: bool = False, outline: Outline | None = None, contour: np.ndarray | None = None,
                     cache: dict | None = None) -> list[Region]:
     """The feasible regions a grasp was planned on: those of the image's outline at the grasp's
     field ``scale`` (default :data:`~qualgrasp.qualitative.outline.DEFAULT_SCALE`) with the
@@ -158,6 +158,10 @@ def planned_regions(image: ImageSource, grasp: Grasp, *, alpha: float | None = N
     outline : Outline, optional
         The image's outline at some scale, used instead of extracting it again when the grasp's
         scale is that one.
+    contour : numpy.ndarray, optional
+        The object's contour as extracted from the image
+        (:func:`qualgrasp.qualitative.vision.extract_contour`): outlines at other scales are
+        computed from it, and the image is not segmented again.
     cache : dict, optional
         Regions already found, by ``(scale, alpha)`` (filled in); for one image, ``threshold``,
         ``largest``, ``finger_width`` and ``margin``.
@@ -184,7 +188,8 @@ def planned_regions(image: ImageSource, grasp: Grasp, *, alpha: float | None = N
     cache = {} if cache is None else cache
     if key not in cache:
         if outline is None or outline.scale != scale:
-            outline = outline_image(image, scale=scale, threshold=threshold, largest=largest)
+            outline = (outline_image(image, scale=scale, threshold=threshold, largest=largest) if contour is None
+                       else outline_contour(contour, scale=scale))
         cache[key] = feasible_regions(outline, key[1], finger_width, margin)
     return cache[key]
 
@@ -268,7 +273,8 @@ def _row(gid, line, result: IndependentRegions | None = None, error: str | None 
 def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str | Path, *, symmetric: bool = True,
                      tol: float | None = None, budget: int = SEARCH_BUDGET, normal_tol: float = 0.0,
                      alpha: float | None = None, finger_width: float = FINGER_WIDTH, margin: float = MARGIN,
-                     threshold: float | None = None, largest: bool = False,
+                     threshold: float | None = None, largest: bool = False, method: str = "otsu",
+                     mask: ImageSource | None = None, rect: tuple[int, int, int, int] | None = None,
                      progress: Callable[[int], None] | None = None) -> IndependentSummary:
     """Independent contact regions of every grasp of a grasp set (JSON Lines) on an image's object.
 
@@ -286,8 +292,9 @@ def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str 
         Feasible regions' parameters (:func:`~qualgrasp.qualitative.regions.feasible_regions`);
         each grasp's regions are those it was planned on (:func:`planned_regions`: its fields
         ``scale`` and ``alpha``, ``alpha`` given overriding the latter).
-    threshold, largest
-        As for :func:`~qualgrasp.qualitative.outline.outline_image`.
+    threshold, largest, method, mask, rect
+        Segmentation (:func:`qualgrasp.qualitative.vision.extract_contour`); the contour is
+        extracted once, and every scale's outline computed from it.
     progress : callable, optional
         Called with 1 after each grasp line.
 
@@ -313,7 +320,8 @@ def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str 
         text = grasps_path.read_text(encoding="utf-8")
     except OSError as err:
         raise GraspFileError(f"cannot read {grasps_path}: {err.strerror or err}") from None
-    outline = outline_image(image, threshold=threshold, largest=largest)
+    contour = extract_contour(image, threshold=threshold, largest=largest, method=method, mask=mask, rect=rect)
+    outline = outline_contour(contour)
     cache: dict = {}
     summary = IndependentSummary()
     rows = []
@@ -327,7 +335,7 @@ def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str 
                 gid = value["id"]
             grasp = grasp_from_dict(value)
             regions = planned_regions(image, grasp, alpha=alpha, finger_width=finger_width, margin=margin,
-                                      threshold=threshold, largest=largest, outline=outline, cache=cache)
+                                      outline=outline, contour=contour, cache=cache)
             result = independent_grasp(outline, grasp, regions=regions, symmetric=symmetric, tol=tol,
                                        budget=budget, normal_tol=normal_tol)
             row = _row(gid, number, result)

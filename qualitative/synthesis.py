@@ -83,11 +83,21 @@ the largest such change keeps a ball of wrenches after any such change (the hull
 generators is within that distance of the hull): it is **resolved**. A grasp whose certified
 epsilon is below it is reported as not resolved by the image, not as a good grasp.
 
+Edge evidence
+-------------
+A segmentation can follow a shadow's soft boundary or a textured background instead of the
+object's edge; a grasp certified on such a contour grasps the shadow. Each grasp records in its
+field ``edge_strength`` the image's edge evidence at each contact
+(:func:`qualgrasp.qualitative.edges.edge_evidence`: the gradient across the contour at the
+contact relative to the contrast and sharpness of the object's edges elsewhere); a contact below
+:data:`qualgrasp.qualitative.edges.WEAK_EDGE` is on a **weak edge** (:func:`on_weak_edge`).
+
 One rule for every route. :func:`unresolved_reasons` gives the reasons a certified grasp is not
-counted as found, from its own fields and its certified epsilon, whoever planned it: today one,
-``below_resolution`` (:func:`below_resolution`), the grasp's field ``resolution`` set by
-synthesis and by the study's baseline (:mod:`qualgrasp.experiments.baseline`) alike. Each reason
-is a :class:`NotCounted` of :data:`NOT_COUNTED` (a name, the label printed, a predicate), so a
+counted as found, from its own fields and its certified epsilon, whoever planned it:
+``below_resolution`` (:func:`below_resolution`, the grasp's field ``resolution``) and
+``weak_edge`` (:func:`on_weak_edge`, its field ``edge_strength``), both set by synthesis and by
+the study's baseline (:mod:`qualgrasp.experiments.baseline`) alike. Each reason is a
+:class:`NotCounted` of :data:`NOT_COUNTED` (a name, the label printed, a predicate), so a
 further reason is one more entry; :func:`counted` is a certified grasp with no reason.
 """
 
@@ -97,7 +107,7 @@ import math
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any, Iterator, Sequence
 
 import numpy as np
 
@@ -110,14 +120,16 @@ from .candidates import ERROR, INSET, PER_REGION, STEP, Candidates, candidates, 
 from .errors import SynthesisError
 from .forcegrasp import MARGIN, friction
 from .independent import independent_grasp
-from .outline import DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, finger_scale, outline_image, outline_scales
+from .outline import (DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, finger_scale, outline_contour,
+                      outline_contour_scales)
 from .procedures import Procedure, SearchInput
 from .regions import ALPHA, FINGER_WIDTH, MARGIN as REGION_MARGIN, Region, feasible_regions
-from .vision import ImageSource
+from .edges import WEAK_EDGE, edge_evidence, weak_edge
+from .vision import ImageSource, extract_contour
 
 __all__ = ["MU", "POSITION", "NORMAL", "SPREAD", "FALLBACK_SCALES", "FALLBACK_STEP", "NOT_COUNTED", "NotCounted",
            "Synthesis", "synthesize", "to_grasp", "choose", "resolution", "normal_span", "below_resolution",
-           "unresolved_reasons", "counted", "search_scales", "search_alphas", "search_attempts"]
+           "on_weak_edge", "set_edge_strength", "unresolved_reasons", "counted", "search_scales", "search_alphas", "search_attempts"]
 
 MU = 0.5
 """Default friction coefficient of procedures with friction."""
@@ -171,14 +183,43 @@ class NotCounted:
         What ``qualgrasp synthesize`` prints after ``verified,``.
     applies : callable
         ``applies(grasp, eps_l1) -> bool``, from the grasp's fields and its certified L1 epsilon.
+    note : str
+        What it means for the user, printed after the summary when some grasp has the reason.
     """
 
     name: str
     label: str
     applies: Any
+    note: str = ""
 
 
-NOT_COUNTED: tuple[NotCounted, ...] = (NotCounted("below_resolution", "BELOW IMAGE RESOLUTION", below_resolution),)
+def on_weak_edge(grasp: Grasp, eps_l1: float) -> bool:
+    """Whether a contact of the grasp lies where the image shows no clear edge of the object (its
+    field ``edge_strength`` has a value below :data:`qualgrasp.qualitative.edges.WEAK_EDGE`;
+    module notes): a shadow's or a texture's boundary. False without the field. ``eps_l1`` is
+    not used (the signature of :class:`NotCounted`).
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import Contact, Grasp
+    >>> g = Grasp((Contact((1, 0), (-1, 0)), Contact((-1, 0), (1, 0))), meta={"edge_strength": [0.9, 0.1]})
+    >>> on_weak_edge(g, 1.0)
+    True
+    """
+    return weak_edge(grasp.meta.get("edge_strength"))
+
+
+NOT_COUNTED: tuple[NotCounted, ...] = (
+    NotCounted("below_resolution", "BELOW IMAGE RESOLUTION", below_resolution,
+               "are below the image's resolution: their certified epsilon is smaller than the wrench "
+               "change that a pixel of error in the contacts and their normals can cause, so the closure "
+               "may be an artefact of the pixels; do not rely on them"),
+    NotCounted("weak_edge", "ON A WEAK EDGE (shadow or texture?)", on_weak_edge,
+               f"have a contact where the image shows no clear edge of the object (field edge_strength "
+               f"below {WEAK_EDGE:g}): the contour there may follow a shadow or a textured background, not the "
+               "object; look at --plot, try --segmentation multiotsu (a shadow), adaptive (uneven "
+               "lighting) or grabcut (a textured background), or give the object's mask with --mask"),
+)
 """Every reason a certified grasp is not counted as found, in the order reported."""
 
 
@@ -463,6 +504,21 @@ def choose(fingers: int | None = None, procedure: str | None = None) -> Procedur
                              + f"), got {fingers}") from None
 
 
+def set_edge_strength(grasps: Sequence[Grasp], image: ImageSource, contour, normals) -> None:
+    """Record in each grasp's field ``edge_strength`` the image's edge evidence at its contacts
+    (:func:`qualgrasp.qualitative.edges.edge_evidence` against the object's ``contour`` and its
+    inward ``normals``, pixels; module notes), for every route that plans on an image."""
+    if not grasps:
+        return
+    P = np.array([c.p[:2] for g in grasps for c in g.contacts], dtype=float)
+    N = np.array([c.n[:2] for g in grasps for c in g.contacts], dtype=float)
+    strengths = edge_evidence(image, contour, normals, P, N)
+    k = 0
+    for g in grasps:
+        g.meta["edge_strength"] = [round(float(v), 4) for v in strengths[k:k + len(g.contacts)]]
+        k += len(g.contacts)
+
+
 def _name(image: ImageSource, name: str | None) -> str:
     if name is not None:
         return name
@@ -474,7 +530,9 @@ def _name(image: ImageSource, name: str | None) -> str:
 def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None = None,
                theta_min: float | None = None, alpha: float | None = None, *, procedure: str | None = None,
                name: str | None = None, certify: bool = True, quality: bool = True,
-               threshold: float | None = None, largest: bool = False, finger_width: float = FINGER_WIDTH,
+               threshold: float | None = None, largest: bool = False, method: str = "otsu",
+               mask: ImageSource | None = None, rect: tuple[int, int, int, int] | None = None,
+               finger_width: float = FINGER_WIDTH,
                region_margin: float = REGION_MARGIN, step: float = STEP, inset: float = INSET,
                per_region: int = PER_REGION, error: float = ERROR, margin: float = MARGIN,
                tolerance: bool = True, scale: float | None = None, explain: bool = True,
@@ -508,8 +566,11 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     quality : bool
         With ``certify``, compute both epsilons (L1 and L-infinity); otherwise only the L1
         epsilon, which tells resolved grasps (module notes).
-    threshold, largest
-        Segmentation (:func:`qualgrasp.qualitative.outline.outline_image`).
+    threshold, largest, method, mask, rect
+        Segmentation (:func:`qualgrasp.qualitative.vision.extract_contour`): a grey level, the
+        largest of several objects, the method (``"otsu"``, ``"multiotsu"``, ``"adaptive"``,
+        ``"grabcut"``), a user's mask of the object, GrabCut's rectangle ``(x, y, w, h)``. The
+        contour is extracted once; every scale's outline is computed from it.
     finger_width, region_margin
         Feasible regions (:func:`qualgrasp.qualitative.regions.feasible_regions`), fractions of the size.
     step, inset, per_region
@@ -570,7 +631,8 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
         raise SynthesisError(f"scale must be in [{SCALE_MIN:g}, {SCALE_MAX:g}] (fraction of the perimeter), "
                              f"got {scale}")
     start = time.perf_counter()
-    fine = outline_image(image, threshold=threshold, largest=largest)
+    contour = extract_contour(image, threshold=threshold, largest=largest, method=method, mask=mask, rect=rect)
+    fine = outline_contour(contour)
     center, length = object_frame(fine.contour)
     tried: list[tuple[float, float, bool]] = []
     most, richest, found = 0, None, []
@@ -578,8 +640,8 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     for rough in (False, True):
         if rough and (found or normal_spread is None):
             break
-        source = iter(attempts) if rough else _attempt_regions(image, fine, finger_width, scale, alpha,
-                                                                region_margin, threshold, largest)
+        source = iter(attempts) if rough else _attempt_regions(contour, fine, finger_width, scale, alpha,
+                                                                region_margin)
         for item in source:
             if rough:
                 s, a, outline, regions, cands, first = item
@@ -609,6 +671,7 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
         grasp.meta["alpha"] = a
         grasps.append(grasp)
     grasps = tuple(grasps)
+    set_edge_strength(grasps, image, fine.contour, fine.normals())
     seconds = time.perf_counter() - start
     start = time.perf_counter()
     reports = tuple(_certified(g, quality) for g in grasps) if certify else ()
@@ -619,20 +682,21 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
                      smooth)
 
 
-def search_scales(image: ImageSource, fine: Outline, finger_width: float, scale: float | None = None, *,
-                  threshold: float | None = None, largest: bool = False):
+def search_scales(contour: np.ndarray, fine: Outline, finger_width: float, scale: float | None = None):
     """The outline scales synthesis tries, in order (module notes): ``scale`` alone when given;
     else the finger's scale (never finer than the default), then up to :data:`FALLBACK_SCALES`
-    coarser scales of the outline's hierarchy, each the start of an interval with another string
-    and at least :data:`FALLBACK_STEP` times the previous scale, and last the default (fine) scale. A generator: the hierarchy is computed only when the first
-    scale is not enough."""
+    coarser scales of the hierarchy of the object's ``contour`` (as extracted from the image,
+    :func:`qualgrasp.qualitative.vision.extract_contour`; ``fine`` is its outline at the default
+    scale), each the start of an interval with another string and at least :data:`FALLBACK_STEP`
+    times the previous scale, and last the default (fine) scale. A generator: the hierarchy is
+    computed only when the first scale is not enough."""
     if scale is not None:
         yield scale
         return
     first = max(fine.scale, finger_scale(fine, finger_width))
     yield first
     last, count = first, 0
-    for iv in outline_scales(image, threshold=threshold, largest=largest):
+    for iv in outline_contour_scales(contour):
         # real outlines change string at many nearby fine scales: step by a factor at least
         if iv.lo >= last * FALLBACK_STEP and count < FALLBACK_SCALES:
             yield iv.lo
@@ -659,9 +723,8 @@ def search_alphas(alpha: float | None, finger_width: float) -> tuple[float, ...]
     return (ALPHA, finger_width) if finger_width < ALPHA else (ALPHA,)
 
 
-def search_attempts(image: ImageSource, fine: Outline, finger_width: float, scale: float | None = None,
-                    alpha: float | None = None, *, threshold: float | None = None,
-                    largest: bool = False) -> Iterator[tuple[float, float]]:
+def search_attempts(contour: np.ndarray, fine: Outline, finger_width: float, scale: float | None = None,
+                    alpha: float | None = None) -> Iterator[tuple[float, float]]:
     """The ``(scale, alpha)`` pairs synthesis tries, in order (module notes): every scale of
     :func:`search_scales` at the first curvature threshold of :func:`search_alphas`, then the same
     scales at the next threshold. A generator: the hierarchy is computed only when the first scale
@@ -669,23 +732,23 @@ def search_attempts(image: ImageSource, fine: Outline, finger_width: float, scal
     scales: list[float] = []
     for k, a in enumerate(search_alphas(alpha, finger_width)):
         if k == 0:
-            for s in search_scales(image, fine, finger_width, scale, threshold=threshold, largest=largest):
+            for s in search_scales(contour, fine, finger_width, scale):
                 scales.append(s)
                 yield s, a
         else:
             yield from ((s, a) for s in scales)
 
 
-def _attempt_regions(image: ImageSource, fine: Outline, finger_width: float, scale: float | None,
-                     alpha: float | None, margin: float, threshold: float | None, largest: bool):
+def _attempt_regions(contour: np.ndarray, fine: Outline, finger_width: float, scale: float | None,
+                     alpha: float | None, margin: float):
     """Per attempt of :func:`search_attempts`: ``(scale, alpha, outline, regions)``, each scale's
     outline computed once; an attempt whose regions are those of an earlier one at the same scale
     (no curve between the two thresholds) is skipped."""
     outlines = {fine.scale: fine}
     seen = set()
-    for s, a in search_attempts(image, fine, finger_width, scale, alpha, threshold=threshold, largest=largest):
+    for s, a in search_attempts(contour, fine, finger_width, scale, alpha):
         if s not in outlines:
-            outlines[s] = outline_image(image, scale=s, threshold=threshold, largest=largest)
+            outlines[s] = outline_contour(contour, scale=s)
         regions = _fine_normals(tuple(feasible_regions(outlines[s], a, finger_width, margin)), fine, outlines[s])
         key = (s, tuple((r.start, r.stop) for r in regions))
         if key not in seen:

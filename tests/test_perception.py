@@ -307,3 +307,68 @@ def test_grabcut_default_rectangle_leaves_a_frame():
     assert x >= 1 and y >= 1 and x + w <= horse.shape[1] - 1 and y + h <= horse.shape[0] - 1
     contour = extract_contour(horse, method="grabcut")
     assert shapely.Polygon(contour).area == pytest.approx((~horse).sum(), rel=0.03)
+
+
+# ------------------------------------------------------------------- wired into synthesis and the CLI
+
+from typer.testing import CliRunner  # noqa: E402
+
+from qualgrasp.cli import app  # noqa: E402
+from qualgrasp.experiments.baseline import baseline  # noqa: E402
+from qualgrasp.qualitative.synthesis import on_weak_edge  # noqa: E402
+
+
+def test_synthesis_records_edge_evidence_and_does_not_count_grasps_on_the_shadow():
+    """Default segmentation on the shadow scene: the grasps with a contact off the true edge carry
+    weak edge evidence and are not counted as resolved; with --segmentation multiotsu every
+    certified grasp is on the object and counted."""
+    image, poly = shadow()
+    result = synthesize(image, fingers=4, quality=False, tolerance=False)
+    offs = [shapely.distance(poly.exterior, shapely.points([c.p for c in g.contacts])).max() for g in result.grasps]
+    for g, off, why, ok in zip(result.grasps, offs, result.not_counted, result.certified):
+        assert len(g.meta["edge_strength"]) == len(g.contacts)
+        assert on_weak_edge(g, 1.0) == (off > 5)
+        assert ("weak_edge" in why) == (ok and off > 5)
+    assert any(off > 5 for off in offs) and result.summary()["weak_edge"] > 0
+    right = synthesize(image, fingers=4, quality=False, tolerance=False, method="multiotsu")
+    assert right.grasps and right.summary()["weak_edge"] == 0
+    far = [shapely.distance(poly.exterior, shapely.points([c.p for c in g.contacts])).max() for g in right.grasps]
+    assert max(far) < 3
+
+
+def test_a_blurred_image_is_not_a_shadow():
+    """Edge evidence is relative to the image's own edges: a uniformly blurred image flags nothing."""
+    image = cv2.GaussianBlur(render("polygon").astype(np.float64), (0, 0), 4.0)
+    result = synthesize(np.clip(np.round(image), 0, 255).astype(np.uint8), fingers=2, quality=False,
+                        tolerance=False)
+    assert result.grasps and result.summary()["weak_edge"] == 0
+
+
+def test_the_baseline_is_judged_by_the_same_edge_rule():
+    image, _ = shadow()
+    found = baseline(image, 2, name="shadow")
+    assert all(len(g.meta["edge_strength"]) == 2 for g in found.grasps)
+
+
+def test_segmentation_options_on_the_command_line(tmp_path):
+    image, poly = shadow()
+    path = tmp_path / "shadow.png"
+    cv2.imwrite(str(path), image)
+    run = CliRunner().invoke
+    out = run(app, ["synthesize", str(path), "--fingers", "4", "-o", str(tmp_path / "g.jsonl"), "--no-tolerance"])
+    assert out.exit_code == 0 and "ON A WEAK EDGE" in out.output and "--segmentation" in out.output
+    out = run(app, ["synthesize", str(path), "--fingers", "4", "-o", str(tmp_path / "g.jsonl"), "--no-tolerance",
+                    "--segmentation", "multiotsu"])
+    assert out.exit_code == 0 and "WEAK EDGE" not in out.output
+    mask = tmp_path / "mask.png"
+    cv2.imwrite(str(mask), (coverage(poly) > 0.5).astype(np.uint8) * 255)
+    out = run(app, ["outline", str(path), "--mask", str(mask)])
+    assert out.exit_code == 0 and out.output.strip() == outline_image(image, mask=mask).string
+    for args, message in ((["--segmentation", "nope"], "unknown segmentation method"),
+                          (["--mask", str(mask), "--segmentation", "adaptive"], "mask is the segmentation"),
+                          (["--rect", "1,2,3"], "--rect must be four whole numbers"),
+                          (["--rect", "10,10,200,200"], "rectangle starts GrabCut")):
+        out = run(app, ["regions", str(path), *args])
+        assert out.exit_code == 2 and message in out.output, (args, out.output)
+    out = run(app, ["regions", str(path), "--segmentation", "grabcut", "--rect", "40,40,320,320"])
+    assert out.exit_code == 0, out.output

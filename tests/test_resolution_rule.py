@@ -58,7 +58,7 @@ def test_no_route_counts_a_frictionless_closure_of_the_disc(tmp_path):
     robust = [r for r in _rows(tmp_path / "robustness.csv") if r["route"] == "Baseline 4"]
     assert all(r["planned"] == "0" for r in robust) and sum(int(r["below_resolution"]) for r in robust) > 0
     assert dict(next(r for r in result.routes if r.route == "Baseline 4").not_counted) == {
-        "below_resolution": base["certified"]}
+        "below_resolution": base["certified"], "weak_edge": 0}
 
 
 def test_frictionless_closures_counted_on_the_stadium_are_real():
@@ -94,7 +94,7 @@ def test_one_rule_for_both_routes(monkeypatch, tmp_path):
     """With a coarser image (every grasp's resolution made larger than any epsilon), the
     qualitative grasps are flagged by the same function as the baseline's, in synthesis, its
     command and the study alike."""
-    assert REASONS == tuple(r.name for r in NOT_COUNTED) == ("below_resolution",)
+    assert REASONS == tuple(r.name for r in NOT_COUNTED) == ("below_resolution", "weak_edge")
     image = render("polygon")
     s = synthesize(image, procedure="forcegrasp2", quality=False, tolerance=False)
     assert s.grasps and all(s.resolved) and s.summary()["below_resolution"] == 0
