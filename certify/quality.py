@@ -465,7 +465,8 @@ def epsilon(grasp: Grasp, norm: str = "L1", *, rel_gap: float = 0.01, budget: in
         an SOCP, counts as :data:`SOCP_COST`); the gap reached is reported. A count, not a
         time, so that results are reproducible on any machine.
     time_limit : float, optional
-        Seconds after which the computation stops with the bounds reached (``limited``).
+        Seconds after which the computation stops with the bounds reached (``limited``),
+        counted from the closure verdict, compiling kernels excluded.
     verdict : Verdict, optional
         The grasp's force-closure verdict, if already known.
 
