@@ -7,7 +7,8 @@ The package has three halves, each importable on its own:
   synthesis procedures;
 * :mod:`qualgrasp.experiments`: the paper's figures, the comparison study, the demo.
 
-The names below are the main API, re-exported from the halves.
+The names below are the main API, re-exported from the halves; ``__version__`` is the installed
+distribution's version (its one source is ``pyproject.toml``).
 
 Examples
 --------
@@ -19,6 +20,8 @@ Examples
 ('closure', True)
 """
 
+from importlib.metadata import version
+
 # Absolute imports: this file is also the repository root's __init__.py, which pytest imports
 # under the folder's name when it collects tests/; absolute imports load the installed package
 # whatever that folder is called.
@@ -28,6 +31,8 @@ from qualgrasp.certify import (Certificate, Check, Contact, Grasp, Report, Verdi
 from qualgrasp.certify.errors import CertificateError, CertifyError, GraspError, GraspFileError, SolverError
 from qualgrasp.certify.quality import Epsilon, epsilon
 from qualgrasp.qualitative.synthesis import Synthesis, synthesize
+
+__version__ = version("qualgrasp")
 
 __all__ = [
     "Contact", "Grasp", "grasp_from_dict", "grasp_to_dict",

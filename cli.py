@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import typer
 
+from qualgrasp import __version__
 from qualgrasp.certify import cli as certify_cli
 from qualgrasp.experiments import cli as experiments_cli
 from qualgrasp.qualitative import cli as qualitative_cli
@@ -17,6 +18,21 @@ __all__ = ["app", "main"]
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="Qualitative grasp synthesis and convex certification of closure grasps.")
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        typer.echo(f"qualgrasp {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _options(version: bool = typer.Option(False, "--version", callback=_print_version, is_eager=True,
+                                          help="Print the version and exit.")) -> None:
+    # options of the application itself, before any command
+    pass
+
+
 certify_cli.register(app)
 qualitative_cli.register(app)
 experiments_cli.register(app)

@@ -50,11 +50,15 @@ normals of its weakest faces, which pushes those faces out, until ``hi - lo <= r
 the polytope has ``MAX_VERTICES`` vertices or the work ``budget`` is spent. Each round costs
 ``O(m)`` per direction examined plus a hull of at most ``MAX_VERTICES`` points, whatever ``m``.
 
-A per-grasp time limit (``time_limit``, seconds) stops the L-infinity sweep and the spatial
-refinement early: the row keeps its closure verdict and reports the bounds reached (planar
-L-infinity: ``hi`` the best support value found, ``lo`` the L1 epsilon; spatial: the polytope's
-``lo`` and the best ``hi``), with ``limited`` set. Results then depend on the machine's speed;
-without the limit being hit they are deterministic.
+A per-grasp time limit (``time_limit``, seconds) stops the L-infinity sweep, the refinement of
+the planar ``support`` evidence and the spatial refinement early: the row keeps its closure
+verdict and reports the bounds reached (planar L-infinity: ``hi`` the best support value found,
+``lo`` the L1 epsilon or what the support points found so far prove; spatial: the polytope's
+``lo`` and the best ``hi``), with ``limited`` set whenever the limit cut a bound. Results then
+depend on the machine's speed; without the limit being hit they are deterministic. The clock
+counts computation only: it starts once the closure verdict is known, and the kernels are
+compiled (or loaded from numba's cache) before it runs, so a cold compile cache never changes a
+result.
 
 Epsilon is 0 for grasps not in closure (and for degenerate ones): the closure verdict is decided
 first, so flat hulls and rank-deficient sets never reach qhull.
@@ -72,6 +76,9 @@ import scipy.sparse as sp
 from scipy.spatial import ConvexHull, QhullError
 
 from ._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
+from ._kernels.jit import BOOL, F1, F2, FLOAT, I1, I2, INT, precompile
+from ._kernels.planar import planar_generators
+from ._kernels.surface import cycle_code, face_bounds
 from .closure import Verdict, force_closure
 from .evidence import (EPS_TOL, ConicSupport, Evidence, planar_generator_arrays,
                        planar_support_vertices, stated_lo, sum_errors, surface_faces,
@@ -104,6 +111,17 @@ _TOP = 16
 _SWEEP_BATCH = 64
 #: Weakest faces whose normals are added per round of the spatial refinement.
 _ADD = 2
+#: The kernels the epsilon of spatial grasps calls (those checking surfaces), with the argument
+#: types it calls them with: compiled before the time limit's clock runs (:func:`_after_compiling`).
+_SURFACE_KERNELS = ((face_bounds, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)))
+#: The same for planar grasps.
+_PLANAR_KERNELS = _SURFACE_KERNELS + (
+    (planar_generators, (F2, F2, F1, F1, F1, FLOAT, I1, F1, F1, F2, F2)),
+    (planar_epsilon_one, (F2, I1, INT, BOOL)),
+    (support_rows, (F2, I1, INT, F2, BOOL)),
+    (planar_edges, (F2, I1)),
+    (linf_sweep, (F2, I1, INT, F2, INT, INT, F1, F2)),
+)
 
 
 @dataclass(frozen=True)
@@ -162,6 +180,15 @@ def _zero(grasp: Grasp, norm: str) -> Epsilon:
 
 def _expired(deadline: float | None) -> bool:
     return deadline is not None and time.perf_counter() > deadline
+
+
+def _after_compiling(deadline: float | None, kernels) -> float | None:
+    """Compile ``kernels`` (:func:`~qualgrasp.certify._kernels.jit.precompile`) and return
+    ``deadline`` pushed back by the time that took: a time limit counts computation, never
+    compilation, so that a cold compile cache cannot change a result."""
+    start = time.perf_counter()
+    precompile(kernels)
+    return None if deadline is None else deadline + (time.perf_counter() - start)
 
 
 # --- planar ---------------------------------------------------------------------------------------
@@ -254,7 +281,9 @@ def planar_epsilons(W, E, owner, m: int, *, deadline: float | None = None, exact
     m : int
         Number of contacts.
     deadline : float, optional
-        :func:`time.perf_counter` value after which the L-infinity sweep stops.
+        :func:`time.perf_counter` value after which the L-infinity sweep and the refinement of
+        its ``support`` evidence stop (``limited``); pushed back by the time spent compiling
+        kernels here.
     exact : callable, optional
         ``exact()`` returns the exact generators (3, k) (Fractions), asked for only when the
         rigorous float checks of a surface cannot decide a face; without it such a surface
@@ -265,6 +294,7 @@ def planar_epsilons(W, E, owner, m: int, *, deadline: float | None = None, exact
     dict
         ``{"L1": (lo, hi, direction, evidence, limited), "Linf": (...)}``.
     """
+    deadline = _after_compiling(deadline, _PLANAR_KERNELS)
     W = np.ascontiguousarray(W, dtype=float)
     E = np.ascontiguousarray(E, dtype=float)
     owner = np.ascontiguousarray(owner, dtype=np.int64)
@@ -323,7 +353,7 @@ def planar_epsilons(W, E, owner, m: int, *, deadline: float | None = None, exact
                     ev = Evidence("sums", direction, ref=tuple(int(i) for i in choice[used].ravel()),
                                   faces=tuple(int(i) for i in faces.ravel()))
         else:
-            found = _planar_support(W, E, owner, m, eps, np.asarray(u, dtype=float), deadline, gens)
+            found, limited = _planar_support(W, E, owner, m, eps, np.asarray(u, dtype=float), deadline, gens)
             if found is not None and found[0] >= l1_lo:
                 lo, dirs = found
                 ev = Evidence("support", direction, points=tuple(float(x) for x in dirs.ravel()))
@@ -338,7 +368,8 @@ def _planar_support(W, E, owner, m, eps, u, deadline, gens):
     """Planar L-infinity lower bound by ``support`` evidence: the hull of support points along
     the coordinate directions and ``u``, refined along the normals of its faces nearest the
     origin (each cut adds a vertex of the GWS beyond the face) until the surface proves ``eps``
-    or :data:`MAX_VERTICES` is reached. Returns ``(lo, directions)`` or None."""
+    or ``4 MAX_VERTICES`` directions are used, or the ``deadline`` passes. Returns ``((lo,
+    directions) or None, limited)``, ``limited`` when the deadline stopped the refinement."""
     dirs = [np.array(v, dtype=float) for v in np.vstack([np.eye(3), -np.eye(3), u[None]])]
     seen = set()
 
@@ -352,7 +383,7 @@ def _planar_support(W, E, owner, m, eps, u, deadline, gens):
         return out
 
     dirs = fresh(dirs)
-    hull, done = None, 0
+    hull, done, limited = None, 0, False
     while True:
         pts = planar_support_vertices(W, E, owner, m, np.array(dirs))[0]
         try:
@@ -362,9 +393,12 @@ def _planar_support(W, E, owner, m, eps, u, deadline, gens):
                 hull.add_points(pts[done:])
             done = len(dirs)
         except (QhullError, ValueError):
-            return None
+            return None, limited
         dist = -hull.equations[:, -1]
-        if dist.min() >= eps * (1 - EPS_TOL / 16) or len(dirs) >= 4 * MAX_VERTICES or _expired(deadline):
+        if dist.min() >= eps * (1 - EPS_TOL / 16) or len(dirs) >= 4 * MAX_VERTICES:
+            break
+        if _expired(deadline):
+            limited = True
             break
         new = fresh(list(hull.equations[np.argsort(dist, kind="stable")[:2 * _ADD], :-1]))
         if not new:
@@ -379,7 +413,7 @@ def _planar_support(W, E, owner, m, eps, u, deadline, gens):
         return [sum((C[r, j] for j in R[i] if j >= 0), 0) for r in range(3)]
 
     lo = _lower(eps, _prove(V, EV, surface_faces(V), vertex))
-    return None if lo is None else (lo, dirs)
+    return (None if lo is None else (lo, dirs)), limited
 
 
 def _sweep(W, owner, m, deadline):
@@ -431,7 +465,8 @@ def epsilon(grasp: Grasp, norm: str = "L1", *, rel_gap: float = 0.01, budget: in
         an SOCP, counts as :data:`SOCP_COST`); the gap reached is reported. A count, not a
         time, so that results are reproducible on any machine.
     time_limit : float, optional
-        Seconds after which the computation stops with the bounds reached (``limited``).
+        Seconds after which the computation stops with the bounds reached (``limited``),
+        counted from the closure verdict, compiling kernels excluded.
     verdict : Verdict, optional
         The grasp's force-closure verdict, if already known.
 
@@ -467,7 +502,8 @@ def epsilons(grasp: Grasp, norms=NORMS, *, rel_gap: float = 0.01, budget: int = 
              time_limit: float | None = None, verdict: Verdict | None = None) -> dict[str, Epsilon]:
     """Epsilon of ``grasp`` for each of ``norms`` (:func:`epsilon`), sharing the work: the
     planar generators, and the L1 bounds that serve as the L-infinity lower bound. The
-    ``time_limit`` (seconds) is for all norms together.
+    ``time_limit`` (seconds) is for all norms together; its clock starts once the closure
+    verdict is known and stops while kernels compile.
 
     Returns
     -------
@@ -476,10 +512,11 @@ def epsilons(grasp: Grasp, norms=NORMS, *, rel_gap: float = 0.01, budget: int = 
     """
     for norm in norms:
         _check_norm(norm)
-    deadline = None if time_limit is None else time.perf_counter() + time_limit
     verdict = verdict or force_closure(grasp)
     if verdict.status != "closure":
         return {norm: _zero(grasp, norm) for norm in norms}
+    deadline = None if time_limit is None else time.perf_counter() + time_limit
+    deadline = _after_compiling(deadline, _PLANAR_KERNELS if grasp.dim == 2 else _SURFACE_KERNELS)
     center, length = tuple(grasp.center), grasp.length
     out = {}
     if grasp.dim == 2:
@@ -605,7 +642,8 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
     h = pieces.h(U, norm)
     work = len(U)
     u_best, hi = U[int(np.argmin(h))], float(h.min())
-    if not _expired(deadline):
+    limited = _expired(deadline)  # then hi is not even refined locally
+    if not limited:
         u_best, hi, steps = pieces.local_minimum(u_best, norm)
         work += SOCP_COST * steps
     V, EV, dirs, refs, parts = [], [], [], [], []
@@ -626,8 +664,8 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
     for v in np.vstack([np.eye(d), -np.eye(d), u_best[None]]):
         add(v)
     spare = iter(U[2 * d:])  # more starting directions while the hull is flat
-    rounds, limited, hull, done = 0, False, None, 0
-    while True:
+    rounds, hull, done = 0, None, 0
+    while not limited:
         rounds += 1
         try:
             if hull is None and len(V) > d:

@@ -1,10 +1,12 @@
-"""The documented public API: every function ``qualgrasp`` exports has numpydoc sections, and
-every Examples section in the package runs (doctests)."""
+"""The documented public API: every function ``qualgrasp`` exports has numpydoc sections, every
+Examples section in the package runs (doctests), and so does README's Python example."""
 
+import ast
 import doctest
 import importlib
 import inspect
 import pkgutil
+from pathlib import Path
 
 import pytest
 
@@ -36,3 +38,22 @@ def test_examples_run(module):
         if test.examples:
             runner.run(test)
     assert runner.failures == 0, f"{runner.failures} failing example(s) in {module}"
+
+
+def _readme_block(heading: str) -> str:
+    """The first ```python block after ``heading`` in README.md."""
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    after = text[text.index(f"\n{heading}\n"):]
+    start = after.index("```python\n") + len("```python\n")
+    return after[start:after.index("```", start)]
+
+
+def test_readme_python_api_example_runs_as_written():
+    """README's "Python API at a glance" runs as written, and its last line is True as it says."""
+    code = _readme_block("## Python API at a glance")
+    tree = ast.parse(code)
+    last = tree.body.pop()
+    assert isinstance(last, ast.Expr) and code.splitlines()[-1].rstrip().endswith("# True")
+    namespace: dict = {}
+    exec(compile(tree, "README.md", "exec"), namespace)
+    assert eval(compile(ast.Expression(last.value), "README.md", "eval"), namespace) is True

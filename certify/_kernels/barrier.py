@@ -5,14 +5,14 @@ coordinates, compiled (numba): see :func:`socp_dual_barrier` and
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import kernel
 from .linalg import cholesky_solve
 
 __all__ = ["socp_dual_barrier", "barrier_batch"]
 
 
-@njit(cache=True)
+@kernel
 def _barrier_terms(y, Pm, T, rk, kappa, K, q, u, psi, Ty):
     """Affine parts ``u_b = z(y) - p_b . y``, ``T_b y`` and ``psi_b`` (``u^2 - kappa^2 |T y|^2``
     for cones, ``u`` for rays) at ``y``; False when ``y`` is not strictly feasible."""
@@ -44,7 +44,7 @@ def _barrier_terms(y, Pm, T, rk, kappa, K, q, u, psi, Ty):
     return True
 
 
-@njit(cache=True)
+@kernel
 def socp_dual_barrier(Pm, T, rk, kappa, exit_below, gap_tol, max_newton):
     """The spatial closure SOCP (see :mod:`qualgrasp.certify.problem`) through its dual, by a barrier method.
 
@@ -188,7 +188,7 @@ def socp_dual_barrier(Pm, T, rk, kappa, exit_below, gap_tol, max_newton):
     return 0, t, z, y, xn, xt
 
 
-@njit(cache=True)
+@kernel
 def _equilibrate(Pm, T, rk, kappa, xn, xt):
     """Project the forces onto equilibrium (least-squares correction), rescale them to total
     normal force 1 and return their margin ``min_b slack_b`` (``kappa x_n - |x_t|``; ``x_n`` for
@@ -233,7 +233,7 @@ def _equilibrate(Pm, T, rk, kappa, xn, xt):
     return t
 
 
-@njit(cache=True)
+@kernel
 def _phi(y, tau, q, K, u, psi, rk):
     z = 1.0
     for i in range(y.shape[0]):
@@ -244,7 +244,7 @@ def _phi(y, tau, q, K, u, psi, rk):
     return out
 
 
-@njit(cache=True)
+@kernel
 def barrier_batch(Pm, T, rk, kappa, exit_below, gap_tol, max_newton):
     """:func:`socp_dual_barrier` over a batch (B, nb, ...): statuses, margins, directions, forces."""
     B, nb, rmax, d = T.shape

@@ -10,14 +10,14 @@ number of columns, its stored normal (zeros for rays), friction coefficient and 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from ..cones import RAY
+from .jit import kernel
 
 __all__ = ["functional", "polar_value", "polar_values", "farkas_direction", "squeeze_direction"]
 
 
-@njit(cache=True)
+@kernel
 def functional(C, first, width, y, a):
     """``a[c] = y . C[:, first + c]`` for the ``width`` columns of one block."""
     for c in range(width):
@@ -27,7 +27,7 @@ def functional(C, first, width, y, a):
         a[c] = acc
 
 
-@njit(cache=True)
+@kernel
 def polar_value(a, cone, width, n, mu, g):
     """Polar value ``a_n + mu norm((a_t, a_m g / |n|))`` of the functional ``a`` (values on the
     block's ``width`` columns) on one block, ``a[0]`` for a ray: the largest ``y . w`` over the
@@ -51,7 +51,7 @@ def polar_value(a, cone, width, n, mu, g):
     return an + mu * np.sqrt(t2)
 
 
-@njit(cache=True)
+@kernel
 def polar_values(C, cone, first, width, n, mu, g, y):
     """:func:`polar_value` of every block for the functional ``a = C_b' y`` (the same formula
     for every route: see :mod:`qualgrasp.certify.cones`)."""
@@ -63,7 +63,7 @@ def polar_values(C, cone, first, width, n, mu, g, y):
     return out
 
 
-@njit(cache=True)
+@kernel
 def farkas_direction(C, cone, first, width, n, mu, g, y, rel):
     """The rule of :func:`qualgrasp.certify.closure.farkas_certificate`, compiled: ``(ok, y,
     tight)``.
@@ -135,7 +135,7 @@ def farkas_direction(C, cone, first, width, n, mu, g, y, rel):
     return True, out, tight
 
 
-@njit(cache=True)
+@kernel
 def squeeze_direction(C, cols):
     """The direction orthogonal to the columns ``cols`` of ``C`` (6, k) of two point contacts,
     and whether they span exactly 5 dimensions (smallest singular value at most ``1e-12``,

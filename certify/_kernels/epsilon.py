@@ -12,12 +12,13 @@ generators is the convex hull, in :mod:`qualgrasp.certify.quality`).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .jit import kernel
 
 __all__ = ["planar_epsilon_one", "planar_epsilon", "planar_edges", "linf_sweep", "support_rows"]
 
 
-@njit(cache=True)
+@kernel
 def _support_planar(Wb, owner, best, u0, u1, u2, linf):
     """Support function of the planar GWS at ``u``: per contact the largest ``u . g`` over its
     generators (at least 0), combined by max (L1) or sum (L-infinity). ``best`` is a work
@@ -35,7 +36,7 @@ def _support_planar(Wb, owner, best, u0, u1, u2, linf):
     return out
 
 
-@njit(cache=True)
+@kernel
 def planar_edges(Wb, owner):
     """Edge directions of the per-contact polytopes ``conv(0, generators of the contact)``: every
     generator, then the difference of every pair of generators of one contact (a superset of the
@@ -61,7 +62,7 @@ def planar_edges(Wb, owner):
     return E
 
 
-@njit(cache=True)
+@kernel
 def planar_epsilon_one(Wb, owner, m, linf):
     """Epsilon and direction of one planar grasp (see :func:`planar_epsilon`)."""
     k = Wb.shape[1]
@@ -96,7 +97,7 @@ def planar_epsilon_one(Wb, owner, m, linf):
     return best, arg
 
 
-@njit(cache=True)
+@kernel
 def _candidate(Wb, owner, work, linf, x0, x1, x2, y0, y1, y2, tiny, best, arg):
     """Evaluate the support function at both unit normals ``+-(x cross y)``; return the least
     value so far (``arg`` holds its direction)."""
@@ -115,7 +116,7 @@ def _candidate(Wb, owner, work, linf, x0, x1, x2, y0, y1, y2, tiny, best, arg):
     return best
 
 
-@njit(cache=True)
+@kernel
 def planar_epsilon(W, owner, m, linf):
     """Exact Ferrari-Canny epsilon of planar grasps (B, 3, k generators; ``owner`` maps
     generators to the ``m`` contacts, grasps in force closure): the minimum of the support
@@ -133,7 +134,7 @@ def planar_epsilon(W, owner, m, linf):
     return eps, arg
 
 
-@njit(cache=True)
+@kernel
 def support_rows(Wb, owner, m, U, linf):
     """Support function of the planar GWS (generators ``Wb`` (3, k)) at each row of ``U``."""
     work = np.empty(m)
@@ -143,7 +144,7 @@ def support_rows(Wb, owner, m, U, linf):
     return out
 
 
-@njit(cache=True)
+@kernel
 def _insert(top_val, top_u, val, u0, u1, u2):
     """Insert a candidate into the list of the best ones, sorted by value (ascending)."""
     K = top_val.shape[0]
@@ -158,14 +159,14 @@ def _insert(top_val, top_u, val, u0, u1, u2):
     top_u[i, 0], top_u[i, 1], top_u[i, 2] = u0, u1, u2
 
 
-@njit(cache=True)
+@kernel
 def _pseudo_angle(x, y):
     """A number in [0, 4) increasing with the angle of ``(x, y)`` (no trigonometry)."""
     p = x / (abs(x) + abs(y))
     return 3.0 + p if y < 0.0 else 1.0 - p
 
 
-@njit(cache=True)
+@kernel
 def _hull2(xs, ys, idx, n, out, delta):
     """Counter-clockwise convex hull (Andrew's monotone chain) of the ``n`` 2-D points
     ``(xs[idx[i]], ys[idx[i]])``; writes hull positions (into ``idx``) to ``out`` and returns
@@ -208,7 +209,7 @@ def _hull2(xs, ys, idx, n, out, delta):
     return max(h, 2) if n >= 2 else 1
 
 
-@njit(cache=True)
+@kernel
 def _turns_right(xs, ys, o, a, b):
     """Does ``o -> a -> b`` turn clockwise or go straight (within 1e-12 relative)?"""
     ax, ay = xs[a] - xs[o], ys[a] - ys[o]
@@ -217,7 +218,7 @@ def _turns_right(xs, ys, o, a, b):
     return cross <= 1e-12 * (abs(ax) + abs(ay)) * (abs(bx) + abs(by))
 
 
-@njit(cache=True)
+@kernel
 def linf_sweep(Wb, owner, m, E, first, last, top_val, top_u):
     """Candidate facet normals of the planar L-infinity GWS on the great circles orthogonal to
     the edges ``E[first:last]``, the best ones kept in ``top_val`` / ``top_u`` (updated).

@@ -8,7 +8,8 @@ the factor bounding the accumulated rounding of ``n`` operations.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .jit import kernel
 
 __all__ = ["U", "gamma", "solve_small", "lu_factor", "lu_solve", "lu_solve_t", "cholesky_solve",
            "pivot_basis_into", "pivot_basis", "inverse_norm_bound", "projection_bound", "cross_unit",
@@ -19,12 +20,12 @@ U = 2.0**-53
 ETA = 2.0**-1074
 
 
-@njit(cache=True)
+@kernel
 def gamma(n):
     return n * U / (1.0 - n * U)
 
 
-@njit(cache=True)
+@kernel
 def solve_small(A, b):
     """Solve ``A x = b`` by Gaussian elimination with partial pivoting (A is copied).
 
@@ -63,7 +64,7 @@ def solve_small(A, b):
     return x, det
 
 
-@njit(cache=True)
+@kernel
 def lu_factor(M, piv):
     """In-place LU factorisation with partial pivoting; returns the determinant (0 if singular)."""
     n = M.shape[0]
@@ -95,7 +96,7 @@ def lu_factor(M, piv):
     return det
 
 
-@njit(cache=True)
+@kernel
 def lu_solve(LU, piv, x):
     """Solve ``A x = b`` in place (``x`` holds ``b``) from :func:`lu_factor`'s factors of ``A``."""
     n = LU.shape[0]
@@ -117,7 +118,7 @@ def lu_solve(LU, piv, x):
         x[r] = s / LU[r, r]
 
 
-@njit(cache=True)
+@kernel
 def lu_solve_t(LU, piv, x):
     """Solve ``A' x = b`` in place from :func:`lu_factor`'s factors of ``A`` (``P A = L U``)."""
     n = LU.shape[0]
@@ -139,7 +140,7 @@ def lu_solve_t(LU, piv, x):
             x[p] = tmp
 
 
-@njit(cache=True)
+@kernel
 def cholesky_solve(H, rhs, out):
     """Solve ``H out = rhs`` for a symmetric positive definite ``H`` (d, d) in place of a copy;
     return False when ``H`` is not numerically positive definite."""
@@ -169,7 +170,7 @@ def cholesky_solve(H, rhs, out):
     return True
 
 
-@njit(cache=True)
+@kernel
 def pivot_basis_into(C, R, chosen, used):
     """:func:`pivot_basis` into ``chosen`` with work arrays ``R`` (d, k) and ``used`` (k,)."""
     d, k = C.shape
@@ -203,7 +204,7 @@ def pivot_basis_into(C, R, chosen, used):
                     R[i, j] -= acc * R[i, arg]
 
 
-@njit(cache=True)
+@kernel
 def pivot_basis(C):
     """Indices of ``d`` columns of ``C`` (d, k) chosen greedily as in QR with column pivoting:
     at each step the column with the largest norm orthogonal to those already chosen (first
@@ -214,7 +215,7 @@ def pivot_basis(C):
     return chosen
 
 
-@njit(cache=True)
+@kernel
 def inverse_norm_bound(M, EM):
     """Upper bound on ``norm_inf(M_exact^-1)`` for a square ``M_exact`` within ``EM`` of ``M``,
     from an approximate inverse ``R``: ``norm(I - R M_exact) <= alpha < 1`` gives
@@ -250,7 +251,7 @@ def inverse_norm_bound(M, EM):
     return rnorm * (1.0 + 4 * k * U) / (1.0 - alpha)
 
 
-@njit(cache=True)
+@kernel
 def projection_bound(C, E, y):
     """Upper bound on the norm of the exact projection of ``y`` onto the span of the exact
     columns (within ``E`` of ``C``, fewer columns than rows): ``|C' y| / sigma_min(C)``, with
@@ -283,7 +284,7 @@ def projection_bound(C, E, y):
     return gnorm / (np.sqrt(1.0 / inv) * (1.0 - 4 * U)) * (1.0 + 4 * U)
 
 
-@njit(cache=True)
+@kernel
 def cross_unit(a, b):
     y0 = a[1] * b[2] - a[2] * b[1]
     y1 = a[2] * b[0] - a[0] * b[2]
@@ -292,7 +293,7 @@ def cross_unit(a, b):
     return np.array([y0, y1, y2]) / nrm if nrm > 0.0 else np.zeros(3)
 
 
-@njit(cache=True)
+@kernel
 def null_direction(C):
     """A unit vector orthogonal to the columns of ``C`` (3, k <= 2): their cross product when
     they span a plane (to within 1e-12 relative), else the cross product of the longer column
@@ -313,7 +314,7 @@ def null_direction(C):
     return cross_unit(a, axis)
 
 
-@njit(cache=True)
+@kernel
 def thin(Wb):
     """Conservative test that ``Wb`` (3, k) may be numerically rank deficient:
     ``det(G) / trace(G)^3 < 1e-12`` for ``G = W W'``, true whenever ``sigma_min / sigma_max
@@ -333,7 +334,7 @@ def thin(Wb):
     return not (tr > 0.0 and det >= 1e-12 * tr * tr * tr)
 
 
-@njit(cache=True)
+@kernel
 def world_values(to_values, x):
     """Certificate values ``to_values @ x`` for a batch (B, ncert, nvar) x (B, nvar), summed in
     variable order: the per-grasp and columnar paths share it, so their values are identical."""

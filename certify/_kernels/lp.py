@@ -5,14 +5,14 @@ loop per grasp, and its closed form for planar wrenches (``d = 3``)."""
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import kernel
 from .linalg import lu_factor, lu_solve, lu_solve_t, solve_small
 
 __all__ = ["lp_enumerate", "lp_planar_one", "lp_planar"]
 
 
-@njit(cache=True)
+@kernel
 def lp_enumerate(W, combos, feas):
     """Min-weight LPs ``max t : W lam = 0, 1'lam = 1, lam >= t`` by basis enumeration.
 
@@ -130,7 +130,7 @@ def lp_enumerate(W, combos, feas):
     return t_out, lam_out, y_out, has_y
 
 
-@njit(cache=True)
+@kernel
 def lp_planar_one(Wb, combos, feas, dual_below, C, D, buf, lam, y):
     """:func:`lp_planar` for one generator matrix ``Wb`` (3, k); fills ``lam`` and ``y`` and
     returns ``(t, has_y)``. ``C``, ``D``, ``buf`` are work arrays (k, k, 3), (k, k) and
@@ -231,7 +231,7 @@ def lp_planar_one(Wb, combos, feas, dual_below, C, D, buf, lam, y):
     return best_t, has_y
 
 
-@njit(cache=True)
+@kernel
 def lp_planar(W, combos, feas, dual_below=np.inf):
     """:func:`lp_enumerate` for ``d = 3`` (planar wrenches) in closed form.
 

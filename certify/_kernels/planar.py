@@ -5,9 +5,9 @@ epsilon (:func:`planar_batch`, the columnar path of :mod:`qualgrasp.certify.fast
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from .epsilon import planar_epsilon_one
+from .jit import kernel
 from .linalg import ETA, U, gamma, null_direction, pivot_basis_into, thin
 from .lp import lp_planar_one
 from .recheck import verify_farkas_general, verify_interior_general, verify_null_general
@@ -19,7 +19,7 @@ __all__ = ["DUAL_BELOW", "planar_generators", "planar_batch"]
 DUAL_BELOW = 1e-3
 
 
-@njit(cache=True)
+@kernel
 def planar_generators(P, N, mu, width, c, L, owner, offset, friction, W, E):
     """Generator wrenches ``W`` (3, k) of one planar grasp, with the arithmetic of
     :func:`qualgrasp.certify.wrench.generator_columns` (same operations, same order, so the same
@@ -69,7 +69,7 @@ def planar_generators(P, N, mu, width, c, L, owner, offset, friction, W, E):
                    + gamma(4) * (abs(rx * fy) + abs(ry * fx)) + 4 * ETA) * (1.0 + 2 * U) / L + ETA
 
 
-@njit(cache=True)
+@kernel
 def _classify(Wb, Eb, combos, feas, margin, residual_tol, C, D, buf, R, used, lam, y, basis,
               rays, first, ones, zeros2, zeros1, no_tight):
     """Verdict of one planar generator matrix, settled only where the per-grasp rules of
@@ -111,7 +111,7 @@ def _classify(Wb, Eb, combos, feas, margin, residual_tol, C, D, buf, R, used, la
     return (2 if ok else 0), t
 
 
-@njit(cache=True)
+@kernel
 def planar_batch(P, N, mu, width, c, L, owner, offset, friction, combos, owner_f, offset_f,
                  friction_f, combos_f, form_same, margin, feas, residual_tol, quality):
     """Certify a batch of planar grasps sharing one contact pattern, in one compiled pass.

@@ -10,17 +10,17 @@ given as arrays ``(cone, first, width, n, mu, g)`` (:func:`qualgrasp.certify.pro
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from ..cones import RAY
 from .cones import polar_values
+from .jit import kernel
 from .linalg import U, gamma, inverse_norm_bound, pivot_basis_into, projection_bound
 
 __all__ = ["residual_bound", "correction_bound", "verify_interior_general", "verify_farkas_general",
            "verify_null_general", "certify_rows", "null_rows"]
 
 
-@njit(cache=True)
+@kernel
 def residual_bound(C, E, x):
     """Upper bound on ``max |C_exact x|`` (exact columns within ``E`` of ``C``) and scales."""
     d, k = C.shape
@@ -37,7 +37,7 @@ def residual_bound(C, E, x):
     return rmax, xsum, cmax
 
 
-@njit(cache=True)
+@kernel
 def correction_bound(C, E, basis, rmax):
     """Bound on ``max |C_B_exact^-1 r|`` for any exact residual ``|r| <= rmax`` (and a proof
     that ``C_B`` is invertible), from :func:`inverse_norm_bound` on the basis columns and their
@@ -55,7 +55,7 @@ def correction_bound(C, E, basis, rmax):
     return inv * rmax * (1.0 + 4 * d * U)
 
 
-@njit(cache=True)
+@kernel
 def verify_interior_general(C, E, cone, first, width, n, mu, g, x, basis, residual_tol):
     """Rigorous float proof that values ``x`` over certificate columns ``C`` (d, k) certify
     closure: exact residual bounded, basis invertible, exact correction bounded by ``delta``, and
@@ -102,7 +102,7 @@ def verify_interior_general(C, E, cone, first, width, n, mu, g, x, basis, residu
     return True
 
 
-@njit(cache=True)
+@kernel
 def verify_farkas_general(C, E, cone, first, width, n, mu, g, y, tight, shift):
     """Rigorous float proof that ``y``, moved by at most ``shift`` (the exact projection off the
     ``tight`` blocks, see :func:`~.linalg.projection_bound`), strictly separates every other
@@ -150,7 +150,7 @@ def verify_farkas_general(C, E, cone, first, width, n, mu, g, y, tight, shift):
     return True
 
 
-@njit(cache=True)
+@kernel
 def verify_null_general(C, E, y):
     """Rigorous float proof, for fewer columns than rows, that the exact projection of ``y``
     off the columns' span is within ``1e-6 |y|`` of ``y`` (so non-zero), as the exact checker
@@ -161,7 +161,7 @@ def verify_null_general(C, E, y):
     return projection_bound(C, E, y) <= 1e-6 * np.sqrt(ny) * (1.0 - 8 * U)
 
 
-@njit(cache=True)
+@kernel
 def certify_rows(C, E, cone, first, width, N, mu, g, values, y, closure, farkas, scale,
                  residual_tol):
     """Per row of a batch (B, d, k): for ``closure`` rows choose the basis and prove the
@@ -192,7 +192,7 @@ def certify_rows(C, E, cone, first, width, N, mu, g, values, y, closure, farkas,
     return code, basis
 
 
-@njit(cache=True)
+@kernel
 def null_rows(C, E, y):
     """:func:`verify_null_general` for every row of a batch: 3 where proved, else 0."""
     out = np.zeros(C.shape[0], dtype=np.int64)

@@ -11,12 +11,13 @@ caller holds whatever the order of the sums.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .jit import kernel
 
 __all__ = ["piece_bounds"]
 
 
-@njit(cache=True)
+@kernel
 def piece_bounds(Y, Q, N, contact, fm, ow, weights, cmask, cand, scale, cx, cy, L, gamma):
     """Lower bounds ``lb`` (B,) and the candidate giving each (``cand[b] >= 0``: that one only).
 

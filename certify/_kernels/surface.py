@@ -15,8 +15,8 @@ from __future__ import annotations
 from itertools import permutations
 
 import numpy as np
-from numba import njit
 
+from .jit import kernel
 from .linalg import U, gamma
 
 __all__ = ["face_bounds", "leibniz_tables", "planar_h_bounds", "cycle_code"]
@@ -30,7 +30,7 @@ def leibniz_tables(n: int) -> tuple[np.ndarray, np.ndarray]:
     return perms, signs
 
 
-@njit(cache=True)
+@kernel
 def face_bounds(V, EV, faces, perms, psign):
     """For every face (row of ``faces``, ``d`` vertex indices into ``V`` (nv, d)): whether its
     determinant ``det(v_1, ..., v_d)`` is proved positive, and rigorous lower and upper bounds
@@ -96,7 +96,7 @@ def face_bounds(V, EV, faces, perms, psign):
     return ok, lo, hi
 
 
-@njit(cache=True)
+@kernel
 def planar_h_bounds(W, EW, owner, m, u, linf):
     """Rigorous bounds ``(lo, hi)`` of ``h(u) / |u|`` for the exact generators within ``EW`` of
     ``W`` (3, k): per contact the largest ``u . g`` (at least 0), combined by max (L1) or sum
@@ -131,7 +131,7 @@ def planar_h_bounds(W, EW, owner, m, u, linf):
     return h_lo / r_hi * (1.0 - 2 * U), h_hi / r_lo * (1.0 + 2 * U)
 
 
-@njit(cache=True)
+@kernel
 def cycle_code(faces, nv):
     """Whether ``faces`` (F, d) on ``nv`` vertices form a closed oriented cycle: 0 yes; 1 an
     index out of range; 2 a face repeating a vertex; 3 a ridge not in exactly two faces; 4 two

@@ -1,0 +1,77 @@
+"""The installation: compiled kernels are cached in the user's cache directory, never inside the
+package (files there would outlive ``pip uninstall``), and the version has one source."""
+
+import os
+import subprocess
+import sys
+import tomllib
+from importlib.metadata import version
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+import qualgrasp
+from qualgrasp.cli import app
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = Path(qualgrasp.__file__).resolve().parent
+
+# A kernel compiled in a fresh interpreter (numba writes the cache when it compiles), then
+# numba's own setting printed: qualgrasp must leave it as the user had it.
+_COMPILE = """
+import numba
+from qualgrasp.certify._kernels.linalg import cross_unit
+import numpy as np
+cross_unit(np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
+print(repr(numba.config.CACHE_DIR))
+"""
+
+
+def _compile(tmp_path, **env):
+    """Compile a kernel in a fresh interpreter with ``env`` (HOME and XDG_CACHE_HOME in
+    ``tmp_path`` unless given, NUMBA_CACHE_DIR unset unless given); its stdout and the cache
+    files written inside the package meanwhile."""
+    base = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", "XDG_CACHE_HOME")}
+    base["HOME"] = str(tmp_path / "home")
+    base.update(env)
+    before = set((PACKAGE / "certify").rglob("*.nb[ic]"))
+    out = subprocess.run([sys.executable, "-c", _COMPILE], env=base, capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-3000:]
+    return out.stdout.strip(), set((PACKAGE / "certify").rglob("*.nb[ic]")) - before
+
+
+def test_kernels_are_cached_in_xdg_cache_home(tmp_path):
+    printed, in_package = _compile(tmp_path, XDG_CACHE_HOME=str(tmp_path / "xdg"))
+    assert list((tmp_path / "xdg" / "qualgrasp" / "numba").rglob("linalg.cross_unit-*.nbi"))
+    assert not in_package
+    assert printed == "''"  # numba's setting for the user's own code is left as it was
+
+
+def test_kernels_are_cached_in_home_cache_without_xdg(tmp_path):
+    _, in_package = _compile(tmp_path)
+    assert list((tmp_path / "home" / ".cache" / "qualgrasp" / "numba").rglob("linalg.cross_unit-*.nbi"))
+    assert not in_package
+
+
+def test_numba_cache_dir_is_honoured(tmp_path):
+    printed, in_package = _compile(tmp_path, NUMBA_CACHE_DIR=str(tmp_path / "mine"))
+    assert list((tmp_path / "mine").rglob("linalg.cross_unit-*.nbi"))
+    assert not list(tmp_path.joinpath("home").rglob("*.nbi")) and not in_package
+    assert printed == repr(str(tmp_path / "mine"))
+
+
+def test_no_writable_cache_dir_means_no_cache_and_kernels_still_run(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    printed, in_package = _compile(tmp_path, XDG_CACHE_HOME=str(blocker))  # XDG_CACHE_HOME/qualgrasp: not creatable
+    assert not in_package and not list(tmp_path.rglob("*.nbi"))
+
+
+def test_version_has_one_source():
+    expected = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
+    assert qualgrasp.__version__ == version("qualgrasp") == expected
+
+
+def test_version_option():
+    result = CliRunner().invoke(app, ["--version"])
+    assert result.exit_code == 0 and result.output == f"qualgrasp {qualgrasp.__version__}\n"
