@@ -53,8 +53,8 @@ import trimesh
 from .gripper import ParallelJaw, PointHand
 from .rays import RayCaster
 
-__all__ = ["TOLERANCE", "RESOLUTION", "Patch", "Outcome", "pad_grid", "jaw_contacts", "fingertip_contacts",
-           "REASONS"]
+__all__ = ["TOLERANCE", "RESOLUTION", "Patch", "Outcome", "pad_grid", "approach_collision", "jaw_contacts",
+           "fingertip_contacts", "REASONS"]
 
 #: Default penetration tolerance, m (a rubber pad's compliance).
 TOLERANCE = 5e-4
@@ -144,7 +144,7 @@ def _sweep_boxes(gripper: ParallelJaw, w: float) -> list[tuple[str, np.ndarray, 
             ("palm", np.array([[-half, half], [-gripper.palm_depth / 2, gripper.palm_depth / 2]]), -gripper.palm_offset)]
 
 
-def _approach_collision(mesh: trimesh.Trimesh, caster: RayCaster, T: np.ndarray, gripper: ParallelJaw,
+def approach_collision(mesh: trimesh.Trimesh, caster: RayCaster, T: np.ndarray, gripper: ParallelJaw,
                         w: float) -> str | None:
     """The part that meets the object while approaching, or None (module docstring, step 2)."""
     R, o = T[:3, :3], T[:3, 3]
@@ -229,7 +229,7 @@ def jaw_contacts(mesh: trimesh.Trimesh, gripper: ParallelJaw, poses: np.ndarray,
             out.append(Outcome(reason="too_narrow", message=f"opening {w:.4g} m is narrower than the gripper's "
                                                             f"smallest ({gripper.min_opening:g} m)"))
             continue
-        part = _approach_collision(mesh, caster, T, gripper, w)
+        part = approach_collision(mesh, caster, T, gripper, w)
         if part is not None:
             out.append(Outcome(reason="collision", message=f"the {part} meets the object while approaching"))
             continue
