@@ -293,15 +293,15 @@ def fingertip_contacts(mesh: trimesh.Trimesh, hand: PointHand, fingertips: np.nd
         direction /= length[:, None]
         hits = caster.first_hits(row, direction)
         reach = hits.hit & (hits.t <= hand.travel)
+        behind = hits.hit & (np.einsum("ij,ij->i", mesh.face_normals[hits.face], direction) > 0)
+        if behind.any():
+            out.append(Outcome(reason="collision",
+                               message=f"fingertip {int(np.flatnonzero(behind)[0])} starts inside the object"))
+            continue
         if not reach.all():
             i = int(np.flatnonzero(~reach)[0])
             out.append(Outcome(reason="no_contact", message=f"fingertip {i} meets nothing within its travel "
                                                             f"({hand.travel:g} m)"))
-            continue
-        behind = np.einsum("ij,ij->i", mesh.face_normals[hits.face], direction) > 0
-        if behind.any():
-            out.append(Outcome(reason="collision",
-                               message=f"fingertip {int(np.flatnonzero(behind)[0])} starts inside the object"))
             continue
         points = row + hits.t[:, None] * direction
         out.append(Outcome(tuple(Patch(p, 0.0 - mesh.face_normals[f], 0.0, 0.0, 0.0, p[None], float(t))

@@ -100,7 +100,8 @@ def sample_poses(mesh: trimesh.Trimesh, gripper: ParallelJaw, n: int, *, mu: flo
         phi = rng.uniform(0, half, len(pts))
         perp = np.array([_perpendicular(-v, rng) for v in n1])
         v = -n1 * np.cos(phi)[:, None] + perp * np.sin(phi)[:, None]
-        eps = 1e-6 * max(mesh.scale, 1e-3)
+        # start inside, past the numpy engine's acceptance of hits up to 1e-6 behind the origin
+        eps = max(1e-5, 1e-6 * mesh.scale)
         hits = caster.first_hits(pts + eps * v, v)
         for i in np.flatnonzero(hits.hit):
             n2, vi = mesh.face_normals[hits.face[i]], v[i]
