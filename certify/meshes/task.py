@@ -283,6 +283,9 @@ def least_grip(grasp: Grasp, mass: float, com: Sequence[float], direction: Seque
     s_star = 1.0 / theta
     lo, hi = s_star * (1 - _BRACKET), s_star * (1 + _BRACKET)
     slip = _slip(programs, w, theta, lo)
+    if slip is not None and sum(slip.lam) == 0:
+        # theta* is a rounding residue: the certificate separates the weight at every grip force
+        return GripBound(d, math.inf, math.inf, None, slip)
     programs.budget.value = hi
     forces = None
     if programs.solve(programs.interior) and programs.t.value is not None and programs.t.value > 0:
