@@ -1,0 +1,257 @@
+"""Command-line layer of :mod:`qualgrasp.certify.meshes`: ``qualgrasp contacts`` and
+``qualgrasp sample-poses``.
+
+``register(app)`` adds both commands to the ``qualgrasp`` application; each is a thin layer over
+:func:`contacts_file` and :func:`qualgrasp.certify.meshes.sampling.sample_poses`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+import typer
+from rich.console import Console
+from rich.markup import escape
+
+from ..checks import OptionError, number_in, output_file
+from ..errors import CertifyError
+from ..table import grasps_table, is_parquet
+from .contacts import RESOLUTION, TOLERANCE, fingertip_contacts, jaw_contacts
+from .errors import PoseError
+from .gripper import CONVENTIONS, ParallelJaw, builtin_grippers, load_gripper
+from .mesh import UNITS, load_mesh, mass_properties
+from .poses import contact_row, error_row, grasp_of, read_poses
+from .rays import ENGINES, RayCaster
+from .task import check_every_direction, check_holds, check_slips, every_direction, hold_verdict, least_grip
+
+__all__ = ["register", "contacts_file", "ContactsSummary", "write_rows"]
+
+console = Console(stderr=True)
+
+
+def _fail(message: str) -> None:
+    console.print("[red]error:[/red]", escape(message.replace("\n", "\\n")), soft_wrap=True)
+    raise typer.Exit(2)
+
+
+@dataclass
+class ContactsSummary:
+    """What :func:`contacts_file` did: rows with contacts, error rows by reason, hold verdicts."""
+
+    grasps: int = 0
+    errors: Counter = field(default_factory=Counter)
+    holds: Counter = field(default_factory=Counter)
+    repairs: tuple = ()
+
+
+def write_rows(path: Path, rows: list[dict], grasps: bool) -> None:
+    """Write rows as JSON Lines, or Parquet by extension (grasp rows: certify's grasp schema plus
+    the extra columns)."""
+    if not is_parquet(path):
+        with path.open("w", encoding="utf-8") as fh:
+            for row in rows:
+                fh.write(json.dumps(row, allow_nan=False) + "\n")
+        return
+    if not grasps:
+        pq.write_table(pa.Table.from_pylist(rows), path)
+        return
+    table = grasps_table(rows)
+    for key in dict.fromkeys(k for r in rows for k in r if k not in table.column_names):
+        table = table.append_column(key, pa.array([r.get(key) for r in rows]))
+    pq.write_table(table, path)
+
+
+def _parse_gravity(text: str) -> np.ndarray | None:
+    """``all`` (None) or one direction ``x,y,z`` (normalised)."""
+    if text == "all":
+        return None
+    try:
+        d = np.array([float(v) for v in text.split(",")])
+    except ValueError:
+        d = np.zeros(0)
+    if d.shape != (3,) or not np.isfinite(d).all() or np.linalg.norm(d) == 0:
+        raise OptionError(f"--gravity must be 'all' or a direction x,y,z (three numbers, not all 0), got {text!r}")
+    return d / np.linalg.norm(d)
+
+
+def _hold_fields(grasp, props, budget: float, gravity: np.ndarray | None, level: int) -> dict:
+    if gravity is None:
+        e = every_direction(grasp, props.mass, props.com, level=level)
+        ok = check_every_direction(grasp, props.mass, props.com, e)
+        lo, hi = e.lo, e.hi
+        cert = {"level": e.level, "radius": e.radius, "worst": e.worst.to_json(),
+                "vertices": [v.to_json() for v in e.vertices]}
+    else:
+        b = least_grip(grasp, props.mass, props.com, gravity)
+        ok = (math.isinf(b.hi) or check_holds(grasp, props.mass, props.com, gravity, b.hi * (1 + 1e-12), b.forces)) \
+            and (b.lo == 0 or check_slips(grasp, props.mass, props.com, b.direction, b.slip))
+        lo, hi, cert = b.lo, b.hi, b.to_json()
+    status = hold_verdict(lo, hi, budget)
+    return {"hold_status": status, "hold_budget": budget, "grip_lo": None if math.isinf(lo) else lo,
+            "grip_hi": None if math.isinf(hi) else hi,
+            "hold_verified": bool(ok), "hold_certificate": json.dumps(cert)}
+
+
+def contacts_file(mesh_path: Path, poses_path: Path, output: Path, *, gripper: str = "franka_panda",
+                  convention: str = "qualgrasp", units: str = "m", repair: bool = False, mu: float | None = None,
+                  model: str = "soft", tolerance: float = TOLERANCE, resolution: int = RESOLUTION,
+                  density: float | None = None, mass: float | None = None, engine: str = "auto",
+                  errors: Path | None = None, points: bool = True, hold: float | None = None,
+                  gravity: str = "all", level: int = 1) -> ContactsSummary:
+    """Contacts of every pose of a pose file on a mesh, written as a certify grasp set (and an
+    error file for the poses without contacts). See :mod:`qualgrasp.certify.meshes.poses`.
+
+    Raises
+    ------
+    CertifyError
+        An input or option is refused (the message names it); nothing is written then.
+    """
+    g = load_gripper(gripper)
+    if convention not in CONVENTIONS:
+        raise OptionError(f"--convention must be one of {', '.join(CONVENTIONS)}, got {convention!r}")
+    if model not in ("soft", "point"):
+        raise OptionError(f"--model must be soft or point, got {model!r}")
+    number_in(tolerance, "--tolerance", 0, 0.1, unit="m")
+    if not 2 <= resolution <= 200:
+        raise OptionError(f"--resolution must be between 2 and 200 cells per side, got {resolution}")
+    if mu is not None:
+        number_in(mu, "--mu", 0, 1e6)
+    if hold is not None:
+        number_in(hold, "--hold", 0, 1e9, unit="N", low_open=True)
+    grav = _parse_gravity(gravity)
+    output = output_file(output, "--output", reads=(mesh_path, poses_path))
+    errors = output_file(errors or output.with_name(output.name.split(".")[0] + ".errors.jsonl"), "--errors",
+                         reads=(mesh_path, poses_path, output))
+    mesh = load_mesh(mesh_path, units=units, repair=repair)
+    props = mass_properties(mesh, density=density, mass=mass)
+    caster = RayCaster(mesh, engine)
+    friction = g.mu if mu is None else mu
+    summary = ContactsSummary(repairs=mesh.metadata.get("repairs", ()))
+    rows, bad = [], []
+    for chunk in read_poses(poses_path, g, convention):
+        good = [r for r in chunk if r.error is None]
+        for r in chunk:
+            if r.error is not None:
+                bad.append(error_row(r, "bad_pose", r.error))
+        if isinstance(g, ParallelJaw):
+            outs = jaw_contacts(mesh, g, np.array([r.T for r in good]).reshape(-1, 4, 4),
+                                np.array([r.width for r in good]), tolerance=tolerance, resolution=resolution,
+                                caster=caster)
+        else:
+            outs = fingertip_contacts(mesh, g, np.array([r.fingertips for r in good]).reshape(-1, g.fingers, 3),
+                                      caster=caster)
+        for r, out in zip(good, outs):
+            if not out.ok:
+                bad.append(error_row(r, out.reason, out.message))
+                continue
+            grasp = grasp_of(out, friction, model if isinstance(g, ParallelJaw) else "point", props, r.id)
+            row = contact_row(r, out, grasp, g, props, points=points)
+            if hold is not None:
+                row.update(_hold_fields(grasp, props, hold, grav, level))
+                summary.holds[row["hold_status"]] += 1
+            rows.append(row)
+    summary.grasps = len(rows)
+    summary.errors = Counter(b["reason"] for b in bad)
+    write_rows(output, rows, grasps=True)
+    write_rows(errors, bad, grasps=False)
+    return summary
+
+
+def contacts_command(
+    mesh: Path = typer.Argument(..., help="Object mesh: OBJ, STL, PLY, GLB, OFF (closed, in --units)."),
+    poses: Path = typer.Argument(..., help="Poses: JSON Lines, Parquet, or an ACRONYM HDF5 file (needs h5py)."),
+    output: Path = typer.Option(..., "-o", "--output", help="Grasp set for 'qualgrasp certify': .jsonl or .parquet."),
+    gripper: str = typer.Option("franka_panda", help="Built-in gripper (" + ", ".join(builtin_grippers())
+                                + ") or a gripper file (.toml, .json)."),
+    convention: str = typer.Option("qualgrasp", help="Pose convention: " + ", ".join(CONVENTIONS) + "."),
+    units: str = typer.Option("m", help="Unit the mesh is drawn in: " + ", ".join(UNITS) + "."),
+    repair: bool = typer.Option(False, "--repair", help="Apply trimesh's standard repairs first (reported)."),
+    mu: float = typer.Option(None, help="Friction coefficient (default: the gripper file's)."),
+    model: str = typer.Option("soft", help="Contact model of the patches: soft (torsion from the patch) or point."),
+    tolerance: float = typer.Option(TOLERANCE, help="Penetration tolerance of the patches, m."),
+    resolution: int = typer.Option(RESOLUTION, help="Pad grid cells per side."),
+    density: float = typer.Option(None, help="Density, kg/m^3 (default 1000 unless --mass)."),
+    mass: float = typer.Option(None, help="Mass of the object, kg (instead of --density)."),
+    engine: str = typer.Option("auto", help="Ray engine: " + ", ".join(ENGINES) + " (auto: embree if installed)."),
+    errors: Path = typer.Option(None, help="Error rows file (default OUTPUT's name with .errors.jsonl)."),
+    points: bool = typer.Option(True, help="Write each patch's points."),
+    hold: float = typer.Option(None, help="Certify whether each grasp holds the object's weight with a grip force "
+                                          "of at most this many newtons."),
+    gravity: str = typer.Option("all", help="With --hold: 'all' (every direction) or one direction x,y,z "
+                                            "(object frame)."),
+    level: int = typer.Option(1, help="With --hold and --gravity all: icosphere level of the direction "
+                                      "polytope (0 to 4; bound gap 26, 7, 2, 0.5, 0.1 %)."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No summary."),
+) -> None:
+    """Close the gripper at every pose on the mesh and write the contacts as a certify grasp set.
+
+    Poses without contacts (colliding while approaching, a pad meeting nothing, wider than the
+    gripper opens, malformed) go to the error file with their reason. Exit code 1 when some pose
+    is an error row, 2 when an input or option is refused.
+    """
+    if not 0 <= level <= 4:
+        _fail(f"--level must be between 0 and 4, got {level}")
+    try:
+        summary = contacts_file(mesh, poses, output, gripper=gripper, convention=convention, units=units,
+                                repair=repair, mu=mu, model=model, tolerance=tolerance, resolution=resolution,
+                                density=density, mass=mass, engine=engine, errors=errors, points=points,
+                                hold=hold, gravity=gravity, level=level)
+    except (CertifyError, ImportError) as err:
+        _fail(str(err))
+    if not quiet:
+        for note in summary.repairs:
+            console.print(f"repaired: {note}")
+        console.print(f"{summary.grasps} grasps -> {output}")
+        for reason, count in sorted(summary.errors.items()):
+            console.print(f"{count} poses without contacts: {reason}")
+        for status, count in sorted(summary.holds.items()):
+            console.print(f"{count} grasps {status} at {hold:g} N")
+    if summary.errors:
+        raise typer.Exit(1)
+
+
+def sample_poses_command(
+    mesh: Path = typer.Argument(..., help="Object mesh: OBJ, STL, PLY, GLB, OFF (closed, in --units)."),
+    output: Path = typer.Option(..., "-o", "--output", help="Pose file to write: .jsonl or .parquet."),
+    gripper: str = typer.Option("franka_panda", help="Built-in parallel-jaw gripper or a gripper file."),
+    n: int = typer.Option(100, "-n", "--n", help="Number of poses."),
+    mu: float = typer.Option(None, help="Friction coefficient of the antipodal test (default: the gripper's)."),
+    units: str = typer.Option("m", help="Unit the mesh is drawn in: " + ", ".join(UNITS) + "."),
+    repair: bool = typer.Option(False, "--repair", help="Apply trimesh's standard repairs first (reported)."),
+    seed: int = typer.Option(0, help="Random seed."),
+    engine: str = typer.Option("auto", help="Ray engine: " + ", ".join(ENGINES) + "."),
+) -> None:
+    """Sample antipodal parallel-jaw poses on a mesh (qualgrasp convention), free of collisions
+    while approaching, ready for 'qualgrasp contacts'."""
+    from .sampling import sample_poses
+
+    try:
+        if n < 1 or n > 10_000_000:
+            raise OptionError(f"-n must be between 1 and 10000000 poses, got {n}")
+        out = output_file(output, "--output", reads=(mesh,))
+        g = load_gripper(gripper)
+        if not isinstance(g, ParallelJaw):
+            raise OptionError(f"--gripper {gripper} is not a parallel-jaw gripper")
+        if mu is not None:
+            number_in(mu, "--mu", 0, 1e6)
+        m = load_mesh(mesh, units=units, repair=repair)
+        poses = sample_poses(m, g, n, mu=g.mu if mu is None else mu, seed=seed, caster=RayCaster(m, engine))
+    except (CertifyError, ImportError, PoseError) as err:
+        _fail(str(err))
+    rows = [{"id": i, "pose": p.T.tolist(), "width": p.width} for i, p in enumerate(poses)]
+    write_rows(out, rows, grasps=False)
+    console.print(f"wrote {len(rows)} poses to {out}" + (f" (asked for {n}: the sampler found no more)"
+                                                        if len(rows) < n else ""))
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``contacts`` and ``sample-poses`` to the ``qualgrasp`` application."""
+    app.command("contacts")(contacts_command)
+    app.command("sample-poses")(sample_poses_command)
