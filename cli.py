@@ -11,6 +11,7 @@ import typer
 
 from qualgrasp import __version__
 from qualgrasp.certify import cli as certify_cli
+from qualgrasp.certify.meshes import cli as meshes_cli
 from qualgrasp.experiments import cli as experiments_cli
 from qualgrasp.qualitative import cli as qualitative_cli
 
@@ -34,6 +35,7 @@ def _options(version: bool = typer.Option(False, "--version", callback=_print_ve
 
 
 certify_cli.register(app)
+meshes_cli.register(app)
 qualitative_cli.register(app)
 experiments_cli.register(app)
 
