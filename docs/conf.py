@@ -27,12 +27,12 @@ release = version = metadata.version("qualgrasp")
 extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
-    "sphinx.ext.mathjax",
     "numpydoc",
     "sphinx_gallery.gen_gallery",
     "qualgrasp_docs",  # after autosummary: it adds to autosummary_context
 ]
 
+html_math_renderer = "mathml"  # qualgrasp_docs: MathML, no script from a CDN
 root_doc = "index"
 templates_path = ["_templates"]
 exclude_patterns = ["_build", "_templates", "gallery"]  # gallery/: sources of auto_examples/
@@ -46,7 +46,6 @@ autosummary_imported_members = False
 autosummary_context: dict = {}  # qualgrasp_docs adds "elsewhere": re-exported paths
 autodoc_typehints = "none"  # the numpydoc sections state every type, with units
 autodoc_member_order = "bysource"
-autodoc_default_options = {"show-inheritance": False}
 add_module_names = False
 python_display_short_literal_types = True
 
@@ -101,4 +100,6 @@ html_theme_options = {
     "footer_end": ["sphinx-version", "theme-version"],
 }
 html_context = {"default_mode": "light"}
+# single pages: no section navigation to show on the left
+html_sidebars = {page: [] for page in ("index", "getting-started", "formats", "cli")}
 html_show_sourcelink = False

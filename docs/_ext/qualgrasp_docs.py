@@ -8,6 +8,8 @@ columns and public names is read from the package itself, never copied by hand.
 * ``.. qualgrasp-columns:: DOTTED.NAME`` writes a table of a schema given as a sequence of
   objects with ``name``, ``type``, ``description`` and ``error`` (the results schema,
   ``qualgrasp.certify.results.COLUMNS``).
+* Math is written as MathML (``html_math_renderer = "mathml"``), which browsers render natively:
+  no MathJax from a CDN, so the pages also read right offline.
 * Public names: a function or class re-exported by several modules (``qualgrasp.verify`` is
   ``qualgrasp.certify.verify`` is ``qualgrasp.certify.certificates.verify``) gets one API page,
   under its shortest public name. :func:`public_names` finds, for every other path, that
@@ -110,6 +112,17 @@ def public_names(package: str = PACKAGE) -> dict[str, str]:
     return out
 
 
+def canonical_path(path: str, elsewhere: dict[str, str]) -> str | None:
+    """The documented path of ``path`` when it, or the class it is a member of, is re-exported
+    (``qualgrasp.certify.Certificate.from_json`` -> ``qualgrasp.Certificate.from_json``)."""
+    parts = path.split(".")
+    for cut in range(len(parts), 1, -1):
+        head = ".".join(parts[:cut])
+        if head in elsewhere:
+            return ".".join([elsewhere[head], *parts[cut:]])
+    return None
+
+
 def resolve_elsewhere(app: Sphinx, env, node, contnode):
     """``missing-reference``: a Python reference to a re-exported path resolves to its canonical
     page; one to a ``qualgrasp`` name that cannot be imported is a warning."""
@@ -123,12 +136,13 @@ def resolve_elsewhere(app: Sphinx, env, node, contnode):
         candidates = ([f"{module}.{cls}.{target}"] if cls else []) + [f"{module}.{target}", target]
     domain = env.get_domain("py")
     for candidate in candidates:
-        if candidate in elsewhere:
+        canonical = canonical_path(candidate, elsewhere)
+        if canonical is not None:
             new = node.deepcopy()
-            new["reftarget"] = elsewhere[candidate]
+            new["reftarget"] = canonical
             new["refspecific"] = False
             return domain.resolve_xref(env, node["refdoc"], app.builder, node["reftype"],
-                                       elsewhere[candidate], new, contnode)
+                                       canonical, new, contnode)
     if target.startswith(PACKAGE + "."):
         try:
             import_object(target)
@@ -139,6 +153,16 @@ def resolve_elsewhere(app: Sphinx, env, node, contnode):
 
 
 # -------------------------------------------------------------------------------- CLI reference
+
+_OPTION = re.compile(r"(?<![\w-])(--?[A-Za-z][\w-]*)")
+
+
+def help_markup(text: str) -> str:
+    """Help text as reStructuredText: literal, with option names (``--grasps``) as code, so
+    that no dash is turned into a typographic one."""
+    pieces = _OPTION.split(text)
+    return "".join(f"``{p}``" if k % 2 else escape(p) for k, p in enumerate(pieces))
+
 
 def _paragraphs(text: str) -> list[str]:
     """Help text as paragraphs (click's ``\\b`` no-rewrap markers dropped, lines joined)."""
@@ -154,7 +178,7 @@ def cli_lines(command, name: str, parent=None, depth: int = 0) -> list[str]:
     lines = [title, "=-~^"[min(depth, 3)] * len(title), ""] if depth else []
     lines += [".. code-block:: text", "", "   " + command.get_usage(ctx).strip(), ""]
     for paragraph in _paragraphs(command.help):
-        lines += [escape(paragraph), ""]
+        lines += [help_markup(paragraph), ""]
     records = []
     for param in command.get_params(ctx):
         if param.name == "help":  # every command has it; the page says so once
@@ -168,7 +192,7 @@ def cli_lines(command, name: str, parent=None, depth: int = 0) -> list[str]:
                   "   * - argument or option", "     - meaning"]
         for kind, (opts, help_text) in records:
             label = opts if kind == "option" else f"{opts} (argument)"
-            lines += [f"   * - ``{label}``", f"     - {escape(' '.join(help_text.split())) or '-'}"]
+            lines += [f"   * - ``{label}``", f"     - {help_markup(' '.join(help_text.split())) or '-'}"]
         lines.append("")
     if hasattr(command, "list_commands"):
         for sub in command.list_commands(ctx):
@@ -222,6 +246,32 @@ class ColumnsDirective(CliDirective):
         return self.parse(lines + [""])
 
 
+# -------------------------------------------------------------------------------- math
+
+def _mathml(translator, node, block: bool) -> None:
+    """Write ``node``'s LaTeX as MathML (docutils' converter): the browser renders it, with no
+    script and no network, so the pages read the same offline."""
+    from docutils.utils.math import latex2mathml
+
+    tex = node.astext()
+    try:
+        mathml = latex2mathml.tex2mathml(tex, as_block=block)
+    except Exception as err:  # the converter's errors have no common base class
+        logger.warning("cannot write %r as MathML: %s", tex, err, location=node,
+                       type="qualgrasp", subtype="math")
+        mathml = f"<code>{translator.encode(tex)}</code>"
+    translator.body.append(f'<div class="math">{mathml}</div>' if block else mathml)
+    raise nodes.SkipNode
+
+
+def visit_math(translator, node) -> None:
+    _mathml(translator, node, block=False)
+
+
+def visit_displaymath(translator, node) -> None:
+    _mathml(translator, node, block=True)
+
+
 # -------------------------------------------------------------------------------- setup
 
 def submodules(package: str = PACKAGE) -> dict[str, list[str]]:
@@ -247,4 +297,5 @@ def setup(app: Sphinx) -> dict[str, Any]:
     app.connect("missing-reference", resolve_elsewhere)
     app.add_directive("qualgrasp-cli", CliDirective)
     app.add_directive("qualgrasp-columns", ColumnsDirective)
+    app.add_html_math_renderer("mathml", (visit_math, None), (visit_displaymath, None))
     return {"parallel_read_safe": True, "parallel_write_safe": True, "version": "1"}

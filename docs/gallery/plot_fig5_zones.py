@@ -3,8 +3,9 @@ Figure 5: zones of freedom of a FormGrasp grasp
 ===============================================
 
 FormGrasp places four frictionless fingers one after the other. After each contact the zone of
-freedom shrinks: the centres of rotation still allowed clockwise (``Z-``) and counter-clockwise
-(``Z+``), and the translations still allowed. The grasp is in form closure when nothing is left
+freedom shrinks: the centres of rotation still allowed clockwise on screen (``Z+``, turning +x
+towards +y with y pointing down) and counter-clockwise (``Z-``), and the translations still
+allowed. The grasp is in form closure when nothing is left
 (Reuleaux's method, see :ref:`concept-synthesis`). The grasp shown is a synthesised one, and its
 certified margin comes from :func:`qualgrasp.certify_grasp`.
 """

@@ -22,12 +22,15 @@ from qualgrasp.experiments.study import compare
 out = Path(tempfile.mkdtemp(prefix="qualgrasp-study-"))
 result = compare(BUILTINS, out, settings="quick")
 
+
+def cell(value, spec=".3f"):
+    return "-" if value is None else format(value, spec)
+
+
 print(f"{len(result.objects)} objects in {result.seconds:.0f} s")
-print(f"{'route':<14} {'grasps':>6} {'eps best':>9} {'best/baseline':>14} {'robustness':>11} {'tolerance':>10}")
+print("route           grasps  eps best  best/baseline  robustness  tolerance")
 for r in result.routes:
-    def cell(value, spec=".3f"):
-        return "-" if value is None else format(value, spec)
-    print(f"{r.route:<14} {r.grasps:>6} {cell(r.eps_best):>9} {cell(r.ratio_best, '.2f'):>14} "
+    print(f"{r.route:<14} {r.grasps:>7} {cell(r.eps_best):>9} {cell(r.ratio_best, '.2f'):>14} "
           f"{cell(r.robustness):>11} {cell(r.delta_median):>10}")
 
 
