@@ -61,6 +61,7 @@ show("study-quality-time")
 # pose error (rotation, translation) or a shape error (noise, blur, segmentation threshold) of
 # the image they were planned on.
 show("study-robustness")
+# sphinx_gallery_thumbnail_number = 3
 
 # %%
 # Certified tolerance
