@@ -81,6 +81,7 @@ sphinx_gallery_conf = {
     "gallery_dirs": "auto_examples",
     "filename_pattern": r"/plot_",  # every script runs during the build
     "image_scrapers": ("matplotlib",),
+    "capture_repr": (),  # show what the scripts print, not the repr of a last expression
     "within_subsection_order": "FileNameSortKey",
     "remove_config_comments": True,
     "download_all_examples": False,

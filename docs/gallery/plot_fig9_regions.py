@@ -19,7 +19,7 @@ from qualgrasp.qualitative.objects import render
 
 image = render("polygon")
 synth = synthesize(image, fingers=3, mu=0.5, name="polygon")  # with certified tolerances
-print("median certified tolerance (fraction of the size):", synth.summary()["median_delta_fraction"])
+print(f"median certified tolerance: {synth.summary()['median_delta_fraction']:.3f} of the object's size")
 
 plt.rcParams.update(RC)  # the figures' own style, also when the gallery saves the picture
 plt.figure(fig9_regions(synth, image))  # the gallery shows the figures pyplot knows about
