@@ -213,8 +213,10 @@ class CliDirective(SphinxDirective):
         import typer.main
 
         spec = self.arguments[0] if self.arguments else "qualgrasp.cli:app"
-        module, _, attr = spec.partition(":")
-        app = getattr(importlib.import_module(module), attr)
+        try:
+            app = import_object(spec.replace(":", "."))
+        except ImportError as err:
+            raise self.error(f"qualgrasp-cli: cannot import the application {spec}: {err}") from None
         command = typer.main.get_command(app)
         lines = cli_lines(command, self.options.get("prog", PACKAGE))
         return self.parse(lines)
@@ -236,7 +238,10 @@ class ColumnsDirective(CliDirective):
     option_spec: dict = {}
 
     def run(self) -> list[nodes.Node]:
-        columns = import_object(self.arguments[0])
+        try:
+            columns = import_object(self.arguments[0])
+        except ImportError as err:
+            raise self.error(f"qualgrasp-columns: cannot import the schema: {err}") from None
         lines = [".. list-table::", "   :header-rows: 1", "   :widths: 18 20 47 15", "",
                  "   * - column", "     - type (Arrow)", "     - meaning", "     - in an error row"]
         for col in columns:
