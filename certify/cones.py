@@ -56,7 +56,7 @@ def inside(cone: str, v: Sequence, n: Sequence = (), mu=0, g=0) -> bool:
 
 
 def polar(cone: str, a: Sequence, n: Sequence = (), mu=0, g=0) -> bool:
-    """Is ``a`` (the functional ``y . w`` on the block's columns) in the cone's strict polar,
+    """Is ``a`` (the functional ``y @ w`` on the block's columns) in the cone's strict polar,
     ``a_n + mu norm((a_t, a_m g / |n|)) < 0``? Exact on Fractions (squared)."""
     if cone == "ray":
         return a[0] < 0

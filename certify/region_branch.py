@@ -304,7 +304,7 @@ def _piece_vertices(arcs: Geometry, arc: np.ndarray, s0, s1, t0, t1):
 
 def bounds(regions: RegionTuple, arcs: Geometry, model: _Model, contact, arc, face, box, s0, s1, t0, t1,
            Y: np.ndarray | None = None, cand: np.ndarray | None = None):
-    """Rigorous lower bounds, per item, of ``L max_g y . w_g`` over a cell and a piece.
+    """Rigorous lower bounds, per item, of ``L max_g y @ w_g`` over a cell and a piece.
 
     Items are ``(contact, arc, cell face, cell box, piece s0 s1 t0 t1)`` arrays of one length
     ``B``; ``Y`` (B, 4, 3) replaces the cell's corners (the analysis uses the centre direction);
@@ -624,7 +624,7 @@ def _certify_choice(regions: RegionTuple, cands, choice):
 def cells_certificate(cells, geo: Geometry) -> dict[str, Any]:
     """The JSON certificate of robustness: ``[face, lo0, hi0, lo1, hi1, contact, pieces]`` per
     covered cell (face index into :data:`FACES`, the cell's box on it), each piece
-    ``[j0, j1, s0, s1, t0, t1, candidate]``: arcs ``j0 .. j1 - 1`` of the contact's region,
+    ``[j0, j1, s0, s1, t0, t1, candidate]``: arcs ``j0`` to ``j1 - 1`` of the contact's region,
     the sub-box of a single arc's chord parameter and normal fraction, and the combination of
     generators (:func:`candidate_weights`) whose bound is positive."""
     out = []

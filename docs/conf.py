@@ -11,7 +11,6 @@ from their schema (``_ext/qualgrasp_docs.py``), and the gallery runs ``gallery/p
 
 from __future__ import annotations
 
-import logging
 import sys
 from importlib import metadata
 from pathlib import Path
@@ -55,25 +54,6 @@ numpydoc_xref_param_type = False  # type words such as "array of float" are pros
 numpydoc_attributes_as_param_list = True
 numpydoc_validation_checks: set = set()  # style is the test suite's business, not the build's
 
-
-class _SummaryCutInLiteral(logging.Filter):
-    """Drop docutils' "Inline literal start-string without end-string" when it comes from an
-    autosummary table's one-line summary, and only then.
-
-    Why: autosummary cuts a summary at the first ". " even inside an inline literal (Sphinx 9.0
-    parses the whole paragraph, not the cut, when it checks the cut), and four first sentences
-    contain ``y . w``: qualgrasp.certify.cones.polar, qualgrasp.certify.evidence.planar_support_choice,
-    qualgrasp.certify.region_branch.cells_certificate and qualgrasp.certify.region_branch.bounds.
-    The pages of those functions render correctly; only their summary line in the module's table
-    is cut short. Remove this filter once those docstrings write the dot product without ". ".
-    """
-
-    def filter(self, record: logging.LogRecord) -> bool:
-        return not (str(record.msg).startswith("Inline literal start-string without end-string")
-                    and "<autosummary>" in str(getattr(record, "location", "")))
-
-
-logging.getLogger("sphinx.sphinx.util.docutils").addFilter(_SummaryCutInLiteral())
 
 # -- gallery ------------------------------------------------------------------------------------
 sphinx_gallery_conf = {
