@@ -12,6 +12,7 @@ __all__ = [
     "GraspFileError",
     "CertificateError",
     "SolverError",
+    "OptionError",
 ]
 
 
@@ -33,3 +34,7 @@ class CertificateError(CertifyError, ValueError):
 
 class SolverError(CertifyError, RuntimeError):
     """A convex solver failed to return a usable answer."""
+
+
+class OptionError(CertifyError, ValueError):
+    """A command-line option or path is unusable (the message names the flag)."""
