@@ -132,7 +132,7 @@ def verify_command(
     console.print(f"{checked} certified rows re-checked, {summary.errors} error rows skipped, "
                   f"{len(summary.failures)} failed"
                   + (f"; {missing} of the {summary.grasps} grasps have no results row (a subset: not a failure)"
-                     if missing else ""))
+                     if missing else ""), soft_wrap=True)
     if summary.failures:
         raise typer.Exit(1)
 
