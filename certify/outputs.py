@@ -31,7 +31,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Iterable, Iterator
 
-from .errors import OptionError
+from .errors import OptionError, WriteError
 
 __all__ = ["same_file", "inside", "check_output", "check_name_length", "OutputLock", "lock_output",
            "temporary_name", "atomic_output", "write_lines", "write_error", "file_kind", "writable_folder"]
@@ -103,7 +103,8 @@ def check_name_length(path: str | Path, flag: str, *, companions: Iterable[str |
     OptionError
         Naming the flag, the name's length and the limit.
     """
-    for p in (Path(path), *map(Path, companions)):
+    out = Path(path)
+    for p in (out, *map(Path, companions)):
         folder = _folder(p)
         try:
             limit = os.pathconf(folder if folder.exists() else ".", "PC_NAME_MAX")
@@ -111,8 +112,9 @@ def check_name_length(path: str | Path, flag: str, *, companions: Iterable[str |
             limit = 255
         size = len(os.fsencode(p.name))
         if size > limit:
-            what = "its name" if p == Path(path) else f"the name of its companion {p.name[-12:]}"
-            raise OptionError(f"{flag}: the output's name is too long: {what} has {size} bytes, at most "
+            tail = p.name[len(out.name):] if p != out and p.name.startswith(out.name) else ""
+            what = f"its companion NAME{tail} would have" if p != out else "it has"
+            raise OptionError(f"{flag}: the output's name is too long: {what} {size} bytes, at most "
                               f"{limit} in {folder}; choose a shorter name")
 
 
@@ -272,15 +274,17 @@ def lock_output(path: str | Path, flag: str) -> OutputLock:
         if not same:  # unlinked by its previous owner after we opened it: try again
             os.close(fd)
             continue
-        if created:
-            os.write(fd, _LOCK_MARK + f"pid {os.getpid()}\noutput {os.path.abspath(path)}\n".encode(errors="replace"))
-        else:
-            head = os.pread(fd, len(_LOCK_MARK), 0)
+        if not created:
+            head = os.pread(fd, len(_LOCK_MARK), 0) if stat.S_ISREG(os.fstat(fd).st_mode) else b"?"
             if head != _LOCK_MARK and head:
                 os.close(fd)
                 raise OptionError(f"{flag}: {lock} exists and was not written by qualgrasp; move it away")
+        try:  # who holds the lock, for a person looking; a full disk leaves it empty, still a lock
             os.ftruncate(fd, 0)
-            os.pwrite(fd, _LOCK_MARK + f"pid {os.getpid()}\noutput {os.path.abspath(path)}\n".encode(errors="replace"), 0)
+            os.pwrite(fd, _LOCK_MARK + f"pid {os.getpid()}\noutput {os.path.abspath(path)}\n".encode(
+                errors="replace"), 0)
+        except OSError:
+            pass
         return OutputLock(path, lock, fd)
     raise OptionError(f"{flag}: cannot lock {path}: its lock file keeps changing")
 
@@ -308,8 +312,9 @@ def write_error(target: str | Path, err: OSError) -> str:
 def atomic_output(path: str | Path, flag: str = "-o", *, reads: Iterable[str | Path] = ()) -> Iterator[Path]:
     """Write ``path`` safely: check it (:func:`check_output`), lock it (:func:`lock_output`) and
     give a fresh temporary path to write; renamed over ``path`` when the block ends normally,
-    removed otherwise. An ``OSError`` in the block (full disk, file-size limit, ...) becomes an
-    :class:`OptionError` naming ``flag``.
+    removed otherwise. An ``OSError`` in the block (full disk, file-size limit, ...) becomes a
+    :class:`qualgrasp.certify.errors.WriteError` naming ``flag`` (an :class:`OptionError` and an
+    ``OSError``).
 
     Examples
     --------
@@ -330,7 +335,9 @@ def atomic_output(path: str | Path, flag: str = "-o", *, reads: Iterable[str | P
                 check_output(path, flag, reads=reads)  # nothing put in its place meanwhile
                 os.replace(tmp, path)
             except OSError as err:
-                raise OptionError(f"{flag}: {write_error(path, err)}") from None
+                reason = write_error(path, err)
+                raise WriteError(f"{flag}: {reason}", getattr(err, "errno", None),
+                                 reason.split(": ", 1)[-1]) from None
         finally:
             try:
                 tmp.unlink()

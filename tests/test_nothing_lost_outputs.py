@@ -21,10 +21,8 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from qualgrasp.certify.checks import input_file, output_file, output_folder
-from qualgrasp.certify.errors import OptionError
+from qualgrasp.certify.checks import OptionError, output_file, output_folder
 from qualgrasp.certify.io import write_grasps
-from qualgrasp.certify.outputs import atomic_output, lock_output, write_lines
 from qualgrasp.certify.samples import random_grasps, textbook_grasps
 from qualgrasp.cli import app
 
@@ -183,6 +181,13 @@ def test_certify_output_linked_to_the_input_is_refused(folder, link):
     assert_kept(before, snapshot(folder))
 
 
+def lock_output(path, flag):
+    """A run in progress on ``path`` (the lock it holds)."""
+    from qualgrasp.certify.outputs import lock_output
+
+    return lock_output(path, flag)
+
+
 def test_certify_refuses_a_second_run_on_the_same_output(folder):
     out = folder / "R.jsonl"
     with lock_output(out, "-o"):  # a run in progress
@@ -218,11 +223,13 @@ def test_two_concurrent_runs_end_and_the_output_is_whole(folder):
     assert sorted(p.name for p in folder.iterdir()) == ["R.jsonl", "g.jsonl", "r.jsonl"]
 
 
-def test_certify_name_too_long_for_its_parts_is_refused_before_any_work(folder):
-    out = folder / ("x" * 250 + ".jsonl")
+@pytest.mark.parametrize("length, what", [(244, "NAME.parts"), (250, "it has 256 bytes")])
+def test_certify_name_too_long_for_its_parts_is_refused_before_any_work(folder, length, what):
+    out = folder / ("x" * length + ".jsonl")
     before = snapshot(folder)
     code, text = invoke(*CERTIFY, folder / "g.jsonl", "-o", out)
-    assert code == 2 and "too long" in one_error_line(text)
+    line = one_error_line(text)
+    assert code == 2 and "too long" in line and what in line, line
     assert_kept(before, snapshot(folder))
 
 
@@ -315,6 +322,8 @@ def test_write_grasps_refuses_a_fifo_and_an_input(folder):
 # -- the mechanism other commands call (independent-regions, synthesize --plot, figures --out) ----
 
 def test_atomic_output_refuses_an_input_image_through_any_link(folder):
+    from qualgrasp.certify.outputs import atomic_output
+
     image = folder / "obj.png"
     image.write_bytes(b"\x89PNG not really")
     (folder / "hard.png").hardlink_to(image)
@@ -328,6 +337,8 @@ def test_atomic_output_refuses_an_input_image_through_any_link(folder):
 
 
 def test_a_failed_write_keeps_the_old_output_whole(folder):
+    from qualgrasp.certify.outputs import write_lines
+
     out = folder / "o.jsonl"
     write_lines(out, [{"id": 1}, {"id": 2}])
 
@@ -343,6 +354,8 @@ def test_a_failed_write_keeps_the_old_output_whole(folder):
 
 
 def test_output_folder_refuses_an_input_folder_and_output_file_a_fifo(folder):
+    from qualgrasp.certify.checks import input_file
+
     with pytest.raises(OptionError, match="input"):
         output_folder(folder, "--out", reads=[folder / "g.jsonl"])
     os.mkfifo(folder / "fig.png")
@@ -358,4 +371,28 @@ def test_verify_writes_nothing(folder):
     before = snapshot(folder)
     code, text = invoke("verify", out, "--grasps", folder / "g.jsonl", "--workers", "1")
     assert code == 0, text
+    assert_kept(before, snapshot(folder))
+
+
+def test_a_write_error_is_one_line_and_an_oserror_keeping_the_old_output(folder):
+    """Callers that catch OSError (synthesize -o, --plot) and callers that catch CertifyError
+    both see a failed write; the old output stays whole and no temporary is left."""
+    import errno
+
+    from qualgrasp.certify.errors import CertifyError
+    from qualgrasp.certify.outputs import write_lines
+
+    out = folder / "o.jsonl"
+    write_lines(out, [{"id": 1}])
+
+    def rows():
+        yield {"id": 2}
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    before = snapshot(folder)
+    with pytest.raises(OSError) as caught:
+        write_lines(out, rows())
+    assert isinstance(caught.value, CertifyError) and caught.value.errno == errno.ENOSPC
+    assert str(caught.value) == f"-o: cannot write {out}: the disk is full"
+    assert caught.value.strerror == "the disk is full"
     assert_kept(before, snapshot(folder))
