@@ -7,12 +7,16 @@ its unit), never after minutes of work and never as a traceback. Each raises
 
 Rules
 -----
-* An output file is not a folder, not a file the run reads (the input is never overwritten), has
-  a suffix the writer knows when the format comes from the suffix (a figure without ``.png`` is
-  refused, not silently renamed), and lives in a folder that exists or can be created and can be
-  written; the folder is created.
+* An output file is not a folder, not an existing FIFO, device or socket, not a file the run
+  reads (by inode, through symbolic and hard links: the input is never overwritten), has a suffix
+  the writer knows when the format comes from the suffix (a figure without ``.png`` is refused,
+  not silently renamed), a name its folder allows, and lives in a folder that exists or can be
+  created and can be written; the folder is created. How it is then written (a temporary name, a
+  lock, a rename) is :mod:`qualgrasp.certify.outputs`.
 * An output folder is a folder or does not exist yet (it is created); an existing file there is
-  refused.
+  refused, and so is an input folder of the run.
+* An input file is a regular file (a FIFO or ``/dev/zero`` is refused, never read), within its
+  size limit.
 * Numbers are finite and inside their documented range.
 """
 
@@ -20,35 +24,28 @@ from __future__ import annotations
 
 import math
 import os
+import stat
 from pathlib import Path
 from typing import Iterable
 
-from .errors import CertifyError
+from .errors import OptionError
+from .outputs import check_name_length, check_output, file_kind, inside, same_file, writable_folder
 
-__all__ = ["OptionError", "FIGURE_SUFFIXES", "output_file", "output_folder", "number_in", "count_in"]
+__all__ = ["OptionError", "FIGURE_SUFFIXES", "output_file", "output_folder", "input_file", "number_in",
+           "count_in", "optional_number_in"]
 
 #: Suffixes a figure may be saved with (matplotlib's writers).
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".tif", ".tiff", ".eps", ".ps", ".webp")
 
 
-class OptionError(CertifyError, ValueError):
-    """A command-line option or path is unusable (the message names the flag)."""
-
-
-def _writable_folder(folder: Path, flag: str) -> None:
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except FileExistsError:
-        raise OptionError(f"{flag}: {folder} exists and is not a folder") from None
-    except OSError as err:
-        raise OptionError(f"{flag}: cannot create the folder {folder} ({err.strerror or err})") from None
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise OptionError(f"{flag}: cannot write into {folder}")
-
-
 def output_file(path: str | Path, flag: str, *, suffixes: Iterable[str] | None = None,
                 reads: Iterable[str | Path] = ()) -> Path:
     """Check (and prepare the folder of) an output file; return it as a :class:`~pathlib.Path`.
+
+    The rules of :func:`qualgrasp.certify.outputs.check_output`: not a folder, not an existing
+    FIFO, device or socket, not an input (by inode: symbolic and hard links are seen through), a
+    name the folder allows, a folder that can be created and written. Write the file itself with
+    :func:`qualgrasp.certify.outputs.atomic_output` (temporary name, lock, rename).
 
     Parameters
     ----------
@@ -72,7 +69,7 @@ def output_file(path: str | Path, flag: str, *, suffixes: Iterable[str] | None =
     >>> output_file("figure", "--plot", suffixes=(".png", ".pdf"))
     Traceback (most recent call last):
     ...
-    qualgrasp.certify.checks.OptionError: --plot: figure has no suffix: give one of .png, .pdf
+    qualgrasp.certify.errors.OptionError: --plot: figure has no suffix: give one of .png, .pdf
     """
     path = Path(path)
     if path.is_dir():
@@ -83,23 +80,21 @@ def output_file(path: str | Path, flag: str, *, suffixes: Iterable[str] | None =
             raise OptionError(f"{flag}: {path} has no suffix: give one of {', '.join(allowed)}")
         if path.suffix.lower() not in allowed:
             raise OptionError(f"{flag}: cannot write {path.suffix} files; give one of {', '.join(allowed)}")
-    for other in reads:
-        other = Path(other)
-        if path.exists() and other.exists() and os.path.samefile(path, other):
-            raise OptionError(f"{flag}: {path} is an input of this run; the input is never overwritten")
-    if path.exists() and not path.is_file():
-        raise OptionError(f"{flag}: {path} is not a regular file")
-    _writable_folder(path.parent, flag)
-    return path
+    return check_output(path, flag, reads=reads)
 
 
-def output_folder(path: str | Path, flag: str) -> Path:
+def output_folder(path: str | Path, flag: str, *, reads: Iterable[str | Path] = ()) -> Path:
     """Check (and create) an output folder; return it.
+
+    Refused: an existing path that is not a folder (a file, a FIFO, a device; symbolic links
+    followed), a folder that is one of ``reads`` (an input folder or file of the run), holds one
+    of them, or cannot be created or written. Write each file in it with
+    :func:`qualgrasp.certify.outputs.atomic_output`.
 
     Raises
     ------
     OptionError
-        ``path`` exists and is not a folder, or cannot be created or written.
+        Naming ``flag`` and the problem.
 
     Examples
     --------
@@ -112,7 +107,45 @@ def output_folder(path: str | Path, flag: str) -> Path:
     path = Path(path)
     if path.exists() and not path.is_dir():
         raise OptionError(f"{flag}: {path} exists and is not a folder")
-    _writable_folder(path, flag)
+    for other in reads:
+        if same_file(path, other) or inside(other, path):
+            raise OptionError(f"{flag}: {path} is (or holds) an input of this run ({other}); give another folder")
+    check_name_length(path, flag)
+    writable_folder(path, flag)
+    return path
+
+
+def input_file(path: str | Path, flag: str, *, max_bytes: int | None = None) -> Path:
+    """Check an input file before reading it: it exists, is a regular file (a FIFO or a device
+    such as ``/dev/zero`` would block or never end), can be opened, and holds at most
+    ``max_bytes`` bytes when given; return it.
+
+    Raises
+    ------
+    OptionError
+        Naming ``flag`` and the problem.
+
+    Examples
+    --------
+    >>> from qualgrasp.certify.checks import input_file
+    >>> input_file("/dev/zero", "TRACE")
+    Traceback (most recent call last):
+    ...
+    qualgrasp.certify.errors.OptionError: TRACE: /dev/zero is a device, not a regular file
+    """
+    path = Path(path)
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise OptionError(f"{flag}: {path}: no such file") from None
+    except OSError as err:
+        raise OptionError(f"{flag}: cannot read {path} ({err.strerror or err})") from None
+    if not stat.S_ISREG(st.st_mode):
+        raise OptionError(f"{flag}: {path} is {file_kind(st.st_mode)}, not a regular file")
+    if max_bytes is not None and st.st_size > max_bytes:
+        raise OptionError(f"{flag}: {path} has {st.st_size:,} bytes, more than the limit of {max_bytes:,}")
+    if not os.access(path, os.R_OK):
+        raise OptionError(f"{flag}: cannot read {path} (permission denied)")
     return path
 
 
@@ -153,3 +186,23 @@ def count_in(value: int, flag: str, low: int, high: int | None = None, *, what: 
         span = f"at least {low}" if high is None else f"between {low} and {high}"
         raise OptionError(f"{flag} must be {span}{' ' + what if what else ''}, got {value}")
     return value
+
+
+def optional_number_in(value: float | None, flag: str, low: float, high: float, *, unit: str = "",
+                       low_open: bool = False, high_open: bool = False) -> float | None:
+    """None for an option not given, else :func:`number_in`'s check (``--tol`` with a default
+    computed later, say).
+
+    Examples
+    --------
+    >>> from qualgrasp.certify.checks import optional_number_in
+    >>> optional_number_in(None, "--tol", 0, 1, low_open=True) is None
+    True
+    >>> optional_number_in(0.0, "--tol", 0, 1, low_open=True, unit="pixels")
+    Traceback (most recent call last):
+    ...
+    qualgrasp.certify.errors.OptionError: --tol must be a finite number > 0 and <= 1 pixels, got 0
+    """
+    if value is None:
+        return None
+    return number_in(value, flag, low, high, unit=unit, low_open=low_open, high_open=high_open)

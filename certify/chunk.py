@@ -28,17 +28,17 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from .certificates import Tolerances
-from .columns import GraspColumns, grasp_columns, value_columns
+from .columns import GraspColumns, extra_columns, grasp_columns, value_columns
 from .errors import CertifyError, GraspFileError
 from .fastpath import certify_table
 from .recheck import recheck_table, schema_matches
 from .report import certify_grasp, verify_row
-from .results import NAMES, carried_name, error_row
+from .results import NAMES, carried_clash, carried_name, error_row
 from .solvers import make_solver
-from .table import Chunk, chunk_values, table_to_rows
+from .table import Chunk, chunk_values, column_problem, table_to_rows
 
 __all__ = ["Options", "Quality", "certify_rows", "certify_values", "certify_chunk_results", "certify_arrow",
-           "verify_rows", "verify_chunk", "status_counts"]
+           "verify_rows", "verify_chunk", "status_counts", "STATUSES"]
 
 
 @dataclass(frozen=True)
@@ -84,6 +84,9 @@ def _carried(meta: dict | None) -> tuple[dict, str | None]:
     cannot be written back as JSON (NaN, nested too deeply), if any."""
     if not meta:
         return {}, None
+    clash = carried_clash(list(meta))
+    if clash:
+        return {}, f"cannot carry the extra fields to the results: {clash}"
     out = {}
     for key, value in meta.items():
         try:
@@ -167,16 +170,20 @@ def certify_arrow(data: Any, options: Options = Options(), tol: Tolerances = Tol
             data = pa.table(data)
         except (TypeError, ValueError, pa.ArrowException) as err:
             raise GraspFileError(f"cannot read the data as an Arrow table: {err}") from None
+    problem = column_problem(data.column_names) or carried_clash(extra_columns(data))
+    if problem:
+        raise GraspFileError(f"cannot certify the data: {problem}")
     return _certify_arrow_rows(data, range(1, data.num_rows + 1), options, tol)
 
 
-_STATUSES = ("closure", "no_closure", "degenerate", "error")
+STATUSES = ("closure", "no_closure", "degenerate", "error")
+"""The statuses of a results row."""
 
 
 def _status_of(row: Any) -> str:
     """The status a row states, for the counts (``malformed`` when it is not one of them)."""
     status = row.get("status") if isinstance(row, dict) else None
-    return status if isinstance(status, str) and status in _STATUSES else "malformed"
+    return status if isinstance(status, str) and status in STATUSES else "malformed"
 
 
 def _id_text(gid: Any) -> Any:
@@ -194,16 +201,20 @@ def _same_id(stated: Any, gid: Any) -> bool:
 
 
 def _verify_one(cols: GraspColumns, i: int, line: int, row: Any, tol: Tolerances) -> tuple[str, tuple | None]:
-    """Re-check the results ``row`` of grasp ``i``: ``(status, failure or None)``; never
-    raises on a malformed row."""
+    """Re-check the results ``row`` of grasp ``i``: ``(status, failure or None)``, the failure
+    ``(the row's own id, reason naming its line)``; never raises on a malformed row."""
     status = _status_of(row)
-    gid = cols.id_of(i)
+    own = row.get("id") if isinstance(row, dict) else None
     try:
-        return status, _failure(cols, i, line, row, tol, gid)
+        failure = _failure(cols, i, line, row, tol, cols.id_of(i))
     except RecursionError:
-        return status, (gid, "malformed row (too deeply nested)")
+        failure = (None, "malformed row (too deeply nested)")
     except Exception as err:  # a last resort: a malformed row is a failure, never a traceback
-        return status, (gid, f"malformed row ({type(err).__name__})")
+        failure = (None, f"malformed row ({type(err).__name__})")
+    if failure is None:
+        return status, None
+    reason = failure[1]
+    return status, (own, reason if reason.startswith(f"line {line}") else f"line {line}: {reason}")
 
 
 def _failure(cols: GraspColumns, i: int, line: int, row: Any, tol: Tolerances, gid: Any):
@@ -306,7 +317,7 @@ def verify_rows(cols: GraspColumns, rows: Sequence[int], lines: Sequence[int], r
         if failure:
             failures.append(failure)
         if quality is not None:
-            _note_quality(quality, row, cols.id_of(i))
+            _note_quality(quality, row, row.get("id") if isinstance(row, dict) else None)
     return statuses, failures
 
 
@@ -334,7 +345,7 @@ def verify_chunk(chunk: Chunk, results, tol: Tolerances = Tolerances()) -> tuple
         has_eps = np.asarray(results.column("eps_l1_hi").is_valid().to_numpy(zero_copy_only=False), dtype=bool)
         for mask, flag in ((rows & has_eps, True), (rows & ~has_eps, False)):
             idx = np.flatnonzero(mask)
-            quality.add_many(len(idx), [cols.id_of(int(i)) for i in idx[:100]], flag)
+            quality.add_many(len(idx), results.column("id").take(pa.array(idx[:100])).to_pylist(), flag)
         return status_counts(results.column("status"))[0], failures, quality
     if isinstance(results, pa.Table):
         results = table_to_rows(results)

@@ -128,8 +128,11 @@ def verify_command(
     for gid, reason in summary.failures:
         typer.echo(_printable(f"{gid}\t{reason}"))
     checked = summary.rows - summary.errors
+    missing = getattr(summary, "missing", 0)
     console.print(f"{checked} certified rows re-checked, {summary.errors} error rows skipped, "
-                  f"{len(summary.failures)} failed")
+                  f"{len(summary.failures)} failed"
+                  + (f"; {missing} of the {summary.grasps} grasps have no results row (a subset: not a failure)"
+                     if missing else ""), soft_wrap=True)
     if summary.failures:
         raise typer.Exit(1)
 
@@ -147,10 +150,9 @@ def certify_regions_command(
     Farkas certificate), undecided or error, the certificate, and whether it re-checked. Exit
     code 1 when some rows are errors or failed their own re-check, 2 when the run cannot start.
     """
-    try:  # for the progress bar only: the reader reports what is wrong with the file
-        total = sum(1 for line in regions.open("rb") if line.strip()) if regions.is_file() else None
-    except OSError:
-        total = None
+    if budget < 1:
+        _fail(f"--budget must be at least 1 work unit per tuple, got {budget}")
+    total = count_grasps(regions)  # for the progress bar only: the reader says what is wrong
     with Progress(TextColumn("regions"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
                   console=console, disable=quiet) as bar:
         task = bar.add_task("regions", total=total)
@@ -227,11 +229,10 @@ def sample_command(
     if dim not in models.get(model).dims:
         _fail(f"--model {model} exists in {' and '.join(map(str, models.get(model).dims))} dimensions only, "
               f"not with --dim {dim}")
-    if output.is_dir():
-        _fail(f"the output {output} is a folder; give a file name (.jsonl or .parquet)")
-    output.parent.mkdir(parents=True, exist_ok=True)
-
-    count = write_random_grasp_file(output, n, seed=seed, dim=dim, n_contacts=contacts, model=model)
+    try:
+        count = write_random_grasp_file(output, n, seed=seed, dim=dim, n_contacts=contacts, model=model)
+    except CertifyError as err:
+        _fail(str(err))
     console.print(f"wrote {count} grasps to {output}")
 
 

@@ -3,27 +3,36 @@
 The input is read in chunks of a fixed number of grasps (:func:`qualgrasp.certify.table.iter_chunks`).
 Each chunk is certified by a worker (local processes by default, or a dask.distributed cluster)
 and its results are written to ``RESULTS.parts/part-NNNNNN.EXT`` under a temporary name, renamed
-atomically when complete (local workers write their own parts; dask workers send their results
-back to the client, which writes them, so a remote cluster needs no shared filesystem). Parts of
-a Parquet output are Arrow IPC files (``.arrow``, LZ4): cheap to write and to read back, so the
-Parquet encoding is done once. As parts complete, the main process appends them in chunk order to
-a temporary results file, renamed to ``RESULTS`` when the last one is in; then the parts folder
-is removed.
+atomically when complete, with ``part-NNNNNN.EXT.sum`` stating its rows, bytes and CRC-32 (local
+workers write their own parts; dask workers send their results back to the client, which writes
+them, so a remote cluster needs no shared filesystem). Parts of a Parquet output are Arrow IPC
+files (``.arrow``, LZ4): cheap to write and to read back, so the Parquet encoding is done once. As
+parts complete, the main process appends them in chunk order to a temporary results file in the
+parts folder, renamed to ``RESULTS`` when the last one is in; then the parts folder is removed.
 
 A run killed at any moment leaves only complete parts (plus temporaries, discarded).
-``resume=True`` keeps the complete parts and certifies only the missing chunks, so every input
-grasp appears exactly once, with the same result as in an uninterrupted run (the computation of a
-chunk is deterministic). ``RESULTS.parts/manifest.json`` records the input and the options; a
-resume with a different input, chunk size or options is refused.
+``resume=True`` keeps the complete parts whose sums match (a part truncated by a crash or a disk
+error is computed again) and certifies only the missing chunks, so every input grasp appears
+exactly once, with the same result as in an uninterrupted run (the computation of a chunk is
+deterministic). ``RESULTS.parts/manifest.json`` records the input and the options, and marks the
+folder as this output's (:data:`MADE_BY`); a resume with a different input, chunk size or options
+is refused, and a ``RESULTS.parts`` that no run for this output made is never reused nor removed.
+
+Nothing is lost (:mod:`qualgrasp.certify.outputs`): the output is checked before any work (never
+an input, a FIFO or a device), one run at a time writes it (a second is refused), and a write that
+fails (full disk, file-size limit, read-only folder) ends the run with a one-line
+:class:`CertifyError` that keeps every finished part for ``--resume``.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import sys
 import time
+import zlib
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -34,10 +43,12 @@ import pyarrow.parquet as pq
 
 from .chunk import Options, certify_chunk_results, status_counts
 from .errors import CertifyError, GraspFileError
-from .results import RESULT_SCHEMA, RESULT_WRITE_OPTIONS
+from .outputs import check_output, lock_output, write_error
+from .results import RESULT_SCHEMA, RESULT_WRITE_OPTIONS, carried_clash
 from .table import Chunk, input_format, is_parquet, iter_chunks, rows_to_table, table_to_rows
+from .validation import TOP_LEVEL
 
-__all__ = ["RunSummary", "run", "check_paths", "certify_chunk"]
+__all__ = ["RunSummary", "run", "check_paths", "certify_chunk", "parts_folder", "MADE_BY"]
 
 
 @dataclass
@@ -78,18 +89,59 @@ def _read_part(path: Path) -> pa.Table:
         return pa.ipc.open_file(source).read_all()
 
 
+def _checksum(path: Path) -> tuple[int, int]:
+    """``(size in bytes, CRC-32)`` of a file, read in blocks."""
+    crc, size = 0, 0
+    with path.open("rb") as fh:
+        while block := fh.read(1 << 20):
+            crc = zlib.crc32(block, crc)
+            size += len(block)
+    return size, crc
+
+
+def _sum_path(part: Path) -> Path:
+    return part.with_name(part.name + ".sum")
+
+
 def _write_part(results, path: Path) -> None:
+    """Write a part atomically, with its companion ``.sum`` (rows, bytes, CRC-32) written first:
+    a part counts only when its sum matches (:func:`_part_ok`), so a part truncated by a crash
+    or a disk error is found and computed again."""
     tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")  # writers never share a temporary
-    if path.suffix == ".arrow":
-        table = results if isinstance(results, pa.Table) else rows_to_table(results)
-        with pa.ipc.new_file(tmp, table.schema, options=_IPC) as writer:
-            writer.write_table(table)
-    else:
-        rows = table_to_rows(results) if isinstance(results, pa.Table) else results
-        with tmp.open("w", encoding="utf-8") as fh:
-            for row in rows:
-                fh.write(json.dumps(row, allow_nan=False) + "\n")
-    os.replace(tmp, path)  # atomic: a part exists only when complete
+    tmp_sum = path.with_name(f"{path.name}.sum.{os.getpid()}.tmp")
+    try:
+        if path.suffix == ".arrow":
+            table = results if isinstance(results, pa.Table) else rows_to_table(results)
+            with pa.ipc.new_file(tmp, table.schema, options=_IPC) as writer:
+                writer.write_table(table)
+            rows = table.num_rows
+        else:
+            rows = table_to_rows(results) if isinstance(results, pa.Table) else results
+            with tmp.open("w", encoding="utf-8") as fh:
+                for row in rows:
+                    fh.write(json.dumps(row, allow_nan=False) + "\n")
+            rows = len(rows)
+        size, crc = _checksum(tmp)
+        tmp_sum.write_text(json.dumps({"rows": rows, "bytes": size, "crc32": crc}))
+        os.replace(tmp_sum, _sum_path(path))
+        os.replace(tmp, path)  # atomic: a part exists only when complete
+    except BaseException:
+        for t in (tmp, tmp_sum):
+            try:
+                t.unlink()
+            except OSError:
+                pass
+        raise
+
+
+def _part_ok(part: Path, rows: int) -> bool:
+    """True when ``part`` exists, holds ``rows`` rows and matches its sum (size and CRC-32)."""
+    try:
+        stated = json.loads(_sum_path(part).read_text(encoding="utf-8"))
+        return (isinstance(stated, dict) and stated.get("rows") == rows
+                and [stated.get("bytes"), stated.get("crc32")] == list(_checksum(part)))
+    except (OSError, ValueError):
+        return False
 
 
 def certify_chunk(chunk: Chunk, options: Options, part: str) -> tuple[int, dict[str, int], int]:
@@ -117,43 +169,95 @@ def _part_counts(part: Path) -> tuple[dict[str, int], int]:
     return status_counts([r["status"] for r in rows], [r["verified"] for r in rows])
 
 
+MADE_BY = "qualgrasp certify"
+"""The marker of a checkpoint folder's manifest (``made_by``): only folders carrying it, for the
+same output, are ever reused or removed."""
+
+_OURS = re.compile(r"(manifest\.json|part-\d{6}.*|.*\.tmp)")
+
+
 def _manifest(grasps: Path, results: Path, chunk_size: int, options: Options) -> dict:
     st = grasps.stat()
-    return {"input": str(grasps.resolve()), "input_size": st.st_size, "input_mtime_ns": st.st_mtime_ns,
-            "output": str(results.resolve()), "chunk_size": chunk_size, "options": asdict(options)}
+    return {"made_by": MADE_BY, "input": str(grasps.resolve()), "input_size": st.st_size,
+            "input_mtime_ns": st.st_mtime_ns, "output": str(results.resolve()), "chunk_size": chunk_size,
+            "options": asdict(options)}
+
+
+def parts_folder(results: str | Path) -> Path:
+    """The checkpoint folder of ``results``: ``RESULTS.parts`` next to it."""
+    results = Path(results)
+    return results.with_name(results.name + ".parts")
+
+
+def _owned(parts: Path, results: Path) -> dict | None:
+    """The manifest of ``parts`` when it is a checkpoint folder of this output (a folder, not a
+    link, whose manifest carries :data:`MADE_BY` and the output's path), else None."""
+    if parts.is_symlink() or not parts.is_dir():
+        return None
+    try:
+        old = json.loads((parts / "manifest.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(old, dict) or old.get("made_by") != MADE_BY or old.get("output") != str(results.resolve()):
+        return None
+    return old
 
 
 def _prepare(grasps: Path, results: Path, chunk_size: int, options: Options, resume: bool) -> Path:
-    parts = results.with_name(results.name + ".parts")
+    """The checkpoint folder of the run: kept (resume), emptied of its own files (a new run over a
+    folder of an earlier run for this output) or created. A folder (or file) of that name that
+    this output's runs did not make is never touched: the run is refused."""
+    parts = parts_folder(results)
     manifest = _manifest(grasps, results, chunk_size, options)
-    if resume and parts.exists():
-        try:
-            old = json.loads((parts / "manifest.json").read_text())
-        except (OSError, json.JSONDecodeError):
-            old = None
-        if old != manifest:
-            raise CertifyError(f"cannot resume: {parts} was made from another input or with other "
-                               "options (chunk size, method, quality); run without --resume to start over")
-        for tmp in parts.glob("*.tmp"):
-            tmp.unlink()
-        return parts
-    if parts.exists():
-        shutil.rmtree(parts)
-    parts.mkdir(parents=True)
+    if os.path.lexists(parts):
+        old = _owned(parts, results)
+        if old is None:
+            what = "a folder" if parts.is_dir() and not parts.is_symlink() else "a file"
+            raise CertifyError(f"{'cannot resume: ' if resume else ''}{parts} exists and is {what} that "
+                               "qualgrasp certify did not make for this output (no manifest naming it); "
+                               "move it away or choose another output name")
+        if resume:
+            if old != manifest:
+                raise CertifyError(f"cannot resume: {parts} was made from another input or with other "
+                                   "options (chunk size, method, quality); run without --resume to start over")
+            for tmp in parts.glob("*.tmp"):
+                tmp.unlink()
+            return parts
+        strangers = sorted(p.name for p in parts.iterdir() if not _OURS.fullmatch(p.name) or not p.is_file())
+        if strangers:
+            raise CertifyError(f"{parts} holds files qualgrasp did not write ({', '.join(strangers[:3])}); "
+                               "move them away or choose another output name")
+        for p in parts.iterdir():
+            if p.name != "manifest.json":
+                p.unlink()
+        (parts / "manifest.json").unlink()
+        parts.rmdir()
+    parts.mkdir()
     tmp = parts / "manifest.json.tmp"
     tmp.write_text(json.dumps(manifest, indent=1))
     os.replace(tmp, parts / "manifest.json")
     return parts
 
 
+def _remove_parts(parts: Path) -> None:
+    """Remove a finished run's checkpoint folder: its own files only (a file put there by someone
+    else stays, and so does the folder)."""
+    for p in parts.iterdir():
+        if p.name != "manifest.json" and _OURS.fullmatch(p.name) and p.is_file():
+            p.unlink()
+    if not any(p.name != "manifest.json" for p in parts.iterdir()):
+        (parts / "manifest.json").unlink()
+        parts.rmdir()
+
+
 class _Assembler:
-    """Appends complete parts, in chunk order as they arrive, to the results' temporary file;
-    :meth:`close` renames it to the results and removes the parts (a run killed before that
-    leaves the parts, from which a resumed run assembles again)."""
+    """Appends complete parts, in chunk order as they arrive, to the results' temporary file (in
+    the checkpoint folder); :meth:`close` renames it to the results and removes the parts (a run
+    killed before that leaves the parts, from which a resumed run assembles again)."""
 
     def __init__(self, parts: Path, results: Path) -> None:
         self.parts, self.results = parts, results
-        self.tmp = results.with_name(results.name + ".tmp")
+        self.tmp = parts / f"results.{os.getpid()}.tmp"
         self.parquet = is_parquet(results)
         self.out = None  # opened with the first part, so that nothing is left if no run starts
         self.next, self.ready = 0, set()
@@ -180,15 +284,21 @@ class _Assembler:
             self.next += 1
 
     def close(self, n_chunks: int) -> None:
-        self._open().close()
+        out, self.out = self._open(), None
+        out.close()
         if self.next != n_chunks:
             raise CertifyError(f"internal error: {self.next} of {n_chunks} parts assembled")
+        check_output(self.results, "-o")  # nothing put in the output's place meanwhile
         os.replace(self.tmp, self.results)
-        shutil.rmtree(self.parts)
+        _remove_parts(self.parts)
 
     def abort(self) -> None:
         if self.out is not None:
-            self.out.close()
+            try:
+                self.out.close()
+            except (OSError, pa.ArrowException):  # the disk that failed the write fails the close
+                pass
+            self.out = None
         self.tmp.unlink(missing_ok=True)
 
 
@@ -262,29 +372,24 @@ class _DaskPool:
 
 def check_paths(grasps: Path, results: Path, chunk_size: int = 1) -> None:
     """Refuse a run before any work: an input that is not a grasp set, a chunk size below 1, and
-    an output that is a folder, the input itself (output never overwrites what the run reads) or
-    in a folder that cannot be created or written. The output's folder is created if needed.
+    an output that :func:`qualgrasp.certify.outputs.check_output` refuses (a folder, a FIFO or
+    device, the input itself through any link, a checkpoint folder ``RESULTS.parts`` that is or
+    holds the input, a name too long for that folder, a folder that cannot be created or
+    written). The output's folder is created if needed.
 
     Raises
     ------
-    GraspFileError
-        With a one-line message naming the problem.
+    CertifyError
+        With a one-line message naming the problem (:class:`GraspFileError` for the input and the
+        chunk size, :class:`qualgrasp.certify.errors.OptionError` for the output).
     """
     if chunk_size < 1:
         raise GraspFileError(f"the chunk size must be at least 1 grasp, got {chunk_size}")
-    input_format(grasps)  # raises for a file that is not JSON Lines or Parquet
-    if results.is_dir():
-        raise GraspFileError(f"the output {results} is a folder; give a file name (.jsonl or .parquet)")
-    if results.exists() and os.path.samefile(results, grasps):
-        raise GraspFileError(f"the output {results} is the input file: choose another name (the input "
-                             "is never overwritten)")
-    folder = results.parent if str(results.parent) else Path(".")
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as err:
-        raise GraspFileError(f"cannot create the output's folder {folder}: {err.strerror or err}") from None
-    if not os.access(folder, os.W_OK):
-        raise GraspFileError(f"cannot write into {folder}")
+    if input_format(grasps) == "parquet":  # raises for a file that is not JSON Lines or Parquet
+        clash = carried_clash([n for n in pq.read_schema(grasps).names if n not in TOP_LEVEL])
+        if clash:
+            raise GraspFileError(f"{grasps}: the columns {clash}")
+    check_output(results, "-o", reads=[grasps], companions=[parts_folder(results)])
 
 
 def run(grasps: str | Path, results: str | Path, *, options: Options = Options(),
@@ -308,9 +413,29 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
     progress : callable, optional
         Called with the number of grasps of each chunk as it completes (or is found complete).
     """
-    start = time.perf_counter()
     grasps, results = Path(grasps), Path(results)
     check_paths(grasps, results, chunk_size)
+    with lock_output(results, "-o"):
+        try:
+            return _run(grasps, results, options, workers, dask, resume, chunk_size, progress)
+        except (OSError, pa.ArrowException) as err:
+            raise CertifyError(_fault(err, results)) from None
+
+
+def _fault(err: Exception, results: Path) -> str:
+    """One line for a write that failed mid-run (full disk, file-size limit, read-only folder):
+    what failed, and that the finished parts are kept for ``--resume``."""
+    target = getattr(err, "filename", None) or results
+    message = write_error(target, err) if isinstance(err, OSError) else f"cannot write {results}: {str(err).splitlines()[0][:200]}"
+    parts = parts_folder(results)
+    kept = (f"; the finished parts are kept in {parts}: fix the cause and run again with --resume"
+            if parts.is_dir() and any(parts.glob("part-*.sum")) else "")
+    return message + kept
+
+
+def _run(grasps: Path, results: Path, options: Options, workers: int | None, dask: str | None,
+         resume: bool, chunk_size: int, progress: Callable[[int], None] | None) -> RunSummary:
+    start = time.perf_counter()
     workers = workers or os.cpu_count() or 1
     # The pool first: a scheduler that cannot be reached leaves nothing behind.
     pool = _DaskPool(dask, workers) if dask else (_LocalPool(workers) if workers > 1 else None)
@@ -338,7 +463,7 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
         for chunk in iter_chunks(grasps, chunk_size):
             n_chunks += 1
             part = parts / _part_name(chunk.index, results)
-            if part.exists():
+            if resume and _part_ok(part, len(chunk)):
                 summary.add(*_part_counts(part))
                 summary.resumed_chunks += 1
             elif pool is None:

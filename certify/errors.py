@@ -12,6 +12,8 @@ __all__ = [
     "GraspFileError",
     "CertificateError",
     "SolverError",
+    "OptionError",
+    "WriteError",
 ]
 
 
@@ -33,3 +35,20 @@ class CertificateError(CertifyError, ValueError):
 
 class SolverError(CertifyError, RuntimeError):
     """A convex solver failed to return a usable answer."""
+
+
+class OptionError(CertifyError, ValueError):
+    """A command-line option or path is unusable (the message names the flag)."""
+
+
+class WriteError(OptionError, OSError):
+    """An output could not be written (a full disk, a read-only folder, a file-size limit): an
+    :class:`OptionError` whose message names the flag, and an ``OSError`` with the cause's
+    ``errno`` and reason (``strerror``), so that callers catching either see it."""
+
+    def __init__(self, message: str, code: int | None = None, reason: str | None = None) -> None:
+        OSError.__init__(self, code, reason)
+        self.message = message
+
+    def __str__(self) -> str:
+        return self.message

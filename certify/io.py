@@ -4,47 +4,69 @@ Grasp line: ``{"id": "g1", "contacts": [{"p": [x, y], "n": [nx, ny], "model": "p
 "center": [cx, cy], "length": 1.0}`` (see :func:`qualgrasp.certify.grasp.grasp_from_dict`); Parquet holds
 the same fields (:data:`qualgrasp.certify.table.GRASP_SCHEMA`). In JSON Lines, blank lines are skipped and
 line numbers count from 1 and include them; in Parquet the line number is the row number.
+Files are written by the rules of :mod:`qualgrasp.certify.outputs` (nothing lost).
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any, Iterable, Iterator
 
 import pyarrow.parquet as pq
 
 from .grasp import Grasp, grasp_to_dict
+from .errors import GraspFileError
+from .outputs import atomic_output, write_lines
 from .results import RESULT_WRITE_OPTIONS
-from .table import grasps_table, is_parquet, iter_chunks, rows_to_table, table_to_rows
+from .table import chunk_values, grasps_table, is_parquet, iter_chunks, rows_to_table, table_to_rows
 
 __all__ = ["write_grasps", "read_results", "write_rows"]
 
 
-def write_grasps(path: str | Path, grasps: Iterable[Grasp]) -> int:
-    """Write grasps in the grasp-set schema; return how many were written."""
-    return _write(path, [grasp_to_dict(g) for g in grasps], grasps_table)
+def write_grasps(path: str | Path, grasps: Iterable[Grasp], *, reads: Iterable[str | Path] = (),
+                 flag: str = "-o") -> int:
+    """Write grasps in the grasp-set schema (Parquet for a ``.parquet`` / ``.pq`` name, else JSON
+    Lines) through :func:`qualgrasp.certify.outputs.atomic_output` (never one of ``reads``, a
+    FIFO or a device; one writer at a time; the old file kept whole if the write fails); return
+    how many were written.
+
+    Raises
+    ------
+    OptionError
+        The output is refused or cannot be written (message naming ``flag``).
+    """
+    return _write(path, [grasp_to_dict(g) for g in grasps], grasps_table, reads=reads, flag=flag)
 
 
 def read_results(path: str | Path, chunk_size: int = 4096) -> Iterator[dict]:
-    """Yield the rows of a results file as dictionaries."""
+    """Yield the rows of a results file as dictionaries.
+
+    Raises
+    ------
+    GraspFileError
+        The file is refused as a whole, or a line cannot be read (the message names it).
+    """
     for chunk in iter_chunks(path, chunk_size):
         if isinstance(chunk.rows, list):
-            yield from (json.loads(text) for _, text in chunk.rows)
+            for line, value in zip(chunk.lines, chunk_values(chunk)):
+                if isinstance(value, Exception):
+                    raise GraspFileError(f"{path} line {line}: {value}")
+                yield value
         else:
             yield from table_to_rows(chunk.rows)
 
 
-def write_rows(path: str | Path, rows: Iterable[dict[str, Any]]) -> int:
-    """Write results rows; return how many were written."""
-    return _write(path, list(rows), rows_to_table, RESULT_WRITE_OPTIONS)
+def write_rows(path: str | Path, rows: Iterable[dict[str, Any]], *, reads: Iterable[str | Path] = (),
+               flag: str = "-o") -> int:
+    """Write results rows as :func:`write_grasps` writes grasps; return how many were written."""
+    return _write(path, list(rows), rows_to_table, RESULT_WRITE_OPTIONS, reads=reads, flag=flag)
 
 
-def _write(path: str | Path, rows: list[dict], to_table, options: dict | None = None) -> int:
-    if is_parquet(path):
-        pq.write_table(to_table(rows), path, **(options or {}))
-    else:
-        with Path(path).open("w", encoding="utf-8") as fh:
-            for row in rows:
-                fh.write(json.dumps(row, allow_nan=False) + "\n")
+def _write(path: str | Path, rows: list[dict], to_table, options: dict | None = None, *,
+           reads: Iterable[str | Path] = (), flag: str = "-o") -> int:
+    if not is_parquet(path):
+        return write_lines(path, rows, flag, reads=reads)
+    table = to_table(rows)
+    with atomic_output(path, flag, reads=reads) as tmp:
+        pq.write_table(table, tmp, **(options or {}))
     return len(rows)

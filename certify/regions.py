@@ -36,19 +36,20 @@ naming the line and the field). A bad line becomes an error row and the run goes
 from __future__ import annotations
 
 import json
-import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterator
 
-from .errors import CertifyError, GraspError, GraspFileError
+from .errors import CertifyError, GraspError, OptionError
+from .outputs import atomic_output
 from .region_boundary import Boundary, IndependentRegions, enclosing_diameter, independent_regions
 from .region_branch import DEFAULT_BUDGET
 from .region_certify import DEFAULT_TOL, STATUSES, RegionVerdict, certify_regions, in_region, verify_regions
 from .region_data import (CurvedRegion, RegionTuple, StraightRegion, region_from_dict, region_to_dict,
                           tuple_from_dict, tuple_to_dict)
-from .validation import show
+from .table import input_format, json_lines
+from .validation import id_problem, show
 
 __all__ = [
     "StraightRegion", "CurvedRegion", "RegionTuple", "region_from_dict", "region_to_dict",
@@ -66,29 +67,33 @@ def error_row(message: str, *, id: Any = None, line: int | None = None) -> dict[
 
 
 def read_region_lines(path: str | Path) -> Iterator[tuple[int, Any]]:
-    """``(line number, tuple or message)`` for every non-blank line of a region set (line numbers
-    count from 1 and include blank lines); a line that cannot be read gives its error message,
-    naming the line and the field, instead of a tuple."""
-    path = Path(path)
-    try:
-        fh = path.open("r", encoding="utf-8")
-    except OSError as err:
-        raise GraspFileError(f"cannot read {path}: {err.strerror or err}") from None
-    with fh:
-        for number, text in enumerate(fh, start=1):
-            if not text.strip():
-                continue
-            try:
-                value = json.loads(text)
-            except json.JSONDecodeError as err:
-                yield number, (None, f"line {number}: malformed JSON: {err.msg} (column {err.colno})")
-                continue
-            gid = value.get("id") if isinstance(value, dict) else None
-            gid = gid if isinstance(gid, (str, int)) and not isinstance(gid, bool) else None
-            try:
-                yield number, tuple_from_dict(value)
-            except GraspError as err:
-                yield number, (gid, f"line {number}: {err}")
+    """``(line number, tuple or (id, message))`` for every non-blank line of a region set, read
+    by the toolkit's one line reader (:func:`qualgrasp.certify.table.json_lines`: regular files
+    only, the same limits and messages as grasp sets; line numbers count from 1 and include
+    blank lines); a line that cannot be read gives its id (where one can be read) and an error
+    message naming the line and the field instead of a tuple.
+
+    Raises
+    ------
+    GraspFileError
+        The file as a whole is refused (not a regular file, not JSON Lines), with a one-line
+        message.
+    """
+    for number, value in json_lines(path, "region set"):
+        if isinstance(value, Exception):
+            yield number, (None, f"line {number}: {value}")
+            continue
+        gid = value.get("id") if isinstance(value, dict) else None
+        problem = id_problem(gid)
+        if problem:
+            yield number, (None, f"line {number}: {problem}")
+            continue
+        try:
+            yield number, tuple_from_dict(value)
+        except GraspError as err:
+            yield number, (gid, f"line {number}: {err}")
+        except RecursionError:
+            yield number, (gid, f"line {number}: nested too deeply")
 
 
 @dataclass
@@ -109,13 +114,6 @@ class RegionSummary:
         return self.statuses.get("error", 0)
 
 
-def _same_file(a: Path, b: Path) -> bool:
-    try:
-        return a.resolve() == b.resolve() or (b.exists() and os.path.samefile(a, b))
-    except OSError:
-        return False
-
-
 def certify_region_file(in_path: str | Path, out_path: str | Path, *, budget: int = DEFAULT_BUDGET,
                         tol: float = DEFAULT_TOL, progress: Callable[[int], None] | None = None) -> RegionSummary:
     """Certify every region tuple of a region set into a results file (module docstring).
@@ -125,8 +123,9 @@ def certify_region_file(in_path: str | Path, out_path: str | Path, *, budget: in
     in_path : path
         Region set, JSON Lines.
     out_path : path
-        Results file (JSON Lines), written whole at the end (through a temporary file); never
-        the input.
+        Results file (JSON Lines), written through a temporary file renamed at the end, one run
+        at a time (:func:`qualgrasp.certify.outputs.atomic_output`); never the input, a FIFO or a
+        device.
     budget, tol
         As for :func:`certify_regions`.
     progress : callable, optional
@@ -139,7 +138,10 @@ def certify_region_file(in_path: str | Path, out_path: str | Path, *, budget: in
     Raises
     ------
     GraspFileError
-        The input cannot be read, or the output is the input.
+        The input as a whole cannot be read (:func:`read_region_lines`).
+    OptionError
+        The output is refused (the input, a FIFO or device, a folder), another run is writing
+        it, it cannot be written (full disk, ...), or ``budget`` is below 1.
 
     Examples
     --------
@@ -156,11 +158,20 @@ def certify_region_file(in_path: str | Path, out_path: str | Path, *, budget: in
     'line 2: regions[0].a: expected 2 finite numbers, got [1, "x"]'
     """
     in_path, out_path = Path(in_path), Path(out_path)
-    if _same_file(in_path, out_path):
-        raise GraspFileError(f"the output {out_path} is the input: choose another file")
+    if budget < 1:
+        raise OptionError(f"--budget must be at least 1 work unit, got {budget}")
+    input_format(in_path)  # the whole file is refused before any work
     t0 = time.perf_counter()
     summary = RegionSummary()
-    rows = []
+    with atomic_output(out_path, "-o", reads=[in_path]) as tmp, tmp.open("w", encoding="utf-8") as fh:
+        _certify_lines(in_path, fh, summary, budget, tol, progress)
+    summary.seconds = time.perf_counter() - t0
+    return summary
+
+
+def _certify_lines(in_path: Path, fh, summary: RegionSummary, budget: int, tol: float,
+                   progress: Callable[[int], None] | None) -> None:
+    """Certify every line of a region set, writing its results row to ``fh`` as it comes."""
     for number, item in read_region_lines(in_path):
         if isinstance(item, tuple):
             row = error_row(item[1], id=item[0], line=number)
@@ -175,16 +186,9 @@ def certify_region_file(in_path: str | Path, out_path: str | Path, *, budget: in
                 summary.unverified += not ok
         summary.rows += 1
         summary.statuses[row["status"]] = summary.statuses.get(row["status"], 0) + 1
-        rows.append(row)
+        fh.write(json.dumps(row, allow_nan=False) + "\n")
         if progress is not None:
             progress(1)
-    tmp = out_path.with_name(out_path.name + ".tmp")
-    with tmp.open("w", encoding="utf-8") as fh:
-        for row in rows:
-            fh.write(json.dumps(row, allow_nan=False) + "\n")
-    os.replace(tmp, out_path)
-    summary.seconds = time.perf_counter() - t0
-    return summary
 
 
 def verify_region_file(results: str | Path, regions: str | Path) -> RegionSummary:
@@ -224,18 +228,11 @@ def verify_region_file(results: str | Path, regions: str | Path) -> RegionSummar
     """
     results, regions = Path(results), Path(regions)
     summary = RegionSummary()
-    try:
-        text = results.read_text(encoding="utf-8")
-    except OSError as err:
-        raise GraspFileError(f"cannot read {results}: {err.strerror or err}") from None
     rows = []
-    for number, line in enumerate(text.splitlines(), start=1):
-        if not line.strip():
-            continue
-        try:
-            rows.append(json.loads(line))
-        except json.JSONDecodeError as err:
-            rows.append({"status": None, "_bad": f"results line {number}: malformed JSON: {err.msg}"})
+    for number, value in json_lines(results, "results file"):
+        if isinstance(value, Exception):
+            value = {"status": None, "_bad": f"results line {number}: {value}"}
+        rows.append(value)
     tuples = list(read_region_lines(regions))
     if len(rows) != len(tuples):
         summary.failures.append((None, f"{len(rows)} results rows for {len(tuples)} region tuples"))

@@ -10,18 +10,19 @@ cannot drift apart.
 An input's extra top-level fields (columns of a Parquet or Arrow grasp table other than ``id``,
 ``contacts``, ``center``, ``length``; other keys of a JSON Lines grasp) are carried through
 unchanged after these columns, under :func:`carried_name` (JSON Lines input gives them to JSON
-Lines results only: a Parquet results file has one schema).
+Lines results only: a Parquet results file has one schema). Fields that would share a results name
+(``status`` and ``input_status``) are refused by name (:func:`carried_clash`), never dropped.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import pyarrow as pa
 
 __all__ = ["Column", "CERTIFICATE", "EVIDENCE", "COLUMNS", "NAMES", "RESULT_SCHEMA", "RESULT_WRITE_OPTIONS",
-           "carried_name", "result_row", "error_row", "result_table"]
+           "carried_name", "carried_clash", "result_row", "error_row", "result_table"]
 
 CERTIFICATE = pa.struct([
     ("kind", pa.string()), ("layout", pa.string()), ("values", pa.list_(pa.float64())),
@@ -97,6 +98,26 @@ def carried_name(name: str) -> str:
     while name in NAMES:
         name = f"input_{name}"
     return name
+
+
+def carried_clash(names: Sequence[str]) -> str | None:
+    """Why extra fields ``names`` cannot all be carried (two of them would have the same results
+    name under :func:`carried_name`, as ``status`` and ``input_status`` do), or None.
+
+    Examples
+    --------
+    >>> carried_clash(["note", "status"]) is None
+    True
+    >>> carried_clash(["status", "input_status"])
+    'status and input_status would both be carried as input_status: rename one'
+    """
+    seen: dict[str, str] = {}
+    for name in names:
+        carried = carried_name(name)
+        if carried in seen:
+            return f"{seen[carried]} and {name} would both be carried as {carried}: rename one"
+        seen[carried] = name
+    return None
 
 
 def result_row(**values: Any) -> dict[str, Any]:

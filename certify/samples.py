@@ -10,6 +10,7 @@ import pyarrow.parquet as pq
 
 from . import models as registry
 from .grasp import Contact, Grasp
+from .outputs import atomic_output
 from .table import CONTACT, GRASP_SCHEMA, is_parquet
 
 __all__ = ["RANGES", "random_grasp", "random_grasps", "textbook_grasps", "random_grasp_table", "write_random_grasp_file"]
@@ -149,26 +150,33 @@ def random_grasp_table(seed: int, count: int, *, dim: int = 2, n_contacts: int =
 
 def write_random_grasp_file(path, count: int, *, seed: int = 0, chunk: int = 500_000, **kwargs) -> int:
     """Write ``count`` random grasps (:func:`random_grasp_table`) to a Parquet or JSON Lines file,
-    ``chunk`` at a time, so that memory stays bounded; return how many were written."""
+    ``chunk`` at a time, so that memory stays bounded; return how many were written. The file is
+    written by :func:`qualgrasp.certify.outputs.atomic_output` (a temporary renamed at the end,
+    one writer at a time, never a FIFO or a device).
 
-
+    Raises
+    ------
+    OptionError
+        The output is refused or cannot be written (a one-line message).
+    """
     written = 0
-    writer = pq.ParquetWriter(path, GRASP_SCHEMA) if is_parquet(path) else None
-    fh = None if writer else open(path, "w", encoding="utf-8")
-    try:
-        for start in range(0, count, chunk):
-            n = min(chunk, count - start)
-            table = random_grasp_table(seed + start, n, start=start, **kwargs)
+    with atomic_output(path, "OUT") as tmp:
+        writer = pq.ParquetWriter(tmp, GRASP_SCHEMA) if is_parquet(path) else None
+        fh = None if writer else open(tmp, "w", encoding="utf-8")
+        try:
+            for start in range(0, count, chunk):
+                n = min(chunk, count - start)
+                table = random_grasp_table(seed + start, n, start=start, **kwargs)
+                if writer:
+                    writer.write_table(table)
+                else:
+                    for row in table.to_pylist():
+                        row["contacts"] = [{k: v for k, v in c.items() if v is not None} for c in row["contacts"]]
+                        fh.write(json.dumps({k: v for k, v in row.items() if v is not None}) + "\n")
+                written += n
+        finally:
             if writer:
-                writer.write_table(table)
-            else:
-                for row in table.to_pylist():
-                    row["contacts"] = [{k: v for k, v in c.items() if v is not None} for c in row["contacts"]]
-                    fh.write(json.dumps({k: v for k, v in row.items() if v is not None}) + "\n")
-            written += n
-    finally:
-        if writer:
-            writer.close()
-        if fh:
-            fh.close()
+                writer.close()
+            if fh:
+                fh.close()
     return written

@@ -9,8 +9,9 @@ Parquet files hold the same schema as the JSON Lines files of :mod:`qualgrasp.ce
 * results: the columns of :data:`qualgrasp.certify.results.COLUMNS`, with ``certificate`` a
   struct ``{force, form}`` of certificate structs.
 
-An input file's format is recognised by its content (Parquet's magic number, else JSON Lines;
-anything else is refused with a one-line reason); a results file's by its extension
+An input file's format is recognised by its content (Parquet's magic number, else JSON Lines
+when most of its first lines are JSON objects; anything else is refused with a one-line reason;
+only regular files are read); a results file's by its extension
 (``.parquet`` / ``.pq`` for Parquet, anything else for JSON Lines). Both are read in chunks of a
 fixed number of grasps, so memory stays bounded whatever the file's size, and a chunk's
 boundaries do not depend on how the file was written (needed to resume an interrupted run).
@@ -21,6 +22,8 @@ mark; a line that is too long (:data:`MAX_LINE_BYTES`), not UTF-8 or not JSON is
 from __future__ import annotations
 
 import json
+import os
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterator, Sequence
@@ -29,10 +32,12 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from .errors import GraspFileError
+from .outputs import file_kind
 from .results import RESULT_SCHEMA
 from .validation import param_names
 
-__all__ = ["CONTACT", "GRASP_SCHEMA", "MAX_LINE_BYTES", "READ_ERROR", "is_parquet", "input_format", "Chunk",
+__all__ = ["CONTACT", "GRASP_SCHEMA", "MAX_LINE_BYTES", "READ_ERROR", "SNIFF_BYTES", "is_parquet", "input_format",
+           "column_problem", "json_lines", "Chunk",
            "iter_chunks", "count_grasps", "parse_line", "grasps_table", "rows_to_table", "table_to_rows",
            "chunk_values", "table_values"]
 
@@ -67,40 +72,138 @@ def _not_grasps(path: Path, what: str) -> GraspFileError:
     return GraspFileError(f"{path} is neither JSON Lines nor Parquet: {what}")
 
 
+#: Bytes read from the start of a file to recognise its format.
+SNIFF_BYTES = 1 << 20
+
+
 def input_format(path: str | Path) -> str:
     """``'parquet'`` or ``'jsonl'``, from the file's content (not its name).
+
+    JSON Lines is decided on the lines of the first :data:`SNIFF_BYTES` as a whole: a file whose
+    lines are mostly JSON objects is JSON Lines, and each bad line (a NUL byte, a JSON array) is
+    an error row of its own; only a file that is not mostly JSON objects is refused, with the
+    reason.
 
     Raises
     ------
     GraspFileError
-        The file cannot be read, or holds something else: compressed or binary data, an image,
-        UTF-16 text, or one JSON document spread over many lines (a JSON array of grasps,
-        pretty-printed JSON); the message says which and how to fix it.
+        The file cannot be read, is not a regular file (a FIFO or a device is never read), or
+        holds something else: compressed or binary data, an image, UTF-16 text, one JSON document
+        spread over many lines (a JSON array of grasps, pretty-printed JSON), or a Parquet file
+        with two columns of one name or a column named :data:`READ_ERROR`; the message says
+        which and how to fix it.
     """
     path = Path(path)
     try:
-        if not path.is_file():
-            raise GraspFileError(f"cannot read {path}: " + ("it is a folder" if path.is_dir() else
-                                 "no such file" if not path.exists() else "not a regular file"))
+        st = os.stat(path)
+        if not stat.S_ISREG(st.st_mode):
+            raise GraspFileError(f"cannot read {path}: it is {file_kind(st.st_mode)}, not a regular file")
         with path.open("rb") as fh:
-            head = fh.read(1 << 16)
+            head = fh.read(SNIFF_BYTES)
+    except FileNotFoundError:
+        raise GraspFileError(f"cannot read {path}: no such file") from None
     except OSError as err:
         raise _open_error(path, err) from None
     if head.startswith(b"PAR1"):
+        _check_parquet(path)
         return "parquet"
     for magic, what in _MAGIC:
         if head.startswith(magic):
             raise _not_grasps(path, what)
-    if b"\x00" in head:
-        raise _not_grasps(path, "binary data (NUL bytes)")
-    text = head[3:] if head.startswith(b"\xef\xbb\xbf") else head
-    first = next((line for line in text.replace(b"\r", b"\n").split(b"\n") if line.strip()), b"").strip()
-    if first in (b"[", b"{") or (first.startswith(b"[") and first.endswith(b",")):
-        raise _not_grasps(path, "one JSON document spread over many lines (a JSON array or pretty-printed "
-                                "JSON); write one grasp per line")
-    if first.startswith(b"[") and b'"contacts"' in first:
-        raise _not_grasps(path, "a JSON array of grasps; write one grasp per line")
+    reason = _not_lines(head, complete=len(head) < SNIFF_BYTES)
+    if reason:
+        raise _not_grasps(path, reason)
     return "jsonl"
+
+
+def _not_lines(head: bytes, complete: bool) -> str | None:
+    """Why the start of a file is not JSON Lines, or None when it is: most of its complete lines
+    must be JSON objects, more than half of them (a file whose first line is longer than the
+    sample is judged by that line's start)."""
+    text = head[3:] if head.startswith(b"\xef\xbb\xbf") else head
+    lines = text.replace(b"\r\n", b"\n").replace(b"\r", b"\n").split(b"\n")
+    if not complete:
+        lines = lines[:-1]  # the last one may be cut short
+    lines = [line.strip() for line in lines if line.strip()]
+    if not lines:
+        return None if complete or text.lstrip()[:1] in (b"{", b"") else "the first line is not a JSON object"
+    objects = sum(isinstance(parse_line(line), dict) for line in lines)
+    if 2 * objects > len(lines):
+        return None
+    first = lines[0]
+    if b"\x00" in text:
+        return "binary data (NUL bytes)"
+    if first in (b"[", b"{") or first.endswith((b",", b"[", b"{")):
+        return "one JSON document spread over many lines (a JSON array or pretty-printed JSON); write one grasp per line"
+    if first.startswith(b"[") and b'"contacts"' in first:
+        return "a JSON array of grasps; write one grasp per line"
+    return None  # JSON Lines with bad lines: each is an error row
+
+
+def _check_parquet(path: Path) -> None:
+    """Refuse a Parquet file whose columns the reader cannot keep apart: two columns of one name,
+    or a column named like the reader's marker :data:`READ_ERROR`."""
+    try:
+        names = pq.read_schema(path).names
+    except (OSError, pa.ArrowException) as err:
+        raise _open_error(path, err) from None
+    problem = column_problem(names)
+    if problem:
+        raise GraspFileError(f"{path}: {problem}")
+
+
+def column_problem(names: Sequence[str]) -> str | None:
+    """What makes columns ``names`` unreadable as one table, or None: a name given twice, or the
+    reader's marker :data:`READ_ERROR`.
+
+    Examples
+    --------
+    >>> column_problem(["id", "contacts", "contacts"])
+    'the column contacts appears 2 times: give each column its own name'
+    """
+    seen: dict[str, int] = {}
+    for name in names:
+        seen[name] = seen.get(name, 0) + 1
+    for name, count in seen.items():
+        if count > 1:
+            return f"the column {name} appears {count} times: give each column its own name"
+    if READ_ERROR in seen:
+        return f"the column {READ_ERROR} is reserved by qualgrasp (it marks unreadable rows): rename it"
+    return None
+
+
+def json_lines(path: str | Path, what: str = "line file") -> Iterator[tuple[int, Any]]:
+    """``(line number, value)`` of every non-blank line of a JSON Lines file, read by the rules
+    of grasp sets (:func:`input_format` first, then line by line: numbers count from 1 and
+    include blank lines; a line that cannot be read gives a :class:`GraspFileError` saying why,
+    :func:`parse_line`). Every line file of the toolkit is read this way.
+
+    Raises
+    ------
+    GraspFileError
+        The whole file is refused (:func:`input_format`), or it is Parquet (``what`` names the
+        kind of file expected, for the message).
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "r.jsonl"
+    >>> _ = path.write_bytes(b'{"id": 1}\\n\\n{"id": 2, "x": \\xff}\\n{"id": 3}\\n')
+    >>> [(n, v if isinstance(v, dict) else str(v)) for n, v in json_lines(path)]
+    [(1, {'id': 1}), (3, 'not valid UTF-8 (byte 0xff at column 16)'), (4, {'id': 3})]
+    """
+    path = Path(path)
+    if input_format(path) != "jsonl":
+        raise GraspFileError(f"{path} is a Parquet file; a {what} is JSON Lines (one JSON object per line)")
+    try:
+        fh = path.open("rb")
+    except OSError as err:
+        raise _open_error(path, err) from None
+    with fh:
+        for number, raw in _raw_lines(fh):
+            if raw is not None and not raw.strip():
+                continue
+            yield number, parse_line(raw)
 
 
 def _raw_lines(fh, limit: int = MAX_LINE_BYTES) -> Iterator[tuple[int, bytes | None]]:

@@ -48,7 +48,8 @@ from .models import MAX_LENGTH, MIN_LENGTH
 
 __all__ = ["MAX_CONTACTS", "MIN_NORMAL", "ABSENT", "UNKNOWN", "ContactData", "GraspData",
            "Checked", "show", "number", "numbers", "contact_data", "grasp_data",
-           "check_contacts", "check_grasps", "grasp_rules", "CheckedGrasps", "param_names", "TOP_LEVEL"]
+           "check_contacts", "check_grasps", "grasp_rules", "CheckedGrasps", "param_names", "TOP_LEVEL",
+           "id_problem"]
 
 #: Most contacts in one grasp (documented limit; a longer row is an error).
 MAX_CONTACTS = 10_000
@@ -336,10 +337,9 @@ def grasp_data(values: Sequence[Any]) -> tuple[GraspData, ContactData]:
             data.errors[i] = f"expected a JSON object with a 'contacts' list, got {show(d)}"
             continue
         gid = d.get("id")
-        if gid is not None and (isinstance(gid, bool) or not isinstance(gid, (str, Integral))):
-            data.errors[i] = f"id: expected a string or an integer, got {show(gid)}"
-        elif isinstance(gid, str) and not _is_unicode(gid):
-            data.errors[i] = f"id: not valid Unicode (it holds a lone surrogate), got {show(gid)}"
+        problem = id_problem(gid)
+        if problem:
+            data.errors[i] = problem
         elif gid is not None:
             data.ids[i] = gid if isinstance(gid, str) else int(gid)
         data.meta[i] = {k: v for k, v in d.items() if k not in TOP_LEVEL}
@@ -371,6 +371,24 @@ def grasp_data(values: Sequence[Any]) -> tuple[GraspData, ContactData]:
                 data.length_given[i] = True
                 data.raw[(i, "length")] = d["length"]
     return data, contact_data(contacts)
+
+
+def id_problem(gid: Any) -> str | None:
+    """Why ``gid`` cannot be an id (a string of valid Unicode or an integer; None for none), or
+    None when it can.
+
+    Examples
+    --------
+    >>> id_problem("g1") is None, id_problem(7) is None, id_problem(None) is None
+    (True, True, True)
+    >>> print(id_problem("a\\ud800b"))
+    id: not valid Unicode (it holds a lone surrogate), got "a\ud800b"
+    """
+    if gid is not None and (isinstance(gid, bool) or not isinstance(gid, (str, Integral))):
+        return f"id: expected a string or an integer, got {show(gid)}"
+    if isinstance(gid, str) and not _is_unicode(gid):
+        return f"id: not valid Unicode (it holds a lone surrogate), got {show(gid)}"
+    return None
 
 
 def _is_unicode(text: str) -> bool:

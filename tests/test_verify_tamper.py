@@ -14,6 +14,7 @@ direction moved a little still separates) is accepted; one that does not is reje
 
 import json
 import math
+import re
 from pathlib import Path
 
 import pyarrow as pa
@@ -226,12 +227,13 @@ def run_matrix(files, tmp: Path):
                         back = table_to_rows(table) if column in table.column_names else None
                         value = ... if back is None else back[index].get(column)
                     summary = verify_file(path, grasps, workers=1)
-                    gid = rows[index]["id"]
-                    mine = [r for g, r in summary.failures if g == gid or str(g) == str(gid)]
+                    # a failure names the row's own id: the tampered one when the id was tampered
+                    own = [rows[index]["id"]] + ([None if value is ... else value] if column == "id" else [])
+                    mine = [r for g, r in summary.failures if any(_same(g, x) or str(g) == str(x) for x in own)]
                     changed = value is ... or not _same(old, value)
                     evidence_moved = column in ("certificate", "eps_evidence") and kind == "changed"
                     expected = changed and column != "eps_limited" and not evidence_moved
-                    named = any(column in r for r in mine)
+                    named = any(column in re.sub(r"^line \d+: ", "", r) for r in mine)
                     records.append((fmt, target, column, kind, expected, bool(mine), named,
                                     mine[0] if mine else ""))
     return records
