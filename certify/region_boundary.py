@@ -43,13 +43,16 @@ from .grasp import Contact, Grasp
 from .region_certify import RegionVerdict, certify_regions
 from .region_data import CurvedRegion, RegionTuple, StraightRegion
 
-__all__ = ["Boundary", "IndependentRegions", "independent_regions", "enclosing_diameter", "SEARCH_BUDGET"]
+__all__ = ["Boundary", "IndependentRegions", "independent_regions", "enclosing_diameter", "SEARCH_BUDGET",
+           "TOL_FLOOR", "bisection_tol"]
 
 _NORMAL_EQ = 1e-9
 #: Default branch-and-bound budget of each region tuple tried by the bisection (work units):
 #: smaller than :func:`certify_regions`' default, since a tuple left undecided only makes the
 #: certified ``delta`` a little smaller.
 SEARCH_BUDGET = 50_000
+#: Finest bisection tolerance, fraction of the object's size: at most 30 halvings.
+TOL_FLOOR = 1e-9
 
 
 def enclosing_diameter(points) -> float:
@@ -402,6 +405,32 @@ def _contacts(boundary: Boundary, contacts, models) -> list[Contact]:
     return contacts
 
 
+def bisection_tol(tol: float | None, size: float) -> float:
+    """The bisection tolerance of :func:`independent_regions` for an object of ``size``
+    (boundary units): ``tol``, or ``1e-3`` of the size when None.
+
+    Raises
+    ------
+    GraspError
+        ``tol`` is not finite or below :data:`TOL_FLOOR` of the size: the bisection takes
+        ``log2(size / tol)`` certificates, and below rounding it would not end.
+
+    Examples
+    --------
+    >>> bisection_tol(None, 200.0)
+    0.2
+    >>> bisection_tol(1e-300, 200.0)
+    Traceback (most recent call last):
+    ...
+    qualgrasp.certify.errors.GraspError: tol: expected a finite number of at least 1e-09 of the object's size (2e-07 boundary units), got 1e-300
+    """
+    tol = 1e-3 * size if tol is None else float(tol)
+    if not (math.isfinite(tol) and tol >= TOL_FLOOR * size):
+        raise GraspError(f"tol: expected a finite number of at least {TOL_FLOOR:g} of the object's size "
+                         f"({TOL_FLOOR * size:.3g} boundary units), got {tol:g}")
+    return tol
+
+
 def independent_regions(boundary, normals, contacts, *, limits=None, models=None, tol: float | None = None,
                         symmetric: bool = True, normal_tol: float = 0.0, budget: int = SEARCH_BUDGET,
                         center=None, length=None, on_boundary: float = 1e-6) -> IndependentRegions:
@@ -485,9 +514,7 @@ def independent_regions(boundary, normals, contacts, *, limits=None, models=None
         length = contacts.length if length is None else length
     grasp = Grasp(tuple(cs), center=center, length=length, id=contacts.id if isinstance(contacts, Grasp) else None)
     k = len(cs)
-    tol = 1e-3 * B.size if tol is None else float(tol)
-    if not tol > 0:
-        raise GraspError(f"tol: expected a positive number, got {tol}")
+    tol = bisection_tol(tol, B.size)
     pos, lims = [], []
     for i, c in enumerate(cs):
         s, dist, e = B.locate(c.p)

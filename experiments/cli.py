@@ -13,6 +13,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from ..certify.checks import OptionError, count_in, output_folder
+from ..certify.errors import CertifyError
 from . import figures
 from .demo import demo_steps, run_demo
 from .silhouettes import available_silhouettes, available_wings, write_silhouettes
@@ -31,9 +32,9 @@ def _fail(message: str) -> None:
     raise typer.Exit(2)
 
 
-def _folder(out: Path) -> Path:
+def _folder(out: Path, reads: list[Path] = ()) -> Path:
     try:
-        return output_folder(out, "--out")
+        return output_folder(out, "--out", reads=reads)
     except OptionError as err:
         _fail(str(err))
 
@@ -57,7 +58,10 @@ def demo_command(out: Path = typer.Option(Path("qualgrasp-demo"), "--out", help=
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                   console=console) as bar:
         task = bar.add_task("demo", total=demo_steps())
-        result = run_demo(out, progress=lambda message: bar.update(task, advance=1, description=message))
+        try:
+            result = run_demo(out, progress=lambda message: bar.update(task, advance=1, description=message))
+        except CertifyError as err:  # an output the run may not write (a file in the way, a full disk)
+            _fail(str(err))
     table = Table(title="synthesis on the built-in objects, certified and re-checked")
     for col in ("object", "outline", "route", "grasps", "certified", "median eps"):
         table.add_column(col, no_wrap=True)
@@ -92,7 +96,10 @@ def figures_command(out: Path = typer.Option(Path("qualgrasp-figures"), "--out",
     except ValueError as exc:
         raise typer.BadParameter(str(exc), param_hint="--formats") from exc
     _folder(out)
-    paths = figures.make_figures(out, formats=kinds, progress=lambda message: console.print(message))
+    try:
+        paths = figures.make_figures(out, formats=kinds, progress=lambda message: console.print(message))
+    except CertifyError as err:
+        _fail(str(err))
     for path in paths:
         console.print(f"wrote {path}", soft_wrap=True)  # paths stay whole, for copy and paste
     console.print(f"{len(paths)} files in {out}", soft_wrap=True)
@@ -133,7 +140,7 @@ def compare_command(
             count_in(trials, "--trials", 1, 1000)
     except OptionError as err:
         _fail(str(err))
-    _folder(out)
+    _folder(out, [folder] if folder else [])
     images: list = sorted(p for p in folder.iterdir() if p.suffix.lower() in _IMAGE_SUFFIXES) if folder else []
     images += list(BUILTINS) if builtins else []
     images += bundled(silhouettes, with_horse=bool(silhouettes), wings=wings) if silhouettes or wings else []
@@ -144,16 +151,19 @@ def compare_command(
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                   console=console) as bar:
         task = bar.add_task("compare", total=workload(len(images), settings))
-        result = compare(images, out, settings=settings,
-                         progress=lambda message: bar.update(task, advance=1, description=message))
+        try:
+            result = compare(images, out, settings=settings,
+                             progress=lambda message: bar.update(task, advance=1, description=message))
+        except CertifyError as err:
+            _fail(str(err))
     table = Table(title=f"{len(result.objects)} objects, {result.seconds:.0f} s; eps: certified L1 of the "
                         "grasps counted, robust: fraction still certified under vision errors; slide: "
                         "median of how far every finger of the best grasp may slide either way "
-                        "(certified, fraction of the size); below res: certified grasps not counted, "
-                        "below the image's resolution", box=None,
+                        "(certified, fraction of the size); below res, weak edge: certified grasps not "
+                        "counted, below the image's resolution or with a contact on a weak edge", box=None,
                   padding=(0, 1, 0, 0), pad_edge=False)
     for col in ("route", "grasps", "cert", "eps med", "eps best", "best/base", "s/obj", "robust",
-                "paired", "slide", "below res"):
+                "paired", "slide", "below res", "weak edge"):
         table.add_column(col, no_wrap=True)
 
     def fmt(value, spec=".3f"):
@@ -162,7 +172,8 @@ def compare_command(
     for r in result.routes:
         table.add_row(r.route, str(r.grasps), fmt(r.certified_fraction), fmt(r.eps_median), fmt(r.eps_best),
                       fmt(r.ratio_best), fmt(r.seconds_median), fmt(r.robustness), fmt(r.robustness_paired),
-                      fmt(r.slide_median), str(dict(r.not_counted).get("below_resolution", 0)))
+                      fmt(r.slide_median), str(dict(r.not_counted).get("below_resolution", 0)),
+                      str(dict(r.not_counted).get("weak_edge", 0)))
     console.print(table)
     for name, reason in result.skipped:
         console.print(f"skipped {escape(name)}: {escape(reason)}", soft_wrap=True)
@@ -186,6 +197,6 @@ def silhouettes_command(out: Path = typer.Option(Path("qualgrasp-silhouettes"), 
     _folder(out)
     try:
         paths = write_silhouettes(out, n, with_horse=horse, wings=wings)
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, CertifyError) as exc:
         _fail(str(exc))
     console.print(f"wrote {len(paths)} images into {out}", soft_wrap=True)

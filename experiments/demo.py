@@ -24,6 +24,7 @@ from typing import Callable
 from qualgrasp.certify.batch import Summary, certify_file, verify_file
 from qualgrasp.certify.engine import RunSummary
 from qualgrasp.certify.io import write_grasps
+from qualgrasp.certify.outputs import atomic_output
 from qualgrasp.certify.samples import textbook_grasps
 from qualgrasp.qualitative.objects import render
 from qualgrasp.qualitative.synthesis import MU, synthesize
@@ -183,6 +184,7 @@ def write_report(result: DemoResult) -> Path:
     lines += ["", "## Files", ""]
     for path in (*result.figures, result.grasps, result.results, *result.study.files):
         lines.append(f"- {_link(path, out)}")
-    result.report.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    with atomic_output(result.report, "--out") as tmp:
+        tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return result.report
 

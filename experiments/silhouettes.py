@@ -61,6 +61,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import shapely
+from qualgrasp.certify.outputs import atomic_output
 from qualgrasp.qualitative.objects import normalise, place, render_polygon
 from scipy import ndimage
 from scipy.interpolate import splev, splprep
@@ -394,7 +395,10 @@ def write_silhouettes(out_dir: str | Path, n: int = 24, *, with_horse: bool = Tr
     paths = []
     for item in silhouettes(n, with_horse, wings):
         path = out / f"{item.name}.png"
-        if not cv2.imwrite(str(path), item.image(size)):
-            raise OSError(f"cannot write {path}")
+        ok, png = cv2.imencode(".png", item.image(size))
+        if not ok:
+            raise OSError(f"cannot encode {path}")
+        with atomic_output(path, "--out") as tmp:
+            tmp.write_bytes(png.tobytes())
         paths.append(path)
     return paths

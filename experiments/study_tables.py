@@ -12,6 +12,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from qualgrasp.certify.outputs import atomic_output
+
 from .design import (GRASP_COLUMNS, KINDS, OBJECT_COLUMNS, OVERALL_COLUMNS, REASONS, ROBUSTNESS_COLUMNS,
                      UNITS, RouteSummary, Settings, routes)
 
@@ -126,7 +128,7 @@ def _cell(value: Any, markdown: bool) -> str:
 
 def write_csv(path: Path, rows: list[dict], columns: Sequence[str]) -> Path:
     """Rows as CSV with a header, in the given column order; lists space-separated."""
-    with path.open("w", newline="") as fh:
+    with atomic_output(path, "--out") as tmp, tmp.open("w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(columns)
         writer.writerows([[_cell(r.get(c), False) for c in columns] for r in rows])
@@ -139,7 +141,8 @@ def write_markdown(path: Path, rows: list[dict], columns: Sequence[str], title: 
     lines = [f"# {title}", ""] + ([note, ""] if note else [])
     lines += ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
     lines += ["| " + " | ".join(_cell(r.get(c), True) for c in columns) + " |" for r in rows]
-    path.write_text("\n".join(lines) + "\n")
+    with atomic_output(path, "--out") as tmp:
+        tmp.write_text("\n".join(lines) + "\n")
     return path
 
 

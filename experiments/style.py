@@ -22,6 +22,7 @@ from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from qualgrasp.certify.outputs import atomic_output
 from qualgrasp.qualitative.grasp_plot import CONE, TCOLOR, ZMINUS, ZPLUS
 from qualgrasp.qualitative.objects import BACKGROUND, FOREGROUND
 from qualgrasp.qualitative.plot import STYLE as CURVATURE
@@ -127,6 +128,7 @@ def save(fig: Figure, out: Path, stem: str, formats: Sequence[str]) -> list[Path
     with context():
         for fmt in formats:
             path = out / f"{stem}.{fmt}"
-            fig.savefig(path, format=fmt)
+            with atomic_output(path, "--out") as tmp:
+                fig.savefig(tmp, format=fmt)
             paths.append(path)
     return paths

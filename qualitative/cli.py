@@ -8,7 +8,8 @@ from pathlib import Path
 
 import typer
 
-from ..certify.checks import FIGURE_SUFFIXES, number_in, output_file
+from ..certify.checks import FIGURE_SUFFIXES, number_in, optional_number_in, output_file
+from ..certify.outputs import atomic_output
 from ..certify.errors import CertifyError
 from ..certify.io import write_grasps
 from ..certify.models import MAX_MU
@@ -24,7 +25,11 @@ from .st0 import evaluate_file
 from .synthesis import NOT_COUNTED, synthesize
 from .vision import read_image
 
-__all__ = ["register"]
+__all__ = ["register", "TOL_MIN", "TOL_MAX"]
+
+#: Range of independent-regions' --tol, pixels: the bisection takes log2(size / tol) steps, each
+#: a region certificate, so the finest tolerance bounds the work.
+TOL_MIN, TOL_MAX = 1e-6, 1e6
 
 
 def _fail(message: str) -> None:
@@ -69,12 +74,14 @@ def _segmentation(threshold: float | None, largest: bool, method: str, mask: Pat
     return {"threshold": threshold, "largest": largest, "method": method, "mask": mask, "rect": box}
 
 
-def _save(figure, path: Path, dpi: int) -> None:
-    """Save a figure, or exit 2 saying why it could not be written (a full disk, ...)."""
+def _save(figure, path: Path, dpi: int, reads: list[Path]) -> None:
+    """Save a figure through :func:`qualgrasp.certify.outputs.atomic_output` (never an input,
+    one writer at a time), or exit 2 saying why it could not be written (a full disk, ...)."""
     try:
-        figure.savefig(path, dpi=dpi)
-    except OSError as err:
-        _fail(f"--plot: cannot write {path} ({err.strerror or err})")
+        with atomic_output(path, "--plot", reads=reads) as tmp:
+            figure.savefig(tmp, dpi=dpi, format=path.suffix[1:].lower())
+    except CertifyError as err:
+        _fail(str(err))
 
 
 def register(app: typer.Typer) -> None:
@@ -179,13 +186,13 @@ def regions_command(
         number_in(finger_width, "--finger-width", 1e-3, 1, unit="(fraction of the object's size)")
         number_in(margin, "--margin", 0, 0.5, unit="(fraction of the object's size)", high_open=True)
         if plot is not None:
-            output_file(plot, "--plot", suffixes=FIGURE_SUFFIXES, reads=[image])
+            output_file(plot, "--plot", suffixes=FIGURE_SUFFIXES, reads=[image, *([mask] if mask else [])])
         outline = outline_image(image, **seg)
         regions = feasible_regions(outline, alpha, finger_width, margin)
     except (QualitativeError, ValueError) as err:
         _fail(str(err))
     if plot is not None:
-        _save(outline_figure(outline, regions, read_image(image)), plot, 120)
+        _save(outline_figure(outline, regions, read_image(image)), plot, 120, [image, *([mask] if mask else [])])
     if as_json:
         typer.echo(json.dumps(regions_to_dict(outline, regions, alpha, finger_width, margin)))
         return
@@ -255,19 +262,20 @@ def synthesize_command(
                       low_open=True, high_open=True, unit="degrees")
         if alpha is not None:
             number_in(alpha, "--alpha", 0, ALPHA_MAX, unit="(fraction of the object's size)")
-        output_file(output, "-o", reads=[image])
+        output_file(output, "-o", reads=[image, *([mask] if mask else [])])
         if plot is not None:
-            output_file(plot, "--plot", suffixes=FIGURE_SUFFIXES, reads=[image, output])
+            output_file(plot, "--plot", suffixes=FIGURE_SUFFIXES, reads=[image, *([mask] if mask else []), output])
         result = synthesize(image, fingers, mu, None if theta_min is None else math.radians(theta_min),
                             alpha, procedure=procedure, tolerance=not no_tolerance, scale=scale, **seg)
     except (QualitativeError, ValueError) as err:
         _fail(str(err))
+    reads = [image, *([mask] if mask else [])]
     try:
-        write_grasps(output, result.grasps)
-    except OSError as err:
-        _fail(f"-o: cannot write {output} ({err.strerror or err})")
+        write_grasps(output, result.grasps, reads=reads)
+    except CertifyError as err:
+        _fail(str(err))
     if plot is not None:
-        _save(synthesis_figure(result, read_image(image)), plot, 110)
+        _save(synthesis_figure(result, read_image(image)), plot, 110, [*reads, output])
     friction = "frictionless" if result.mu is None else f"mu {result.mu:.4g}"
     if not result.grasps:
         typer.echo(f"no grasp found: {result.procedure.title} ({result.fingers} fingers, {friction}): "
@@ -319,8 +327,8 @@ def independent_regions_command(
     output: Path = typer.Option(..., "-o", "--output", help="Results file (JSON Lines); never the grasp set."),
     asymmetric: bool = typer.Option(False, "--asymmetric", help="After the common delta, grow each finger's "
                                     "delta in turn (per-finger deltas)."),
-    tol: float | None = typer.Option(None, "--tol", help="Bisection tolerance on delta, pixels "
-                                     "(default 1e-3 of the object's size)."),
+    tol: float | None = typer.Option(None, "--tol", help="Bisection tolerance on delta, pixels, in "
+                                     f"[{TOL_MIN:g}, {TOL_MAX:g}] (default 1e-3 of the object's size)."),
     normal_tol: float = typer.Option(0.0, "--normal-tol", help="Tolerance on the normals, degrees."),
     budget: int = typer.Option(SEARCH_BUDGET, help="Branch-and-bound work units per region tuple tried "
                                "(curved stretches)."),
@@ -350,6 +358,7 @@ def independent_regions_command(
         raise typer.Exit(2)
     seg = _segmentation(threshold, largest, segmentation, mask, rect)
     try:
+        optional_number_in(tol, "--tol", TOL_MIN, TOL_MAX, unit="pixels")
         if alpha is not None:
             number_in(alpha, "--alpha", 0, ALPHA_MAX, unit="(fraction of the object's size)")
         summary = independent_file(image, grasps, output, symmetric=not asymmetric, tol=tol, budget=budget,

@@ -39,18 +39,19 @@ end of its region reaches less far on that side; ``slide`` says how far every fi
 from __future__ import annotations
 
 import json
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 
-from ..certify.errors import CertifyError, GraspError, GraspFileError
+from ..certify.errors import CertifyError, GraspError
 from ..certify.grasp import Grasp, grasp_from_dict
-from ..certify.region_boundary import SEARCH_BUDGET, IndependentRegions, independent_regions
+from ..certify.outputs import atomic_output, check_output
+from ..certify.region_boundary import SEARCH_BUDGET, IndependentRegions, bisection_tol, independent_regions
 from ..certify.region_data import tuple_to_dict
-from ..certify.validation import number, show
+from ..certify.table import json_lines
+from ..certify.validation import id_problem, number, show
 from .errors import QualitativeError
 from .outline import DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_contour, outline_image
 from .regions import ALPHA, ALPHA_MAX, FINGER_WIDTH, MARGIN, Region, feasible_regions
@@ -307,51 +308,49 @@ def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str 
     QualitativeError
         The image cannot be read or holds no single object.
     GraspFileError
-        The grasp set cannot be read, or the output is the grasp set.
+        The grasp set cannot be read as a whole (:func:`qualgrasp.certify.table.json_lines`: not
+        a regular file, not JSON Lines); a bad line is an error row.
+    OptionError
+        The output is an input (the grasp set, the image, the mask; through any link), a
+        folder, a FIFO or a device, or another run is writing it
+        (:func:`qualgrasp.certify.outputs.atomic_output`).
+    GraspError
+        ``tol`` is below :data:`qualgrasp.certify.region_boundary.TOL_FLOOR` of the object's size.
     """
     grasps_path, out_path = Path(grasps_path), Path(out_path)
-    try:
-        same = grasps_path.resolve() == out_path.resolve() or (out_path.exists() and os.path.samefile(grasps_path, out_path))
-    except OSError:
-        same = False
-    if same:
-        raise GraspFileError(f"the output {out_path} is the grasp set: choose another file")
-    try:
-        text = grasps_path.read_text(encoding="utf-8")
-    except OSError as err:
-        raise GraspFileError(f"cannot read {grasps_path}: {err.strerror or err}") from None
+    reads = [grasps_path, *(p for p in (image, mask) if isinstance(p, (str, Path)))]
+    check_output(out_path, "-o", reads=reads)  # before the image's work
     contour = extract_contour(image, threshold=threshold, largest=largest, method=method, mask=mask, rect=rect)
     outline = outline_contour(contour)
+    bisection_tol(tol, outline.size)
     cache: dict = {}
     summary = IndependentSummary()
-    rows = []
-    for number, line in enumerate(text.splitlines(), start=1):
-        if not line.strip():
-            continue
-        gid = None
-        try:
-            value = json.loads(line)
-            if isinstance(value, dict) and isinstance(value.get("id"), (str, int)) and not isinstance(value["id"], bool):
-                gid = value["id"]
-            grasp = grasp_from_dict(value)
-            regions = planned_regions(image, grasp, alpha=alpha, finger_width=finger_width, margin=margin,
-                                      outline=outline, contour=contour, cache=cache)
-            result = independent_grasp(outline, grasp, regions=regions, symmetric=symmetric, tol=tol,
-                                       budget=budget, normal_tol=normal_tol)
-            row = _row(gid, number, result)
-        except json.JSONDecodeError as err:
-            row = _row(None, number, error=f"line {number}: malformed JSON: {err.msg} (column {err.colno})")
-        except (CertifyError, QualitativeError) as err:  # a bad grasp, or no outline at its scale
-            row = _row(gid, number, error=f"line {number}: {err}")
-        rows.append(row)
-        summary.rows += 1
-        summary.statuses[row["status"]] = summary.statuses.get(row["status"], 0) + 1
-        summary.seconds += row["seconds"]
-        if progress is not None:
-            progress(1)
-    tmp = out_path.with_name(out_path.name + ".tmp")
-    with tmp.open("w", encoding="utf-8") as fh:
-        for row in rows:
+    with atomic_output(out_path, "-o", reads=reads) as tmp, tmp.open("w", encoding="utf-8") as fh:
+        for number, value in json_lines(grasps_path, "grasp set"):
+            row = _line_row(image, number, value, outline, contour, cache, alpha=alpha, finger_width=finger_width,
+                            margin=margin, symmetric=symmetric, tol=tol, budget=budget, normal_tol=normal_tol)
             fh.write(json.dumps(row, allow_nan=False) + "\n")
-    os.replace(tmp, out_path)
+            summary.rows += 1
+            summary.statuses[row["status"]] = summary.statuses.get(row["status"], 0) + 1
+            summary.seconds += row["seconds"]
+            if progress is not None:
+                progress(1)
     return summary
+
+
+def _line_row(image, number: int, value: Any, outline: Outline, contour: np.ndarray, cache: dict, *, alpha,
+              finger_width, margin, symmetric, tol, budget, normal_tol) -> dict:
+    """The results row of grasp line ``number`` (``value`` as :func:`qualgrasp.certify.table.json_lines`
+    reads it: a JSON value, or the error that made the line unreadable)."""
+    gid = value.get("id") if isinstance(value, dict) and id_problem(value.get("id")) is None else None
+    try:
+        if isinstance(value, Exception):
+            raise value
+        grasp = grasp_from_dict(value)
+        regions = planned_regions(image, grasp, alpha=alpha, finger_width=finger_width, margin=margin,
+                                  outline=outline, contour=contour, cache=cache)
+        result = independent_grasp(outline, grasp, regions=regions, symmetric=symmetric, tol=tol,
+                                   budget=budget, normal_tol=normal_tol)
+        return _row(gid, number, result)
+    except (CertifyError, QualitativeError) as err:  # a bad grasp, or no outline at its scale
+        return _row(gid, number, error=f"line {number}: {err}")
