@@ -64,6 +64,24 @@ def _start(args, cwd):
                             stderr=subprocess.PIPE)
 
 
+def _kill_after(proc, parts, count: int) -> bool:
+    """SIGKILL the run (its whole process group) once ``count`` parts are written, while it is
+    still running. The run goes on in steps of a few milliseconds between SIGSTOP and SIGCONT,
+    and parts are counted while it is stopped, so the kill always lands mid-run whatever the
+    machine's speed or load; False only when the run ended before writing ``count`` parts."""
+    while True:
+        os.killpg(proc.pid, signal.SIGSTOP)
+        done = len(list(parts.glob("part-*"))) if parts.exists() else 0
+        if proc.poll() is not None:
+            return False
+        if done >= count:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+            return True
+        os.killpg(proc.pid, signal.SIGCONT)
+        time.sleep(0.005)
+
+
 @pytest.mark.parametrize("fmt", ["jsonl", "parquet"])
 def test_kill_9_and_resume_loses_and_duplicates_nothing(grasp_files, tmp_path, fmt):
     jsonl, parquet, n = grasp_files
@@ -77,21 +95,11 @@ def test_kill_9_and_resume_loses_and_duplicates_nothing(grasp_files, tmp_path, f
             "--workers", "2"]
     kills = 0
     proc = _start(args, os.getcwd())
-    for delay in (0.0, 0.4, 0.8):  # kill at several moments, resuming each time
-        deadline = time.time() + 60
-        while time.time() < deadline and proc.poll() is None:
-            done = len(list(parts.glob("part-*"))) if parts.exists() else 0
-            if done >= 2 + 4 * kills:
-                break
-            time.sleep(0.02)
-        time.sleep(delay)
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait()
-            kills += 1
+    for round_ in range(3):  # kill mid-run three times, resuming each time
+        kills += _kill_after(proc, parts, 2 + 4 * round_)
         proc = _start(args + ["--resume"], os.getcwd())
     assert proc.wait(timeout=300) in (0, 1), proc.stderr.read().decode()
-    assert kills >= 1
+    assert kills == 3
     assert not parts.exists()
     rows = _rows(out)
     ids = [r["id"] for r in rows]
