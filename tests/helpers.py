@@ -1,4 +1,8 @@
-"""Independent geometry used by the tests."""
+"""Independent geometry used by the tests, and a way to interrupt a run mid-way on any machine."""
+
+import os
+import signal
+import time
 
 import numpy as np
 
@@ -29,3 +33,21 @@ def rotation(rng, dim):
     if np.linalg.det(q) < 0:
         q[:, 0] = -q[:, 0]
     return q
+
+
+def signal_after(proc, count_parts, count: int, sig=signal.SIGKILL) -> bool:
+    """Send ``sig`` to the process group of ``proc`` once ``count_parts()`` reaches ``count``,
+    while the run is still going. The run advances in steps of a few milliseconds between
+    SIGSTOP and SIGCONT and the parts are counted while it is stopped, so the signal always lands
+    mid-run whatever the machine's speed or load. Returns False only when the run ended first."""
+    while True:
+        os.killpg(proc.pid, signal.SIGSTOP)
+        done = count_parts()
+        if proc.poll() is not None:
+            return False
+        if done >= count:
+            os.killpg(proc.pid, sig)
+            os.killpg(proc.pid, signal.SIGCONT)
+            return True
+        os.killpg(proc.pid, signal.SIGCONT)
+        time.sleep(0.005)

@@ -2,10 +2,8 @@
 
 import json
 import os
-import signal
 import subprocess
 import sys
-import time
 
 import pyarrow.parquet as pq
 import pytest
@@ -14,6 +12,8 @@ from qualgrasp.certify import Grasp
 from qualgrasp.certify.batch import certify_file, verify_file
 from qualgrasp.certify.io import read_results, write_grasps
 from qualgrasp.certify.samples import random_grasps, textbook_grasps
+
+from helpers import signal_after
 
 BAD = '{"id": "bad", "contacts": [{"p": [0, 0], "n": [0, 0]}]}\n'
 
@@ -64,24 +64,6 @@ def _start(args, cwd):
                             stderr=subprocess.PIPE)
 
 
-def _kill_after(proc, parts, count: int) -> bool:
-    """SIGKILL the run (its whole process group) once ``count`` parts are written, while it is
-    still running. The run goes on in steps of a few milliseconds between SIGSTOP and SIGCONT,
-    and parts are counted while it is stopped, so the kill always lands mid-run whatever the
-    machine's speed or load; False only when the run ended before writing ``count`` parts."""
-    while True:
-        os.killpg(proc.pid, signal.SIGSTOP)
-        done = len(list(parts.glob("part-*"))) if parts.exists() else 0
-        if proc.poll() is not None:
-            return False
-        if done >= count:
-            os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait()
-            return True
-        os.killpg(proc.pid, signal.SIGCONT)
-        time.sleep(0.005)
-
-
 @pytest.mark.parametrize("fmt", ["jsonl", "parquet"])
 def test_kill_9_and_resume_loses_and_duplicates_nothing(grasp_files, tmp_path, fmt):
     jsonl, parquet, n = grasp_files
@@ -96,7 +78,10 @@ def test_kill_9_and_resume_loses_and_duplicates_nothing(grasp_files, tmp_path, f
     kills = 0
     proc = _start(args, os.getcwd())
     for round_ in range(3):  # kill mid-run three times, resuming each time
-        kills += _kill_after(proc, parts, 2 + 4 * round_)
+        killed = signal_after(proc, lambda: len(list(parts.glob("part-*"))) if parts.exists() else 0,
+                              2 + 4 * round_)
+        proc.wait()
+        kills += killed
         proc = _start(args + ["--resume"], os.getcwd())
     assert proc.wait(timeout=300) in (0, 1), proc.stderr.read().decode()
     assert kills == 3

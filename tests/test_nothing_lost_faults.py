@@ -14,7 +14,6 @@ import resource
 import signal
 import subprocess
 import sys
-import time
 import uuid
 from pathlib import Path
 
@@ -24,6 +23,8 @@ import pytest
 from qualgrasp.certify.batch import certify_file
 from qualgrasp.certify.io import read_results, write_grasps
 from qualgrasp.certify.samples import random_grasps
+
+from helpers import signal_after
 
 N, CHUNK = 600, 50
 LIMIT = 120  # seconds: longer is a hang
@@ -199,12 +200,8 @@ def test_sigint_then_resume_loses_and_duplicates_nothing(grasps, tmp_path):
     parts = tmp_path / "R.jsonl.parts"
     proc = subprocess.Popen([sys.executable, "-m", "qualgrasp.cli", "certify", str(src), "-o", str(out), *ARGS],
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
-    deadline = time.time() + LIMIT
-    while time.time() < deadline and proc.poll() is None and len(finished_parts(parts) if parts.exists() else []) < 2:
-        time.sleep(0.02)
-    if proc.poll() is None:
-        os.killpg(proc.pid, signal.SIGINT)
-    proc.wait(timeout=LIMIT)
+    assert signal_after(proc, lambda: len(finished_parts(parts)) if parts.exists() else 0, 2, signal.SIGINT)
+    assert proc.wait(timeout=LIMIT) != 0  # interrupted mid-run
     code, text = cli("certify", src, "-o", out, *ARGS, "--resume")
     assert code == 0, text
     assert_whole(out, refs["jsonl"])
