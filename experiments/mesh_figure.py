@@ -19,6 +19,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib import cm, colors  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noqa: E402
+import trimesh  # noqa: E402
+
+from ..certify.meshes.contacts import jaw_contacts  # noqa: E402
+from ..certify.meshes.gripper import load_gripper  # noqa: E402
+from ..certify.meshes.mesh import load_mesh, mass_properties  # noqa: E402
+from ..certify.meshes.poses import grasp_of  # noqa: E402
+from ..certify.meshes.sampling import sample_poses  # noqa: E402
+from ..certify.meshes.task import hold_verdict, least_grip  # noqa: E402
 
 __all__ = ["draw_grasps", "main"]
 
@@ -125,15 +133,6 @@ def draw_grasps(mesh, gripper, grasps: list[dict], path: str | Path, *, title: s
 
 def main(argv: list[str] | None = None) -> Path:
     """Command line (module docstring)."""
-    import trimesh
-
-    from ..certify.meshes.contacts import jaw_contacts
-    from ..certify.meshes.gripper import load_gripper
-    from ..certify.meshes.mesh import load_mesh, mass_properties
-    from ..certify.meshes.poses import grasp_of
-    from ..certify.meshes.sampling import sample_poses
-    from ..certify.meshes.task import least_grip, hold_verdict
-
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("out")
     parser.add_argument("--mesh", default=None)

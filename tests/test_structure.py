@@ -12,10 +12,12 @@ import pytest
 import qualgrasp
 
 ROOT = pathlib.Path(qualgrasp.__file__).parent
-#: Imports allowed inside functions: optional dependencies (dask.distributed), a platform module
+#: Imports allowed inside functions: optional dependencies (dask.distributed, h5py for ACRONYM
+#: pose files, embreex and trimesh's embree route where embreex installs), a platform module
 #: (resource), and cvxpy's reference route (1.5 s to import; only ``make_solver("reference")``
 #: needs it).
-LAZY = {"distributed", "resource", "qualgrasp.certify.solvers.reference"}
+LAZY = {"distributed", "resource", "qualgrasp.certify.solvers.reference", "h5py", "embreex",
+        "trimesh.ray.ray_pyembree"}
 
 
 def _modules():

@@ -29,6 +29,7 @@ from .gripper import CONVENTIONS, ParallelJaw, builtin_grippers, load_gripper
 from .mesh import UNITS, load_mesh, mass_properties
 from .poses import contact_row, error_row, grasp_of, read_poses
 from .rays import ENGINES, RayCaster
+from .sampling import sample_poses
 from .task import check_every_direction, check_holds, check_slips, every_direction, hold_verdict, least_grip
 
 __all__ = ["register", "contacts_file", "ContactsSummary", "write_rows"]
@@ -230,7 +231,6 @@ def sample_poses_command(
 ) -> None:
     """Sample antipodal parallel-jaw poses on a mesh (qualgrasp convention), free of collisions
     while approaching, ready for 'qualgrasp contacts'."""
-    from .sampling import sample_poses
 
     try:
         if n < 1 or n > 10_000_000:

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import trimesh
+from trimesh.ray import ray_triangle
 
 __all__ = ["ENGINES", "embree_available", "Hits", "RayCaster"]
 
@@ -80,11 +81,12 @@ class RayCaster:
         if name == "auto":
             name = "embree" if embree_available() else "triangle"
         if name == "embree":
-            from trimesh.ray.ray_pyembree import RayMeshIntersector
+            from trimesh.ray.ray_pyembree import RayMeshIntersector as Embree
+            intersector = Embree(self.mesh)
         else:
-            from trimesh.ray.ray_triangle import RayMeshIntersector
+            intersector = ray_triangle.RayMeshIntersector(self.mesh)
         object.__setattr__(self, "engine", name)
-        object.__setattr__(self, "_intersector", RayMeshIntersector(self.mesh))
+        object.__setattr__(self, "_intersector", intersector)
 
     def first_hits(self, origins: np.ndarray, directions: np.ndarray) -> Hits:
         """First hit of every ray ``origins[i] + t directions[i]``, ``t >= 0``.
