@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -152,8 +153,7 @@ def compare_command(
                   console=console) as bar:
         task = bar.add_task("compare", total=workload(len(images), settings))
         try:
-            result = compare(images, out, settings=settings,
-                             progress=lambda message: bar.update(task, advance=1, description=message))
+            result = compare(images, out, settings=settings, progress=_study_ticks(bar, task, settings))
         except CertifyError as err:
             _fail(str(err))
     table = Table(title=f"{len(result.objects)} objects, {result.seconds:.0f} s; eps: certified L1 of the "
@@ -179,6 +179,20 @@ def compare_command(
         console.print(f"skipped {escape(name)}: {escape(reason)}", soft_wrap=True)
     for path in result.files:
         console.print(f"wrote {path}", soft_wrap=True)
+
+
+def _study_ticks(bar: Progress, task, settings, before: int = 0):
+    """A progress callback for :func:`qualgrasp.experiments.study.compare` that keeps the bar's
+    total true: the study announces its objects and trials as ``'<phase> k/N'``, after leaving out
+    the images it cannot read, so the total becomes ``before`` (earlier steps) plus
+    :func:`qualgrasp.experiments.study.workload` of the objects actually compared, and the count
+    ends at it."""
+    def tick(message: str) -> None:
+        phase = re.fullmatch(r"objects \d+/(\d+)", message)
+        if phase:
+            bar.update(task, total=before + workload(int(phase.group(1)), settings))
+        bar.update(task, advance=1, description=message)
+    return tick
 
 
 def silhouettes_command(out: Path = typer.Option(Path("qualgrasp-silhouettes"), "--out", help="Output folder."),

@@ -18,12 +18,12 @@ from . import procedures
 from .errors import FormulaError, QualitativeError, TraceError
 from .grasp_plot import synthesis_figure
 from .independent import independent_file
-from .outline import DEFAULT_SCALE, SCALE_MAX, outline_image, outline_scales, outline_to_dict
+from .outline import SCALE_MAX, SCALE_MIN, outline_contour, outline_scales, outline_to_dict, planning_scale
 from .plot import outline_figure
-from .regions import ALPHA_MAX, feasible_regions, regions_to_dict
+from .regions import ALPHA_MAX, FINGER_WIDTH, MARGIN, planning_regions, regions_to_dict
 from .st0 import evaluate_file
 from .synthesis import NOT_COUNTED, synthesize
-from .vision import read_image
+from .vision import extract_contour, read_image
 
 __all__ = ["register", "TOL_MIN", "TOL_MAX"]
 
@@ -74,6 +74,17 @@ def _segmentation(threshold: float | None, largest: bool, method: str, mask: Pat
     return {"threshold": threshold, "largest": largest, "method": method, "mask": mask, "rect": box}
 
 
+def _finger_width(finger_width: float) -> None:
+    number_in(finger_width, "--finger-width", 1e-3, 1, unit="(fraction of the object's size)")
+
+
+def _scale_words(used: float, given: float | None, finger_width: float) -> str:
+    """``scale 0.00707 (the finger's: pad 0.08 of the object's size)``, or ``scale 0.01 (--scale)``."""
+    if given is not None:
+        return f"scale {used:.4g} (--scale)"
+    return f"scale {used:.4g} (the finger's: pad {finger_width:g} of the object's size)"
+
+
 def _save(figure, path: Path, dpi: int, reads: list[Path]) -> None:
     """Save a figure through :func:`qualgrasp.certify.outputs.atomic_output` (never an input,
     one writer at a time), or exit 2 saying why it could not be written (a full disk, ...)."""
@@ -114,7 +125,11 @@ def outline_command(
     image: Path = typer.Argument(..., help="Image file (PNG, JPEG, anything OpenCV reads)."),
     scale: float | None = typer.Option(None, "--scale", help="Smoothing scale: the Gaussian's standard "
                                        "deviation as a fraction of the object's perimeter, in (0, 0.032] "
-                                       "(default 0.004)."),
+                                       "(default the finger's, from --finger-width: the pad width over four "
+                                       "perimeters, never below 0.004)."),
+    finger_width: float = typer.Option(FINGER_WIDTH, "--finger-width", help="Finger pad width, fraction of "
+                                       "the object's size: sets the default --scale, the scale at which the "
+                                       "pad feels the outline (as for regions and synthesize)."),
     scales: bool = typer.Option(False, "--scales", help="Print the scale hierarchy instead: one line per "
                                 "range of scales (fractions of the perimeter) and its string."),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON object with keys string, scale and "
@@ -128,11 +143,12 @@ def outline_command(
 ) -> None:
     """Print the qualitative outline (canonical curvature-type string) of the object in an image.
 
-    With --scale S, at that smoothing scale (a finger pad of width W feels the outline at about
-    W / (4 * perimeter)); with --scales, the hierarchy from 0.004 to 0.032: one line per interval,
-    lo..hi<TAB>string. Coordinates in the JSON are pixels of the input image, x = column, y = row.
-    Exit code 2 when the image cannot be read or does not hold exactly one whole object, or on a
-    bad --scale.
+    By default at the finger's scale, where a pad of --finger-width (0.08 of the object's size)
+    feels the outline, W / (4 * perimeter), as regions and synthesize read it; with --scale S, at
+    that smoothing scale. The scale used is printed on standard error. With --scales, the hierarchy
+    from 0.004 to 0.032: one line per interval, lo..hi<TAB>string. Coordinates in the JSON are
+    pixels of the input image, x = column, y = row. Exit code 2 when the image cannot be read or
+    does not hold exactly one whole object, or on a bad --scale or --finger-width.
     """
 
     seg = _segmentation(threshold, largest, segmentation, mask, rect)
@@ -141,12 +157,18 @@ def outline_command(
     if scale is not None and not (math.isfinite(scale) and 0 < scale <= SCALE_MAX):
         _fail(f"--scale must be a fraction of the object's perimeter in (0, {SCALE_MAX:g}], got {scale:g}")
     try:
+        _finger_width(finger_width)
         if scales:
             hierarchy = outline_scales(image, **seg)
         else:
-            outline = outline_image(image, scale=DEFAULT_SCALE if scale is None else scale, **seg)
-    except QualitativeError as err:
+            contour = extract_contour(image, **seg)
+            fine = outline_contour(contour)
+            at = planning_scale(fine, finger_width) if scale is None else scale
+            outline = fine if at == fine.scale else outline_contour(contour, scale=at)
+    except (QualitativeError, ValueError) as err:
         _fail(str(err))
+    if not scales:
+        typer.echo(f"outline at {_scale_words(outline.scale, scale, finger_width)}: {outline.string}", err=True)
     if scales and as_json:
         typer.echo(json.dumps([{"lo": i.lo, "hi": i.hi, "string": i.string, "corners": i.corners,
                                 "convex": i.convex} for i in hierarchy]))
@@ -161,10 +183,14 @@ def regions_command(
     image: Path = typer.Argument(..., help="Image file (PNG, JPEG, anything OpenCV reads)."),
     alpha: float = typer.Option(0.5, "--alpha", help="Bounding-circle diameter threshold of curves, "
                                 "as a fraction of the object's size (its enclosing circle's diameter)."),
-    finger_width: float = typer.Option(0.08, "--finger-width",
-                                       help="Finger pad width, fraction of the object's size."),
-    margin: float = typer.Option(0.02, "--margin",
+    finger_width: float = typer.Option(FINGER_WIDTH, "--finger-width",
+                                       help="Finger pad width, fraction of the object's size; also sets the "
+                                       "default --scale (the finger's)."),
+    margin: float = typer.Option(MARGIN, "--margin",
                                  help="Distance kept from element ends, fraction of the object's size."),
+    scale: float | None = typer.Option(None, "--scale", help="Outline scale (Gaussian sigma as a fraction of "
+                                       "the perimeter, in (0, 0.032]); default the finger's, as for outline "
+                                       "and synthesize."),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON object with key regions."),
     plot: Path | None = typer.Option(None, "--plot", help="Save a figure of the outline and regions (PNG)."),
     largest: bool = LARGEST,
@@ -175,20 +201,25 @@ def regions_command(
 ) -> None:
     """Print the feasible grasp regions (paper, definitions 1 and 2) of the object in an image.
 
-    One line per region: type, arc-length interval along the contour (pixels), number of points
-    and smallest bounding-circle diameter. With --json: points and inward unit normals as lists of
-    [x, y] in pixels of the input image (x = column, y = row). Exit code 2 on unusable input.
+    On the outline at the finger's scale by default (the regions synthesize plans on; --scale to
+    choose another), whose scale and string are printed first. One line per region: type,
+    arc-length interval along the contour (pixels), number of points and smallest bounding-circle
+    diameter. With --json: points and inward unit normals as lists of [x, y] in pixels of the
+    input image (x = column, y = row), and the outline's scale. Exit code 2 on unusable input.
     """
 
     seg = _segmentation(threshold, largest, segmentation, mask, rect)
+    if scale is not None and not (math.isfinite(scale) and 0 < scale <= SCALE_MAX):
+        _fail(f"--scale must be a fraction of the object's perimeter in (0, {SCALE_MAX:g}], got {scale:g}")
     try:
         number_in(alpha, "--alpha", 0, ALPHA_MAX, unit="(fraction of the object's size)")
-        number_in(finger_width, "--finger-width", 1e-3, 1, unit="(fraction of the object's size)")
+        _finger_width(finger_width)
         number_in(margin, "--margin", 0, 0.5, unit="(fraction of the object's size)", high_open=True)
         if plot is not None:
             output_file(plot, "--plot", suffixes=FIGURE_SUFFIXES, reads=[image, *([mask] if mask else [])])
-        outline = outline_image(image, **seg)
-        regions = feasible_regions(outline, alpha, finger_width, margin)
+        contour = extract_contour(image, **seg)
+        outline, regions = planning_regions(contour, scale=scale, alpha=alpha, finger_width=finger_width,
+                                            margin=margin)
     except (QualitativeError, ValueError) as err:
         _fail(str(err))
     if plot is not None:
@@ -196,7 +227,8 @@ def regions_command(
     if as_json:
         typer.echo(json.dumps(regions_to_dict(outline, regions, alpha, finger_width, margin)))
         return
-    typer.echo(f"outline {outline.string}  size {outline.size:.1f} px  {len(regions)} feasible region(s)")
+    typer.echo(f"outline {outline.string}  at {_scale_words(outline.scale, scale, finger_width)}  "
+               f"size {outline.size:.1f} px  {len(regions)} feasible region(s)")
     for r in regions:
         rho = "inf" if r.rho == float("inf") else f"{r.rho:.1f}"
         typer.echo(f"{r.type}\tarc {r.arc[0]:.1f}..{r.arc[1]:.1f} px\t{len(r.points)} points\trho {rho} px")
@@ -232,6 +264,9 @@ def synthesize_command(
                                        "nothing is found."),
     no_tolerance: bool = typer.Option(False, "--no-tolerance", help="Skip the certified tolerance (independent "
                                       "contact regions) of each grasp, about 0.05 to 0.5 s per grasp."),
+    finger_width: float = typer.Option(FINGER_WIDTH, "--finger-width", help="Finger pad width, fraction of the "
+                                       "object's size: the feasible regions' pad and the default --scale (the "
+                                       "finger's), as for outline and regions."),
 ) -> None:
     """Synthesise grasps of the object in an image and write them in certify's grasp format.
 
@@ -262,11 +297,13 @@ def synthesize_command(
                       low_open=True, high_open=True, unit="degrees")
         if alpha is not None:
             number_in(alpha, "--alpha", 0, ALPHA_MAX, unit="(fraction of the object's size)")
+        _finger_width(finger_width)
         output_file(output, "-o", reads=[image, *([mask] if mask else [])])
         if plot is not None:
             output_file(plot, "--plot", suffixes=FIGURE_SUFFIXES, reads=[image, *([mask] if mask else []), output])
         result = synthesize(image, fingers, mu, None if theta_min is None else math.radians(theta_min),
-                            alpha, procedure=procedure, tolerance=not no_tolerance, scale=scale, **seg)
+                            alpha, procedure=procedure, tolerance=not no_tolerance, scale=scale,
+                            finger_width=finger_width, **seg)
     except (QualitativeError, ValueError) as err:
         _fail(str(err))
     reads = [image, *([mask] if mask else [])]
@@ -291,12 +328,16 @@ def synthesize_command(
     s = result.summary()
     typer.echo(f"{s['grasps']} grasp(s) by {result.procedure.title} ({result.fingers} fingers, {friction}) "
                f"at outline scale {result.scale:.4g} ({result.outline.string}), alpha {result.alpha:g}"
-               f"{_relaxed(result)}{'' if result.smooth else ', contacts of any normal spread'} -> {output}; "
+               f"{_relaxed(result)}{'' if result.smooth else ', contacts of any normal spread'}, on "
+               f"{len(result.regions)} feasible region(s) -> {output}; "
                f"{100 * s['certified_fraction']:.0f} % certified, {s['resolved']} resolved by the image; "
                f"synthesis {s['seconds']:.2f} s, certification {s['certify_seconds']:.2f} s"
                + ("" if s["median_slide_fraction"] is None else
                   f"; median certified slide {s['median_slide_fraction']:.3f} of the object's size "
                   "(every finger may slide that far either way)"))
+    typer.echo(f"regions: the grasps' region indices are those of 'qualgrasp regions {image} --scale "
+               f"{result.scale!r} --alpha {result.alpha!r} --finger-width {finger_width!r}' (same segmentation "
+               "options)")
     for reason in NOT_COUNTED:
         if s[reason.name]:
             typer.echo(f"note: {s[reason.name]} certified grasp(s) {reason.note}")
@@ -335,6 +376,11 @@ def independent_regions_command(
     alpha: float | None = typer.Option(None, "--alpha", help="Feasible regions: bounding-circle diameter "
                                        "threshold of curves, fraction of the object's size (default: each "
                                        "grasp's own field alpha, else 0.5)."),
+    scale: float | None = typer.Option(None, "--scale", help="Feasible regions: outline scale (Gaussian sigma as "
+                                       "a fraction of the perimeter, 0.001 to 0.032; default: each grasp's own "
+                                       "field scale, else the finger's, as for outline, regions and synthesize)."),
+    finger_width: float = typer.Option(FINGER_WIDTH, "--finger-width", help="Feasible regions: finger pad "
+                                       "width, fraction of the object's size (also sets the finger's scale)."),
     largest: bool = LARGEST,
     threshold: float | None = THRESHOLD,
     segmentation: str = SEGMENTATION,
@@ -361,8 +407,12 @@ def independent_regions_command(
         optional_number_in(tol, "--tol", TOL_MIN, TOL_MAX, unit="pixels")
         if alpha is not None:
             number_in(alpha, "--alpha", 0, ALPHA_MAX, unit="(fraction of the object's size)")
+        if scale is not None:
+            number_in(scale, "--scale", SCALE_MIN, SCALE_MAX, unit="(fraction of the object's perimeter)")
+        _finger_width(finger_width)
         summary = independent_file(image, grasps, output, symmetric=not asymmetric, tol=tol, budget=budget,
-                                   normal_tol=math.radians(normal_tol), alpha=alpha, **seg)
+                                   normal_tol=math.radians(normal_tol), alpha=alpha, scale=scale,
+                                   finger_width=finger_width, **seg)
     except (QualitativeError, CertifyError, ValueError) as err:
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(2)
@@ -376,5 +426,7 @@ def independent_regions_command(
                        f"{100 * row['slide_fraction']:.2f} % of the size\textents {extents} px")
     typer.echo(f"{summary.rows} grasp(s) -> {output}: " + ", ".join(f"{n} {s}" for s, n in sorted(summary.statuses.items()))
                + f"; {summary.seconds:.1f} s")
+    for at, string in summary.outlines.items():
+        typer.echo(f"feasible regions on the outline at scale {at:.4g}: {string}")
     if summary.errors:
         raise typer.Exit(1)

@@ -52,7 +52,7 @@ from shapely.geometry.base import BaseGeometry
 from .candidates import GAP, Candidates, separated
 from .errors import SynthesisError
 
-__all__ = ["MARGIN", "GAP", "ForceGrasp", "friction", "nguyen_angles", "span_margin",
+__all__ = ["MARGIN", "GAP", "ForceGrasp", "friction", "angle_between", "nguyen_angles", "span_margin",
            "positively_spans", "pair_grasps", "best_pair_angle", "triplet_grasps", "best_triplet_margins",
            "friction_cone", "friction_zone"]
 
@@ -75,12 +75,14 @@ class ForceGrasp:
     regions : tuple of int
         Region index of each contact.
     angles : tuple of float
-        Angle between each normal and its force direction (the grasp line for two fingers, the
-        direction to ``point`` for three), radians.
+        Angle between each normal and its force direction (the grasp line for two fingers and
+        for the opposed pair of ``pairgrasp3``, whose third finger pushes along its normal: 0;
+        the direction to ``point`` for three fingers by the friction zone), radians.
     margin : float
         Smallest angular distance to the closure boundary (cone edges, spanning), radians.
     point : numpy.ndarray or None
-        Three fingers: the point of the friction zone where the forces meet (pixels).
+        Three fingers by the friction zone: the point where the forces meet (pixels); None for
+        two fingers and for an opposed pair with a third finger.
     theta_min : float
         Half-angle of the friction cones, radians.
     """
@@ -114,8 +116,16 @@ def friction(mu: float | None = None, theta_min: float | None = None) -> tuple[f
     return math.tan(theta_min), float(theta_min)
 
 
-def _angle(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Unsigned angle between vectors (last axis 2), accurate near 0 and pi."""
+def angle_between(u, v) -> np.ndarray:
+    """Unsigned angle between planar vectors (last axis 2; arrays broadcast), radians, accurate
+    near 0 and pi.
+
+    Examples
+    --------
+    >>> round(float(np.degrees(angle_between([1, 0], [1, 1]))), 6)
+    45.0
+    """
+    u, v = np.asarray(u, dtype=float), np.asarray(v, dtype=float)
     cross = u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
     dot = (u * v).sum(axis=-1)
     return np.arctan2(np.abs(cross), dot)
@@ -127,7 +137,7 @@ def nguyen_angles(p1, n1, p2, n2) -> tuple[np.ndarray, np.ndarray]:
     Arrays broadcast over leading axes; the last axis holds (x, y).
     """
     d = np.asarray(p2, dtype=float) - np.asarray(p1, dtype=float)
-    return _angle(np.asarray(n1, dtype=float), d), _angle(np.asarray(n2, dtype=float), -d)
+    return angle_between(np.asarray(n1, dtype=float), d), angle_between(np.asarray(n2, dtype=float), -d)
 
 
 def span_margin(vectors) -> np.ndarray:
@@ -273,7 +283,7 @@ def triplet_grasps(cands: Candidates, contour: np.ndarray, theta_min: float, siz
         if best is None or best[1] < margin * theta_min:
             continue
         idx, score, x = best
-        ang = _angle(N[idx], x - P[idx])
+        ang = angle_between(N[idx], x - P[idx])
         found.append(ForceGrasp(tuple(int(i) for i in idx), P[idx], N[idx],
                                 tuple(int(cands.region[i]) for i in idx), tuple(float(v) for v in ang),
                                 float(score), x.copy(), theta_min))
@@ -381,7 +391,7 @@ def _scores(triple, combos, X, cands, far, theta_min) -> tuple[np.ndarray, np.nd
         taken: list[np.ndarray] = []
         for r in triple:
             idx = cands.of_region(r)
-            cone = theta_min - _angle(N[idx][:, None, :], X[None] - P[idx][:, None, :])
+            cone = theta_min - angle_between(N[idx][:, None, :], X[None] - P[idx][:, None, :])
             taken.append(_pick(idx[np.argsort(-cone, axis=0, kind="stable")], taken, far))
         T = np.stack(taken)
         valid = (T >= 0).all(axis=0)
@@ -404,7 +414,7 @@ def _margins(T: np.ndarray, X: np.ndarray, P, N, theta_min: float) -> np.ndarray
     """Smallest of the cone margins of the meeting points ``X`` and the spanning margins of the
     force directions and of the normals, for contact triples ``T`` (first axis: the three)."""
     d = X - P[T]  # (3, ..., 2)
-    cone = (theta_min - _angle(N[T], d)).min(axis=0)
+    cone = (theta_min - angle_between(N[T], d)).min(axis=0)
     forces = span_margin(np.moveaxis(d, 0, -2))
     normals = span_margin(np.moveaxis(N[T], 0, -2))
     return np.minimum(np.minimum(cone, forces), normals)

@@ -191,8 +191,8 @@ def plot_grasp(ax: Axes, synth: Synthesis, k: int, image: np.ndarray | None = No
                 reach = np.minimum(2 * size, 1.1 * far / math.cos(grasp.theta_min))
         for p, n, r in zip(grasp.points, grasp.normals, reach):
             _draw_cone(ax, p, n, grasp.theta_min, r)
-        if len(grasp.points) == 2:
-            a, b = grasp.points
+        if len(grasp.points) == 2 or grasp.point is None:  # the grasp line of a pair (and its third finger)
+            a, b = grasp.points[:2]
             ax.plot([a[0], b[0]], [a[1], b[1]], color="tab:red", lw=1.5, zorder=5)
         elif grasp.point is not None:
             _draw_geometry(ax, zone, {"facecolor": "tab:green", "edgecolor": "darkgreen", "alpha": 0.45}, zorder=4)
@@ -303,6 +303,9 @@ def synthesis_figure(synth: Synthesis, image: np.ndarray | None = None, count: i
              + f": {len(synth.grasps)} grasp(s)")
     if synth.certified_fraction is not None:
         title += f", {100 * synth.certified_fraction:.0f} % certified"
+    # the outline and regions the grasps were planned on (their region indices refer to these)
+    title += (f"\noutline {synth.outline.string} at scale {synth.scale:.4g}, {len(synth.regions)} feasible "
+              f"region(s) at alpha {synth.alpha:g}")
     if not order:
         fig = Figure(figsize=(7.5, 6.0), layout="constrained")
         FigureCanvasAgg(fig)

@@ -53,8 +53,8 @@ from ..certify.region_data import tuple_to_dict
 from ..certify.table import json_lines
 from ..certify.validation import id_problem, number, show
 from .errors import QualitativeError
-from .outline import DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_contour, outline_image
-from .regions import ALPHA, ALPHA_MAX, FINGER_WIDTH, MARGIN, Region, feasible_regions
+from .outline import DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_contour, planning_scale
+from .regions import ALPHA, ALPHA_MAX, FINGER_WIDTH, MARGIN, Region, feasible_regions, planning_regions
 from .vision import ImageSource, extract_contour
 
 __all__ = ["ON_OUTLINE", "outline_boundary", "contact_limits", "planned_regions", "independent_grasp",
@@ -139,12 +139,14 @@ def contact_limits(outline: Outline, regions: list[Region], points: np.ndarray, 
 def planned_regions(image: ImageSource, grasp: Grasp, *, alpha: float | None = None,
                     finger_width: float = FINGER_WIDTH, margin: float = MARGIN, threshold: float | None = None,
                     largest: bool = False, outline: Outline | None = None, contour: np.ndarray | None = None,
-                    cache: dict | None = None) -> list[Region]:
-    """The feasible regions a grasp was planned on: those of the image's outline at the grasp's
-    field ``scale`` (default :data:`~qualgrasp.qualitative.outline.DEFAULT_SCALE`) with the
-    curvature threshold ``alpha`` when given, else the grasp's field ``alpha``, else
-    :data:`~qualgrasp.qualitative.regions.ALPHA` (as
-    :func:`qualgrasp.qualitative.synthesis.synthesize` records them).
+                    cache: dict | None = None, scale: float | None = None) -> list[Region]:
+    """The feasible regions a grasp was planned on: those of the image's outline at the scale
+    ``scale`` when given, else the grasp's field ``scale``, else the finger's
+    (:func:`qualgrasp.qualitative.outline.planning_scale` of ``finger_width``, the default of every
+    qualitative command), with the curvature threshold ``alpha`` when given, else the grasp's field
+    ``alpha``, else :data:`~qualgrasp.qualitative.regions.ALPHA` (as
+    :func:`qualgrasp.qualitative.synthesis.synthesize` records them), found by
+    :func:`qualgrasp.qualitative.regions.planning_regions` as synthesis finds them.
 
     Parameters
     ----------
@@ -157,15 +159,16 @@ def planned_regions(image: ImageSource, grasp: Grasp, *, alpha: float | None = N
     threshold, largest
         As for :func:`~qualgrasp.qualitative.outline.outline_image`.
     outline : Outline, optional
-        The image's outline at some scale, used instead of extracting it again when the grasp's
-        scale is that one.
+        The image's outline at the default scale (the fine one regions take their normals from).
     contour : numpy.ndarray, optional
         The object's contour as extracted from the image
-        (:func:`qualgrasp.qualitative.vision.extract_contour`): outlines at other scales are
-        computed from it, and the image is not segmented again.
+        (:func:`qualgrasp.qualitative.vision.extract_contour`): outlines are computed from it, and
+        the image is not segmented again.
     cache : dict, optional
-        Regions already found, by ``(scale, alpha)`` (filled in); for one image, ``threshold``,
-        ``largest``, ``finger_width`` and ``margin``.
+        Regions already found, by ``(scale, alpha)``, and the outline of each scale, by ``scale``
+        (filled in); for one image, ``threshold``, ``largest``, ``finger_width`` and ``margin``.
+    scale : float, optional
+        The outline's scale, overriding the grasp's field.
 
     Returns
     -------
@@ -176,7 +179,13 @@ def planned_regions(image: ImageSource, grasp: Grasp, *, alpha: float | None = N
     GraspError
         The grasp's field ``scale`` or ``alpha`` is not a number in range.
     """
-    scale = number(grasp.meta.get("scale", DEFAULT_SCALE))
+    if contour is None:
+        contour = extract_contour(image, threshold=threshold, largest=largest)
+    if outline is None or outline.scale != DEFAULT_SCALE:
+        outline = outline_contour(contour)
+    if scale is None and "scale" not in grasp.meta:
+        scale = planning_scale(outline, finger_width)
+    scale = number(grasp.meta.get("scale") if scale is None else scale)
     if scale is None or not SCALE_MIN <= scale <= SCALE_MAX:
         raise GraspError(f"field scale: expected the outline's scale in [{SCALE_MIN:g}, {SCALE_MAX:g}], "
                          f"got {show(grasp.meta.get('scale'))}")
@@ -185,14 +194,13 @@ def planned_regions(image: ImageSource, grasp: Grasp, *, alpha: float | None = N
         if alpha is None or not 0 <= alpha <= ALPHA_MAX:
             raise GraspError(f"field alpha: expected a curvature threshold in [0, {ALPHA_MAX:g}] (fraction of "
                              f"the object's size), got {show(grasp.meta.get('alpha'))}")
+    scale = float(scale)
     key = (scale, float(alpha))
     cache = {} if cache is None else cache
     if key not in cache:
-        if outline is None or outline.scale != scale:
-            outline = (outline_image(image, scale=scale, threshold=threshold, largest=largest) if contour is None
-                       else outline_contour(contour, scale=scale))
-        cache[key] = feasible_regions(outline, key[1], finger_width, margin)
-    return cache[key]
+        cache[scale], cache[key] = planning_regions(contour, scale=scale, alpha=key[1], finger_width=finger_width,
+                                                    margin=margin, fine=outline)
+    return list(cache[key])
 
 
 def independent_grasp(outline: Outline, grasp: Grasp, *, regions: list[Region] | None = None,
@@ -243,11 +251,13 @@ def independent_grasp(outline: Outline, grasp: Grasp, *, regions: list[Region] |
 
 @dataclass
 class IndependentSummary:
-    """Counts of an :func:`independent_file` run: ``rows``, ``statuses``, ``seconds``."""
+    """Counts of an :func:`independent_file` run: ``rows``, ``statuses``, ``seconds``, and the
+    outline string of every scale whose regions were used (``outlines``, by scale)."""
 
     rows: int = 0
     statuses: dict[str, int] = field(default_factory=dict)
     seconds: float = 0.0
+    outlines: dict[float, str] = field(default_factory=dict)
 
     @property
     def errors(self) -> int:
@@ -274,7 +284,8 @@ def _row(gid, line, result: IndependentRegions | None = None, error: str | None 
 def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str | Path, *, symmetric: bool = True,
                      tol: float | None = None, budget: int = SEARCH_BUDGET, normal_tol: float = 0.0,
                      alpha: float | None = None, finger_width: float = FINGER_WIDTH, margin: float = MARGIN,
-                     threshold: float | None = None, largest: bool = False, method: str = "otsu",
+                     scale: float | None = None, threshold: float | None = None, largest: bool = False,
+                     method: str = "otsu",
                      mask: ImageSource | None = None, rect: tuple[int, int, int, int] | None = None,
                      progress: Callable[[int], None] | None = None) -> IndependentSummary:
     """Independent contact regions of every grasp of a grasp set (JSON Lines) on an image's object.
@@ -293,6 +304,9 @@ def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str 
         Feasible regions' parameters (:func:`~qualgrasp.qualitative.regions.feasible_regions`);
         each grasp's regions are those it was planned on (:func:`planned_regions`: its fields
         ``scale`` and ``alpha``, ``alpha`` given overriding the latter).
+    scale : float, optional
+        The outline's scale of every grasp's regions, overriding its field ``scale`` (default:
+        the field, else the finger's scale, :func:`planned_regions`).
     threshold, largest, method, mask, rect
         Segmentation (:func:`qualgrasp.qualitative.vision.extract_contour`); the contour is
         extracted once, and every scale's outline computed from it.
@@ -328,18 +342,20 @@ def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str 
     with atomic_output(out_path, "-o", reads=reads) as tmp, tmp.open("w", encoding="utf-8") as fh:
         for number, value in json_lines(grasps_path, "grasp set"):
             row = _line_row(image, number, value, outline, contour, cache, alpha=alpha, finger_width=finger_width,
-                            margin=margin, symmetric=symmetric, tol=tol, budget=budget, normal_tol=normal_tol)
+                            margin=margin, scale=scale, symmetric=symmetric, tol=tol, budget=budget,
+                            normal_tol=normal_tol)
             fh.write(json.dumps(row, allow_nan=False) + "\n")
             summary.rows += 1
             summary.statuses[row["status"]] = summary.statuses.get(row["status"], 0) + 1
             summary.seconds += row["seconds"]
             if progress is not None:
                 progress(1)
+    summary.outlines = {k: cache[k].string for k in sorted(k for k in cache if isinstance(k, float))}
     return summary
 
 
 def _line_row(image, number: int, value: Any, outline: Outline, contour: np.ndarray, cache: dict, *, alpha,
-              finger_width, margin, symmetric, tol, budget, normal_tol) -> dict:
+              finger_width, margin, scale, symmetric, tol, budget, normal_tol) -> dict:
     """The results row of grasp line ``number`` (``value`` as :func:`qualgrasp.certify.table.json_lines`
     reads it: a JSON value, or the error that made the line unreadable)."""
     gid = value.get("id") if isinstance(value, dict) and id_problem(value.get("id")) is None else None
@@ -348,7 +364,7 @@ def _line_row(image, number: int, value: Any, outline: Outline, contour: np.ndar
             raise value
         grasp = grasp_from_dict(value)
         regions = planned_regions(image, grasp, alpha=alpha, finger_width=finger_width, margin=margin,
-                                  outline=outline, contour=contour, cache=cache)
+                                  outline=outline, contour=contour, cache=cache, scale=scale)
         result = independent_grasp(outline, grasp, regions=regions, symmetric=symmetric, tol=tol,
                                    budget=budget, normal_tol=normal_tol)
         return _row(gid, number, result)

@@ -144,6 +144,8 @@ __all__ = [
     "outline_image",
     "ScaleInterval",
     "finger_scale",
+    "planning_scale",
+    "tls_line",
     "outline_contour_scales",
     "outline_scales",
     "outline_to_dict",
@@ -730,8 +732,16 @@ def _close_up(items: list[list]) -> None:
         min(cusps, key=lambda item: abs(item[3]))[0] = angle
 
 
-def _tls_line(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Total-least-squares line: a point on it and the unit direction (along the points' order)."""
+def tls_line(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Total-least-squares line through ``(m, 2)`` points: a point on it (their mean) and its unit
+    direction (along the points' order).
+
+    Examples
+    --------
+    >>> p, t = tls_line(np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]))
+    >>> p.tolist(), np.round(t, 4).tolist()
+    ([1.0, 1.0], [0.7071, 0.7071])
+    """
     mean = points.mean(axis=0)
     direction = np.linalg.svd(points - mean, full_matrices=False)[2][0]
     if np.dot(points[-1] - points[0], direction) < 0:
@@ -747,8 +757,8 @@ def _apex(points: np.ndarray, phi: np.ndarray, item: list, half: int, spacing: f
     sharpest = points[span[np.argmax(np.abs(phi[span]))]]
     if symbol in "}{" or half < 2:
         return sharpest
-    p1, u1 = _tls_line(points[np.arange(start - half, start) % n])
-    p2, u2 = _tls_line(points[np.arange(stop, stop + half) % n])
+    p1, u1 = tls_line(points[np.arange(start - half, start) % n])
+    p2, u2 = tls_line(points[np.arange(stop, stop + half) % n])
     cross = u1[0] * u2[1] - u1[1] * u2[0]
     if abs(cross) < math.sin(math.radians(10)):
         return sharpest
@@ -770,7 +780,7 @@ def _segment(item: list, points: np.ndarray, phi: np.ndarray, half: int, spacing
     if symbol in _POINTS:
         position = _frozen(_apex(points, phi, [symbol, start, stop], half, spacing))
     elif symbol == "/":
-        mean, direction = _tls_line(span)
+        mean, direction = tls_line(span)
         ends = (span[[0, -1]] - mean) @ direction
         endpoints = _frozen(mean + ends[:, None] * direction)
     return Segment(symbol, int(start), int(stop), (start * spacing, stop * spacing), float(turning),
@@ -1094,6 +1104,40 @@ def finger_scale(outline: Outline | np.ndarray, finger_width: float, *, samples:
     else:
         _, perimeter, size = _prepare(outline, samples)
     return width * size / (4.0 * perimeter)
+
+
+def planning_scale(outline: Outline | np.ndarray, finger_width: float, *, samples: int = 1024) -> float:
+    """The scale every qualitative command reads an object's outline at by default: the finger's
+    (:func:`finger_scale`), never finer than :data:`DEFAULT_SCALE` nor coarser than
+    :data:`SCALE_MAX`.
+
+    ``qualgrasp outline``, ``regions``, ``synthesize``, ``independent-regions``, ``compare`` and the
+    figures all start from it, so the string shown and the regions the grasps are planned on are
+    those of one outline. The built-in objects keep their strings there (figure 3's ``/}(</{)>``
+    among them): their features are several pads wide.
+
+    Parameters
+    ----------
+    outline : Outline or numpy.ndarray
+        As for :func:`finger_scale`.
+    finger_width : float
+        Pad width, fraction of the object's size.
+    samples : int
+        Resampling of a contour given as an array.
+
+    Returns
+    -------
+    float
+        Scale, fraction of the perimeter.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> square = np.array([[0, 0], [100, 0], [100, 100], [0, 100]], float)
+    >>> round(planning_scale(square, 0.08), 5), planning_scale(square, 0.01), planning_scale(square, 1.0)
+    (0.00707, 0.004, 0.032)
+    """
+    return min(SCALE_MAX, max(DEFAULT_SCALE, finger_scale(outline, finger_width, samples=samples)))
 
 
 def _string_at(points: np.ndarray, scale: float, options: dict) -> str:

@@ -3,7 +3,8 @@
 Graspable elements are the line-like curvature types ``/``, ``)`` and ``(``; no finger goes on an
 angle or a cusp. A point of a graspable element is a **feasible contact** when a finger pad of
 width ``finger_width`` centred there lies on the element at least ``margin`` away from both of its
-ends, and, on a curve, the contour under the pad is flat enough: the diameter ``rho`` of its
+ends (a straight edge's ends are its corners, and a pad may overhang an outward one: notes
+below), and, on a curve, the contour under the pad is flat enough: the diameter ``rho`` of its
 bounding circle exceeds ``alpha``. A region is a maximal run of feasible contacts on one element.
 
 Readings and units
@@ -15,6 +16,18 @@ Readings and units
   ``rho`` means flat. The turning is the element's own, averaged over a pad's length within the
   element (so pixel noise averages out and the neighbouring corners cannot leak in); a region's
   ends are therefore located to about a pad. Straight lines are not checked (paper, footnote 5).
+* **Straight edges.** A straight element ends where its edge does: at a neighbouring angle (``>``
+  or ``<``), the edge runs on into the angle's window in the outline for as long as the contour
+  stays within :data:`ON_LINE` pixels of the element's fitted line, so the edge's end is where
+  the contour leaves it, whatever the outline's scale (at the finger's scale the windows are
+  wider). A pad's centre keeps ``margin`` from an end at an outward angle (the pad may overhang
+  it: nothing is there) and ``margin`` plus half a pad from an end at an inward angle (the other
+  face blocks the pad) or at any other element. The region's points and normal are those of the
+  line fitted (total least squares) to the whole edge, end to end (not to the element's own
+  samples alone, which at a coarse scale may be a short link between two corner windows). An edge
+  shorter than a pad has no region: a pad would rest on nothing. So an edge several pads long
+  gets a region of its length less the margins (a quarter of a pad at an outward corner with the
+  defaults).
 * **Points.** A region's points are the contour samples (spacing ``P / 1024``) where the centre of
   the finger pad may go; the pad covers ``finger_width`` of contour around each of them.
 * **Units.** ``alpha``, ``finger_width`` and ``margin`` are fractions of the object's size ``D``,
@@ -33,17 +46,17 @@ Readings and units
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Any
+from dataclasses import dataclass, replace
+from typing import Any, Sequence
 
 import numpy as np
 from scipy import ndimage
 
-from .outline import Outline, outline_image
-from .vision import ImageSource
+from .outline import Outline, outline_contour, planning_scale, tls_line
+from .vision import ImageSource, extract_contour
 
-__all__ = ["ALPHA", "ALPHA_MAX", "FINGER_WIDTH", "MARGIN", "GRASPABLE", "Region", "feasible_regions",
-           "regions_image", "regions_to_dict"]
+__all__ = ["ALPHA", "ALPHA_MAX", "FINGER_WIDTH", "MARGIN", "GRASPABLE", "ON_LINE", "Region", "feasible_regions",
+           "on_fine_outline", "planning_regions", "regions_image", "regions_to_dict"]
 
 ALPHA = 0.5
 #: Largest curvature threshold the command line and grasp fields accept (fraction of the size).
@@ -51,6 +64,9 @@ ALPHA_MAX = 100.0
 FINGER_WIDTH = 0.08
 MARGIN = 0.02
 GRASPABLE = "/)("
+#: Largest distance (pixels) of the contour from a straight element's line where the edge runs on
+#: into a neighbouring angle's span: the image's resolution.
+ON_LINE = 1.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -157,6 +173,9 @@ def feasible_regions(outline: Outline, alpha: float = ALPHA, finger_width: float
     for k, seg in enumerate(outline.segments):
         if seg.symbol not in GRASPABLE:
             continue
+        if seg.symbol == "/" and not closed:
+            regions += _edge_regions(outline, k, finger_width, margin)
+            continue
         length = seg.stop - seg.start
         lo, hi = (0, length) if closed else (math.ceil(keep), math.floor(length - keep) + 1)
         if hi <= lo:
@@ -176,14 +195,53 @@ def feasible_regions(outline: Outline, alpha: float = ALPHA, finger_width: float
     return regions
 
 
-def _region(outline: Outline, k: int, idx: np.ndarray, rho: np.ndarray, normals: np.ndarray) -> Region:
+def _edge_end(outline: Outline, k: int, side: int, a: np.ndarray, normal: np.ndarray, half_pad: float,
+              margin: float) -> tuple[int, float]:
+    """One end of the straight element ``k`` (``side`` -1: its start, +1: its stop): how many
+    samples of a neighbouring angle's window the edge runs on into (the raw contour within
+    :data:`ON_LINE` pixels of the element's line through ``a`` with unit ``normal``, without a
+    break), and what a pad's centre keeps from that end, pixels (module notes, straight edges)."""
+    n, segs = len(outline.contour), outline.segments
+    seg, neighbour = segs[k], segs[(k + side) % len(segs)]
+    reach = 0
+    if neighbour.symbol in "><":
+        own = seg.start if side < 0 else seg.stop - 1
+        span = neighbour.stop - neighbour.start
+        off = np.abs((outline.contour[(own + side * np.arange(1, span + 1)) % n] - a) @ normal) > ON_LINE
+        reach = int(np.argmax(off)) if off.any() else span
+    return reach, margin if neighbour.symbol == ">" else margin + half_pad  # a pad may overhang an outward angle
+
+
+def _edge_regions(outline: Outline, k: int, finger_width: float, margin: float) -> list[Region]:
+    """Feasible regions of the straight element ``k`` (module notes, straight edges), on the line
+    fitted to the whole edge."""
+    n, seg = len(outline.contour), outline.segments[k]
+    a, b = seg.endpoints
+    if not np.linalg.norm(b - a) > 0:
+        return []
+    t = (b - a) / np.linalg.norm(b - a)
+    half_pad, keep = finger_width * outline.size / 2, margin * outline.size
+    before, first = _edge_end(outline, k, -1, a, np.array([-t[1], t[0]]), half_pad, keep)
+    after, last = _edge_end(outline, k, +1, a, np.array([-t[1], t[0]]), half_pad, keep)
+    idx = np.arange(seg.start - before, seg.stop + after)
+    mean, t = tls_line(outline.contour[idx % n])
+    along = (outline.contour[idx % n] - mean) @ t
+    if along[-1] - along[0] < 2 * half_pad:
+        return []  # an edge shorter than the pad: nothing for a pad to rest on
+    regions = []
+    for i, j in _runs((along >= along[0] + first) & (along <= along[-1] - last)):
+        regions.append(_region(outline, k, idx[i:j], np.full(j - i, np.inf), np.zeros((0, 2)), (mean, t)))
+    return regions
+
+
+def _region(outline: Outline, k: int, idx: np.ndarray, rho: np.ndarray, normals: np.ndarray,
+            line: tuple[np.ndarray, np.ndarray] | None = None) -> Region:
     n, h = len(outline.contour), outline.spacing
     seg = outline.segments[k]
     start = int(idx[0] % n)
     stop = start + len(idx)
     if seg.symbol == "/":
-        a, b = seg.endpoints
-        t = (b - a) / np.linalg.norm(b - a)
+        a, t = line  # a point on the edge's fitted line and its unit direction
         points = a + np.outer((outline.contour[idx % n] - a) @ t, t)
         nrm = np.tile([-t[1], t[0]], (len(idx), 1))
     else:
@@ -193,10 +251,66 @@ def _region(outline: Outline, k: int, idx: np.ndarray, rho: np.ndarray, normals:
                   float(rho.min()) if len(rho) else math.inf)
 
 
+def on_fine_outline(regions: Sequence[Region], fine: Outline, outline: Outline) -> tuple[Region, ...]:
+    """Regions of ``outline`` (a coarser scale of ``fine``; the contour is the same at every scale)
+    with the fine outline's normals on curves and, on straight regions, the contour's own points
+    (a coarse fitted line may pass pixels away from a bumpy edge) with the line's normal: the
+    contacts and normals the procedures reason on and certification sees (module notes)."""
+    if outline is fine:
+        return tuple(regions)
+    normals = np.asarray(fine.normals())
+    n = len(fine.contour)
+    out = []
+    for r in regions:
+        idx = np.arange(r.start, r.stop) % n
+        out.append(replace(r, points=fine.contour[idx]) if r.type == "/" else replace(r, normals=normals[idx]))
+    return tuple(out)
+
+
+def planning_regions(contour: np.ndarray, *, scale: float | None = None, alpha: float = ALPHA,
+                     finger_width: float = FINGER_WIDTH, margin: float = MARGIN,
+                     fine: Outline | None = None) -> tuple[Outline, tuple[Region, ...]]:
+    """The outline and feasible regions grasps are planned on (module notes, scale).
+
+    Parameters
+    ----------
+    contour : numpy.ndarray
+        ``(m, 2)`` closed contour as extracted from the image
+        (:func:`qualgrasp.qualitative.vision.extract_contour`), pixels.
+    scale : float, optional
+        Outline scale, fraction of the perimeter; default
+        :func:`qualgrasp.qualitative.outline.planning_scale` of ``finger_width`` (the finger's).
+    alpha, finger_width, margin : float
+        As for :func:`feasible_regions`.
+    fine : Outline, optional
+        The contour's outline at the default scale (computed when not given).
+
+    Returns
+    -------
+    outline : Outline
+        The outline at ``scale``.
+    regions : tuple of Region
+        Its feasible regions, carrying the fine outline's normals on curves and the contour's own
+        points on straight lines (:func:`on_fine_outline`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> square = np.array([[0, 0], [100, 0], [100, 100], [0, 100]], float)
+    >>> outline, regions = planning_regions(square)
+    >>> outline.string, round(outline.scale, 5), len(regions)
+    ('/>/>/>/>', 0.00707, 4)
+    """
+    fine = outline_contour(contour) if fine is None else fine
+    scale = planning_scale(fine, finger_width) if scale is None else scale
+    outline = fine if scale == fine.scale else outline_contour(contour, scale=scale)
+    return outline, on_fine_outline(feasible_regions(outline, alpha, finger_width, margin), fine, outline)
+
+
 def regions_image(src: ImageSource, *, alpha: float = ALPHA, finger_width: float = FINGER_WIDTH,
-                  margin: float = MARGIN, threshold: float | None = None, largest: bool = False,
-                  **options) -> list[Region]:
-    """Feasible grasp regions of the object in an image.
+                  margin: float = MARGIN, scale: float | None = None, threshold: float | None = None,
+                  largest: bool = False, **options) -> list[Region]:
+    """Feasible grasp regions of the object in an image, on the outline at the finger's scale.
 
     Parameters
     ----------
@@ -204,21 +318,24 @@ def regions_image(src: ImageSource, *, alpha: float = ALPHA, finger_width: float
         Image file or array (see :func:`qualgrasp.qualitative.vision.read_image`).
     alpha, finger_width, margin : float
         See :func:`feasible_regions` (fractions of the object's size).
+    scale : float, optional
+        Outline scale (default the finger's, :func:`planning_regions`).
     threshold, largest, **options
-        See :func:`qualgrasp.qualitative.outline.outline_image`.
+        Segmentation (:func:`qualgrasp.qualitative.vision.extract_contour`).
 
     Returns
     -------
     list of Region
         Points and normals in pixels of the input image (x = column, y = row).
     """
-    outline = outline_image(src, threshold=threshold, largest=largest, **options)
-    return feasible_regions(outline, alpha, finger_width, margin)
+    contour = extract_contour(src, threshold=threshold, largest=largest, **options)
+    return list(planning_regions(contour, scale=scale, alpha=alpha, finger_width=finger_width, margin=margin)[1])
 
 
 def regions_to_dict(outline: Outline, regions: list[Region], alpha: float = ALPHA,
                     finger_width: float = FINGER_WIDTH, margin: float = MARGIN) -> dict[str, Any]:
-    """JSON-ready description: ``string``, ``size`` (pixels), the parameters and ``regions``.
+    """JSON-ready description: ``string``, ``size`` and ``perimeter`` (pixels), the outline's
+    ``scale`` (fraction of the perimeter), the parameters and ``regions``.
 
     Each region has ``type``, ``segment``, ``start``, ``stop``, ``arc`` (pixels), ``rho`` (pixels,
     null on straight lines), ``points`` and ``normals`` (lists of [x, y]).
@@ -227,6 +344,7 @@ def regions_to_dict(outline: Outline, regions: list[Region], alpha: float = ALPH
         "string": outline.string,
         "size": outline.size,
         "perimeter": outline.perimeter,
+        "scale": outline.scale,
         "alpha": alpha,
         "finger_width": finger_width,
         "margin": margin,

@@ -120,10 +120,10 @@ from .candidates import ERROR, INSET, PER_REGION, STEP, Candidates, candidates, 
 from .errors import SynthesisError
 from .forcegrasp import MARGIN, friction
 from .independent import independent_grasp
-from .outline import (DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, finger_scale, outline_contour,
-                      outline_contour_scales)
+from .outline import (DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_contour, outline_contour_scales,
+                      planning_scale)
 from .procedures import Procedure, SearchInput
-from .regions import ALPHA, FINGER_WIDTH, MARGIN as REGION_MARGIN, Region, feasible_regions
+from .regions import ALPHA, FINGER_WIDTH, MARGIN as REGION_MARGIN, Region, feasible_regions, on_fine_outline
 from .edges import WEAK_EDGE, edge_evidence, weak_edge
 from .vision import ImageSource, extract_contour
 
@@ -465,13 +465,15 @@ def normal_span(outline: Outline) -> float:
 
 def _spans(outline: Outline, regions, found, fine: Outline) -> list[float]:
     """Length over which each contact's normal is estimated (pixels): the fitted line of a
-    straight element, four smoothing standard deviations of the fine outline on a curve (the
-    normals curved regions carry; :func:`_fine_normals`)."""
+    straight edge (its element, or its region when the edge runs on into its corners' windows,
+    :mod:`qualgrasp.qualitative.regions`), four smoothing standard deviations of the fine outline on a curve (the
+    normals curved regions carry; :func:`qualgrasp.qualitative.regions.on_fine_outline`)."""
     out = []
     for r in found.regions:
         seg = outline.segments[regions[r].segment]
-        out.append(float(np.linalg.norm(seg.endpoints[1] - seg.endpoints[0])) if seg.symbol == "/"
-                   else normal_span(fine))
+        # a straight region's normal is its edge's line, fitted over at least the region
+        out.append(max(float(np.linalg.norm(seg.endpoints[1] - seg.endpoints[0])), regions[r].length)
+                   if seg.symbol == "/" else normal_span(fine))
     return out
 
 
@@ -693,7 +695,7 @@ def search_scales(contour: np.ndarray, fine: Outline, finger_width: float, scale
     if scale is not None:
         yield scale
         return
-    first = max(fine.scale, finger_scale(fine, finger_width))
+    first = planning_scale(fine, finger_width)
     yield first
     last, count = first, 0
     for iv in outline_contour_scales(contour):
@@ -749,26 +751,11 @@ def _attempt_regions(contour: np.ndarray, fine: Outline, finger_width: float, sc
     for s, a in search_attempts(contour, fine, finger_width, scale, alpha):
         if s not in outlines:
             outlines[s] = outline_contour(contour, scale=s)
-        regions = _fine_normals(tuple(feasible_regions(outlines[s], a, finger_width, margin)), fine, outlines[s])
+        regions = on_fine_outline(feasible_regions(outlines[s], a, finger_width, margin), fine, outlines[s])
         key = (s, tuple((r.start, r.stop) for r in regions))
         if key not in seen:
             seen.add(key)
             yield s, a, outlines[s], regions
-
-
-def _fine_normals(regions: tuple[Region, ...], fine: Outline, outline: Outline) -> tuple[Region, ...]:
-    """Regions of ``outline`` (a coarser scale of ``fine``; the contour is the same at every
-    scale) with the fine outline's normals on curves and, on straight regions, the contour's own
-    points (a coarse fitted line may pass pixels away from a bumpy edge) with the line's normal."""
-    if outline is fine:
-        return regions
-    normals = np.asarray(fine.normals())
-    n = len(fine.contour)
-    out = []
-    for r in regions:
-        idx = np.arange(r.start, r.stop) % n
-        out.append(replace(r, points=fine.contour[idx]) if r.type == "/" else replace(r, normals=normals[idx]))
-    return tuple(out)
 
 
 def _tried(tried: list[tuple[float, float, bool]]) -> str:

@@ -282,13 +282,18 @@ def images(tmp_path_factory):
 
 def test_cli_scale(images):
     noisy = str(images["noisy"])
-    fine = runner.invoke(app, ["outline", noisy])
+    fine = runner.invoke(app, ["outline", noisy, "--scale", repr(DEFAULT_SCALE)])
     assert fine.exit_code == 0, fine.output
     assert fine.stdout.strip() != SQUARE
+    assert f"scale {DEFAULT_SCALE:.4g} (--scale)" in fine.stderr
     scale = finger_scale(outline_image(noisy_square(BUMPS)[0]), FINGER_WIDTH)
     result = runner.invoke(app, ["outline", noisy, "--scale", repr(scale)])
     assert result.exit_code == 0, result.output
     assert result.stdout.strip() == SQUARE
+    # by default at the finger's scale, as regions and synthesize read it, and saying so
+    result = runner.invoke(app, ["outline", noisy])
+    assert result.exit_code == 0, result.output
+    assert result.stdout.strip() == SQUARE and f"scale {scale:.4g} (the finger's" in result.stderr
     result = runner.invoke(app, ["outline", str(images["figure3"]), "--scale", "0.004"])
     assert result.stdout.strip() == EXPECTED["figure3"]
     result = runner.invoke(app, ["outline", noisy, "--scale", repr(scale), "--json"])

@@ -81,16 +81,22 @@ def test_one_region_per_side_away_from_corners(name, scale):
     regions = feasible_regions(outline)
     vertices = np.asarray(poly.exterior.coords)[:-1]
     edges = [LineString([vertices[k], vertices[(k + 1) % len(vertices)]]) for k in range(len(vertices))]
+    ring = shapely.geometry.polygon.orient(shapely.Polygon(vertices), 1.0)
+    assert np.allclose(np.asarray(ring.exterior.coords)[:-1], vertices)  # shape() is positively oriented
+    before, after = np.roll(vertices, 1, axis=0), np.roll(vertices, -1, axis=0)
+    u, v = vertices - before, after - vertices
+    outward = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0] > 0
+    keep = np.where(outward, MARGIN, MARGIN + FINGER_WIDTH / 2) * outline.size
     covered = []
     for region in regions:
         assert region.type == "/"
         d = np.array([shapely.distance(e, shapely.points(region.points)) for e in edges])
         (edge,) = np.flatnonzero(d.max(axis=1) < 0.3)  # every point on one and the same side
         covered.append(edge)
-        # no finger on a corner: the pad and the margin stay off every vertex
-        keep = (MARGIN + FINGER_WIDTH / 2) * outline.size
-        gap = np.linalg.norm(region.points[:, None, :] - vertices[None], axis=2).min()
-        assert gap > keep - 1.0
+        # no finger on a corner: the margin stays off every outward vertex (the pad may overhang it),
+        # the margin and half the pad off every inward one (the other face blocks the pad)
+        gap = np.linalg.norm(region.points[:, None, :] - vertices[None], axis=2).min(axis=0)
+        assert (gap > keep - 1.0).all()
     assert sorted(covered) == list(range(len(edges)))
 
 
