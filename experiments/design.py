@@ -45,9 +45,13 @@ class Route:
 
 
 def routes() -> tuple[Route, ...]:
-    """Every route: one qualitative route per registered procedure, then their baselines."""
+    """Every route: one qualitative route per registered procedure, then one baseline per finger
+    count and contact model (two procedures with three point contacts share ``Baseline 3``: the
+    baseline searches contacts, not procedures), carrying the first such procedure."""
     procs = procedures.procedures()
-    return tuple(Route("qualitative", p) for p in procs) + tuple(Route("baseline", p) for p in procs)
+    baselines = {(p.fingers, p.model): p for p in reversed(procs)}  # the first registered wins
+    return tuple(Route("qualitative", p) for p in procs) + tuple(
+        Route("baseline", p) for p in procs if baselines[(p.fingers, p.model)] is p)
 
 
 KINDS = ("rotation", "translation", "noise", "blur", "threshold")

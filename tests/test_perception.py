@@ -363,7 +363,7 @@ def test_segmentation_options_on_the_command_line(tmp_path):
     mask = tmp_path / "mask.png"
     cv2.imwrite(str(mask), (coverage(poly) > 0.5).astype(np.uint8) * 255)
     out = run(app, ["outline", str(path), "--mask", str(mask)])
-    assert out.exit_code == 0 and out.output.strip() == outline_image(image, mask=mask).string
+    assert out.exit_code == 0 and out.stdout.strip() == outline_image(image, mask=mask, scale=scale_of(out)).string
     for args, message in ((["--segmentation", "nope"], "unknown segmentation method"),
                           (["--mask", str(mask), "--segmentation", "adaptive"], "mask is the segmentation"),
                           (["--rect", "1,2,3"], "--rect must be four whole numbers"),
@@ -372,3 +372,8 @@ def test_segmentation_options_on_the_command_line(tmp_path):
         assert out.exit_code == 2 and message in out.output, (args, out.output)
     out = run(app, ["regions", str(path), "--segmentation", "grabcut", "--rect", "40,40,320,320"])
     assert out.exit_code == 0, out.output
+
+
+def scale_of(result) -> float:
+    """The outline scale ``qualgrasp outline`` reports on standard error."""
+    return float(re.search(r"outline at scale ([0-9.e-]+)", result.stderr).group(1))

@@ -316,3 +316,12 @@ def test_silhouettes_and_compare_commands(tmp_path):
     assert result.exit_code == 2 and "no images" in result.output
     result = runner.invoke(app, ["compare", str(tmp_path / "sil"), "--setting", "huge"])
     assert result.exit_code == 2
+
+
+def test_route_names_are_unique_and_baselines_one_per_contact_pattern():
+    """Two procedures with three point contacts (forcegrasp3, pairgrasp3) share one baseline."""
+    from qualgrasp.experiments.design import routes
+    names = [r.name for r in routes()]
+    assert len(names) == len(set(names))
+    patterns = [(r.fingers, r.procedure.model) for r in routes() if r.method == "baseline"]
+    assert len(patterns) == len(set(patterns))
