@@ -16,6 +16,7 @@ from ...certify.checks import OptionError, count_in, output_folder
 from ..design import BUILTINS
 from ..silhouettes import available_silhouettes, available_wings
 from ..silhouettes import silhouettes as bundled
+from .study import VALIDATIONS, validate
 
 __all__ = ["register"]
 
@@ -56,8 +57,6 @@ def validate_command(
         import pymunk  # noqa: F401
     except ImportError:
         _fail('the physical validation needs pymunk: pip install "qualgrasp[physics]"')
-    from .study import VALIDATIONS, validate
-
     setting = "quick" if quick else setting
     if setting not in VALIDATIONS:
         _fail(f"--setting must be one of {', '.join(VALIDATIONS)}, got {setting!r}")
@@ -96,7 +95,7 @@ def _print(result) -> None:
     cases = list(zip(*result.closed.values()))
     for group in cases:
         c = group[0]
-        table.add_row(c.case, c.formula, *(f"{g.error:+.3f}" if g.exact else f"{g.measured:g}" for g in group))
+        table.add_row(c.case, c.formula, *(f"{g.error:+.3f}" if g.exact else f"{g.measured:.2g}" for g in group))
     console.print(table)
     table = Table(title="certified verdict against the physical outcome (nominal placement)", box=None,
                   padding=(0, 1, 0, 0), pad_edge=False)

@@ -55,9 +55,12 @@ def plot_resisted(out: Path, rows: list[dict], floor: float) -> list[Path]:
             ax.set_title(f"{m} fingers, mu {mu:g}" if mu else f"{m} frictionless fingers")
             ax.set_xlabel("certified L1 epsilon (as planned)")
             ax.legend(loc="upper left")
+        for ax in axes:
+            ax.text(0.98, low * 1.25, "did not hold", ha="right", va="bottom", fontsize=7, color="0.3",
+                    transform=ax.get_yaxis_transform())
+            ax.text(0.98, floor * 1.08, "floor", ha="right", va="bottom", fontsize=7, color="0.45",
+                    transform=ax.get_yaxis_transform())
         axes[0].set_ylabel("largest disturbance resisted (F0)")
-        axes[0].text(0.0, low, "did not hold ", ha="right", va="center", fontsize=7, color="0.3",
-                     transform=axes[0].get_yaxis_transform())
         fig.suptitle("Does a larger epsilon resist a larger push in physics?")
         return save(fig, out, "physics-resisted", _FORMATS)
 
@@ -78,8 +81,7 @@ def plot_placements(out: Path, rows: list[dict], outside_max: float) -> list[Pat
         ax.axvspan(0, 1, color=GOOD, alpha=0.08, lw=0)
         ax.axvline(1.0, color=GOOD, lw=1.0, ls="--")
         ax.text(0.5, 0.03, "inside the certified\nregions", ha="center", va="bottom", fontsize=8, color="darkgreen")
-        ax.text(1.04, 0.03, "certified tolerance", ha="left", va="bottom", fontsize=8, color="darkgreen",
-                rotation=90)
+        ax.text(1.03, 1.03, "certified tolerance", ha="left", va="bottom", fontsize=8, color="darkgreen")
         for source in ("qualitative", "baseline"):
             sel = [r for r in moved if r["source"] == source]
             if not sel:
@@ -100,8 +102,8 @@ def plot_placements(out: Path, rows: list[dict], outside_max: float) -> list[Pat
         ax.set_xlim(0, edges[-1])
         ax.set_xlabel("placement error (x certified tolerance; each finger slid this far along the outline)")
         ax.set_ylabel("held rate")
-        ax.legend(loc="lower left", bbox_to_anchor=(0.0, 0.12))
-        ax.set_title("Placements inside the certified regions hold; outside, they start to fail")
+        ax.legend(loc="upper right", bbox_to_anchor=(1.0, 0.93))
+        ax.set_title("Held rate of placements inside and outside the certified regions (trials per bin)")
         return save(fig, out, "physics-placements", _FORMATS)
 
 
@@ -110,23 +112,24 @@ def plot_settings(out: Path, rows: list[dict], closed: dict, labels: dict) -> li
     default = {(r["object"], r["route"], r["grasp"]): r for r in _nominal(rows)}
     pairs = [(default[k], r) for r in _nominal(rows, "fine") for k in [(r["object"], r["route"], r["grasp"])]
              if k in default]
+    colours = ("tab:blue", "tab:purple")
     with context():
-        fig = new_figure(9.0, 3.4)
-        a, b = fig.subplots(1, 2, width_ratios=(1.35, 1))
+        fig = new_figure(9.0, 3.6)
+        a, b = fig.subplots(1, 2, width_ratios=(1.5, 1))
         names = [c.case for c in next(iter(closed.values())) if c.exact]
         y = np.arange(len(names))
         for j, (key, cs) in enumerate(closed.items()):
             err = [c.error for c in cs if c.exact]
-            a.barh(y + (j - 0.5) * 0.38, err, height=0.36, label=labels.get(key, key),
-                   color=("tab:blue", "tab:purple")[j % 2])
+            a.barh(y + (j - 0.5) * 0.38, err, height=0.36, label=f"{key}: {labels.get(key, key)}",
+                   color=colours[j % 2])
         a.axvline(0, color="0.3", lw=0.6)
         a.set_yticks(y, names, fontsize=7.5)
         a.invert_yaxis()
         a.set_xlabel("relative error against the closed form")
-        zero = [c for c in next(iter(closed.values())) if not c.exact]
-        a.set_title("Simulator on closed-form cases (" + "; ".join(
-            f"{c.case.split(':')[0]}: {c.measured:g}" for c in zero) + " resisted, exact 0)", fontsize=8)
-        a.legend(loc="lower right", fontsize=7)
+        zero = [c for c in next(iter(closed.values())) if not c.exact and c.unit.startswith("F0")]
+        resisted = ", ".join(f"{c.case}: {max(cs[i].measured for cs in closed.values()):g}"
+                             for i, c in enumerate(next(iter(closed.values()))) if c in zero)
+        a.set_title("Closed-form cases" + (f"\n(exact 0 -> {resisted})" if resisted else ""), fontsize=8)
         if pairs:
             x = np.array([p[0]["resisted"] for p in pairs])
             z = np.array([p[1]["resisted"] for p in pairs])
@@ -138,9 +141,10 @@ def plot_settings(out: Path, rows: list[dict], closed: dict, labels: dict) -> li
             b.set_xscale("log")
             b.set_yscale("log")
             agree = sum(1 for p, q in pairs if p["held"] == q["held"])
-            b.set_title(f"{len(pairs)} grasps at both settings: held agrees on {agree}", fontsize=8.5)
-        b.set_xlabel(f"resisted, {labels.get('default', 'default')} (F0)")
-        b.set_ylabel(f"resisted, {labels.get('fine', 'fine')} (F0)")
+            b.set_title(f"The same {len(pairs)} grasps at both settings\n(held agrees on {agree})", fontsize=8)
+        b.set_xlabel("largest resisted, default (F0)")
+        b.set_ylabel("largest resisted, fine (F0)")
+        fig.legend(*a.get_legend_handles_labels(), loc="outside lower center", ncols=2, fontsize=7.5)
         fig.suptitle("The simulator's own error, and the effect of the time step, iterations and stiffness")
         return save(fig, out, "physics-settings", _FORMATS)
 
@@ -152,7 +156,11 @@ def plot_filmstrip(out: Path, frames: tuple, outline: np.ndarray, radius: float,
 
     ``frames`` as recorded by :func:`qualgrasp.experiments.physics.planar.hold`, ``outline`` the
     object's ring and ``radius`` the fingers', world units."""
-    pick = np.unique(np.linspace(0, len(frames) - 1, count).round().astype(int))
+    pushed = [i for i, f in enumerate(frames) if any(f[3])]
+    first = pushed[0] if pushed else len(frames)
+    pick = [0, max(first - 1, 0)] + [pushed[int(round(j))] for j in np.linspace(0, len(pushed) - 1, count - 2)
+                                     if pushed]
+    pick = sorted(set(pick))
     peak = max(max(math.hypot(f[3][0], f[3][1]), abs(f[3][2])) for f in frames) or 1.0
     with context():
         fig = new_figure(1.75 * len(pick), 2.35)
@@ -184,7 +192,8 @@ def plot_filmstrip(out: Path, frames: tuple, outline: np.ndarray, radius: float,
             ax.set_xticks([])
             ax.set_yticks([])
             mag = math.sqrt(w[0] ** 2 + w[1] ** 2 + w[2] ** 2)
-            ax.set_title(f"t = {t:.2f} s\n|w| = {mag:.2f} F0", fontsize=8)
+            phase = "squeeze" if i < first else "push"
+            ax.set_title(f"{phase}, t = {t:.2f} s\n|w| = {mag:.2f} F0", fontsize=8)
         fig.suptitle(title, fontsize=9.5)
         return save(fig, out, "physics-filmstrip", _FORMATS)
 

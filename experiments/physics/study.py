@@ -78,7 +78,8 @@ from .planar import DIRECTIONS, Finger, Physics, PlanarObject, hold, holds, resi
 from .plots import plot_all, plot_filmstrip
 
 __all__ = ["COLUMNS", "FINE", "Validation", "QUICK_VALIDATION", "FULL_VALIDATION", "VALIDATIONS",
-           "ValidationResult", "grasps_of", "validate_object", "explain", "summarise", "validate"]
+           "ValidationResult", "grasps_of", "validate_object", "explain", "summarise", "summary_markdown",
+           "read_trials", "read_closed_forms", "filmstrip", "validate"]
 
 FINE = Physics(dt=5e-4, iterations=40, stiffness=1000.0)
 """The second physics setting: half the time step, twice the solver iterations, twice the
@@ -185,10 +186,10 @@ class _Planned:
     status: str
 
 
-def _tolerance(outline, image, grasp: Grasp):
-    """Certified tolerance of a grasp on the outline at the default scale: ``(regions, status)``."""
+def _tolerance(outline, regions, grasp: Grasp):
+    """Certified tolerance of a grasp on the outline at the default scale within ``regions``:
+    ``(IndependentRegions or None, status)``."""
     try:
-        regions = planned_regions(image, grasp, largest=True, outline=outline)
         found = independent_grasp(outline, grasp, regions=regions)
     except GraspError as err:
         return None, f"none: {err}"
@@ -227,20 +228,22 @@ def grasps_of(subject: Subject, settings: Validation = QUICK_VALIDATION) -> tupl
         proc = route.procedure
         mu = settings.mu if proc.friction else None
         if route.method == "qualitative":
-            try:
+            try:  # tolerances of the chosen grasps only, as synthesize gives them (its regions, the fine outline)
                 s = synthesize(image, procedure=proc.name, mu=mu, name=subject.name, quality=False,
-                               largest=True, explain=False)
+                               largest=True, explain=False, tolerance=False)
             except QualitativeError:
                 continue
             order = np.argsort([-r.eps_l1 for r in s.reports], kind="stable")[: settings.per_route]
             for i in order:
-                t = s.tolerances[i]
+                t, status = _tolerance(outline, list(s.regions), s.grasps[i]) if s.reports[i].certified \
+                    else (None, "none")
                 out.append(_Planned("qualitative", route.name, proc.name, s.grasps[i], s.reports[i].certified,
-                                    s.reports[i].eps_l1, t, "none" if t is None else t.status))
+                                    s.reports[i].eps_l1, t, status))
         else:
             found = baseline(image, proc, mu, settings.budget, name=subject.name)
             for g, ok, eps in list(zip(found.grasps, found.certified, found.epsilons))[: settings.per_route]:
-                t, status = _tolerance(outline, image, g) if ok else (None, "none")
+                t, status = (_tolerance(outline, planned_regions(image, g, largest=True, outline=outline), g)
+                             if ok else (None, "none"))
                 out.append(_Planned("baseline", route.name, proc.name, g, ok, eps, t, status))
             for g in _random_grasps(seen, route, settings.mu if proc.friction else 0.0, settings.random, rng):
                 report = certify_grasp(g, quality=True)
@@ -504,6 +507,40 @@ def _closed_rows(closed: dict) -> list[dict]:
     return [{"setting": k, **asdict(c)} for k, cs in closed.items() for c in cs]
 
 
+_BOOLS = ("certified", "certified_true", "held", "ejected")
+_INTS = ("fingers", "weakest", "tests")
+_FLOATS = ("mu", "eps", "delta_fraction", "error", "error_fraction", "eps_true", "resisted")
+
+
+def _typed(column: str, text: str):
+    if text == "":
+        return None
+    if column in _BOOLS:
+        return text == "True"
+    if column in _INTS:
+        return int(text)
+    if column in _FLOATS:
+        return float(text)
+    return text
+
+
+def read_trials(path: str | Path) -> list[dict]:
+    """The rows of a ``trials.csv`` written by :func:`validate`, typed as :func:`validate_object`
+    gives them (numbers to 6 significant digits)."""
+    with Path(path).open(newline="", encoding="utf-8") as fh:
+        return [{c: _typed(c, r[c]) for c in COLUMNS} for r in csv.DictReader(fh)]
+
+
+def read_closed_forms(path: str | Path) -> dict:
+    """The closed-form rows of a ``closed-forms.csv`` written by :func:`validate`, per setting."""
+    closed: dict = {}
+    with Path(path).open(newline="", encoding="utf-8") as fh:
+        for r in csv.DictReader(fh):
+            closed.setdefault(r["setting"], []).append(closed_forms.ClosedForm(
+                r["case"], r["formula"], float(r["exact"]), float(r["measured"]), float(r["error"]), r["unit"]))
+    return closed
+
+
 # --------------------------------------------------------------------------------------------------
 # The study
 
@@ -541,23 +578,21 @@ def validate(images: Iterable[Any], out: str | Path, *, settings: str | Validati
     say("closed-form cases")
     tasks = [(s, settings, k < settings.recheck) for k, s in enumerate(items)]
     rows: list[dict] = []
-    if settings.workers <= 1:
-        for k, task in enumerate(tasks):
-            rows += _guarded(*task, skipped)
+    trials = out / "trials.csv"
+    with trials.open("w", newline="", encoding="utf-8") as fh:  # rows as objects finish: a long run can be read early
+        writer = csv.writer(fh)
+        writer.writerow(COLUMNS)
+        for k, got in enumerate(_objects(tasks, settings.workers)):
+            if isinstance(got, tuple):
+                skipped.append(got)
+            else:
+                rows += got
+                writer.writerows([_fmt(r.get(c)) for c in COLUMNS] for r in got)
+                fh.flush()
             say(f"objects {k + 1}/{len(tasks)}")
-    else:
-        with ProcessPoolExecutor(settings.workers) as pool:
-            futures = [pool.submit(_guarded, *task, None) for task in tasks]
-            for k, (task, f) in enumerate(zip(tasks, futures)):
-                got = f.result()
-                if isinstance(got, tuple):
-                    skipped.append(got)
-                else:
-                    rows += got
-                say(f"objects {k + 1}/{len(tasks)}")
     seconds = time.perf_counter() - start
     summary = summarise(rows)
-    files = [_write_csv(out / "trials.csv", COLUMNS, rows),
+    files = [trials,
              _write_csv(out / "closed-forms.csv", ("setting", "case", "formula", "exact", "measured", "error", "unit"),
                         _closed_rows(closed))]
     pairs = _setting_pairs(rows)
@@ -605,13 +640,22 @@ def filmstrip(items: Sequence[Subject], rows: list[dict], settings: Validation):
     return None
 
 
-def _guarded(subject: Subject, settings: Validation, recheck: bool, skipped: list | None):
-    """:func:`validate_object`, an image the vision cannot read becoming a skipped entry."""
+def _objects(tasks: list[tuple], workers: int):
+    """:func:`_guarded` of every task, in order, in ``workers`` processes."""
+    if workers <= 1:
+        for task in tasks:
+            yield _guarded(*task)
+        return
+    with ProcessPoolExecutor(workers) as pool:
+        futures = [pool.submit(_guarded, *task) for task in tasks]
+        for f in futures:
+            yield f.result()
+
+
+def _guarded(subject: Subject, settings: Validation, recheck: bool):
+    """:func:`validate_object`, an image the vision cannot read becoming a skipped entry
+    ``(name, reason)``."""
     try:
         return validate_object(subject, settings, recheck)
-    except QualitativeError as err:
-        entry = (subject.name, f"{type(err).__name__}: {err}")
-        if skipped is None:
-            return entry
-        skipped.append(entry)
-        return []
+    except (QualitativeError, ValueError) as err:  # unreadable image; a polygon the engine cannot take
+        return subject.name, f"{type(err).__name__}: {err}"
