@@ -3,6 +3,7 @@ wrapper over :func:`qualgrasp.experiments.physics.study.validate`."""
 
 from __future__ import annotations
 
+import importlib.util
 from dataclasses import replace
 from pathlib import Path
 
@@ -53,9 +54,7 @@ def validate_command(
     and random grasps of every object, nominal and with placement errors inside and outside their
     certified regions; the simulator's error on closed-form cases. Exit code 2 on a refused option
     or output folder, or when pymunk is not installed."""
-    try:
-        import pymunk  # noqa: F401
-    except ImportError:
+    if importlib.util.find_spec("pymunk") is None:
         _fail('the physical validation needs pymunk: pip install "qualgrasp[physics]"')
     setting = "quick" if quick else setting
     if setting not in VALIDATIONS:

@@ -63,7 +63,7 @@ from typing import Sequence
 
 import numpy as np
 import shapely
-from shapely.geometry import Point, Polygon
+from shapely.geometry import Polygon
 
 __all__ = ["Physics", "DIRECTIONS", "PlanarObject", "Finger", "World", "Hold", "Resistance", "convex_pieces",
            "squeeze", "hold", "holds", "resistance", "hold_time"]

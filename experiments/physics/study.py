@@ -51,6 +51,7 @@ the second setting), ``summary.md``, and the figures of :mod:`~qualgrasp.experim
 from __future__ import annotations
 
 import csv
+import math
 import time
 import zlib
 from concurrent.futures import ProcessPoolExecutor
@@ -79,7 +80,7 @@ from .plots import plot_all, plot_filmstrip
 
 __all__ = ["COLUMNS", "FINE", "Validation", "QUICK_VALIDATION", "FULL_VALIDATION", "VALIDATIONS",
            "ValidationResult", "grasps_of", "validate_object", "explain", "summarise", "summary_markdown",
-           "read_trials", "read_closed_forms", "filmstrip", "validate"]
+           "read_trials", "read_closed_forms", "filmstrip", "report", "validate"]
 
 FINE = Physics(dt=5e-4, iterations=40, stiffness=1000.0)
 """The second physics setting: half the time step, twice the solver iterations, twice the
@@ -446,7 +447,8 @@ def summary_markdown(summary: dict, closed: dict, settings: Validation, objects:
                      rows: list[dict]) -> str:
     """The Markdown summary of a validation run."""
     ph = settings.physics
-    lines = [f"# Physical validation: {objects} objects, {seconds:.0f} s", "",
+    took = "" if math.isnan(seconds) else f", {seconds:.0f} s"
+    lines = [f"# Physical validation: {objects} objects{took}", "",
              f"Physics ({ph.label()}; mass {ph.mass:g}, preload F0 = 1, finger force at most {ph.max_force:g} F0, "
              f"slip tolerance {ph.slip:g} of the size, floor {ph.floor:g} F0, {settings.directions} directions). "
              "A grasp **held** when it resisted the floor disturbance in every direction; **resisted** is the largest "
@@ -602,7 +604,7 @@ def validate(images: Iterable[Any], out: str | Path, *, settings: str | Validati
                               "held_default": a["held"], "held_fine": b["held"], "resisted_default": a["resisted"],
                               "resisted_fine": b["resisted"]} for a, b in pairs)))
     md = out / "summary.md"
-    md.write_text(summary_markdown(summary, closed, settings, len(items) - len(skipped), seconds, rows),
+    md.write_text(summary_markdown(summary, closed, settings, len({r["object"] for r in rows}), seconds, rows),
                   encoding="utf-8")
     files.append(md)
     if plots:
@@ -613,6 +615,39 @@ def validate(images: Iterable[Any], out: str | Path, *, settings: str | Validati
             frames, obj, title = film
             files += plot_filmstrip(out, frames, obj.outline, settings.physics.finger_radius, obj.length, title)
     return ValidationResult(summary, closed, rows, time.perf_counter() - start, tuple(files), tuple(skipped))
+
+
+def report(out: str | Path, settings: str | Validation = "full", images: Iterable[Any] | None = None,
+           seconds: float | None = None) -> tuple[dict, list[Path]]:
+    """Summary and figures again from the files of a run in ``out`` (``trials.csv`` and
+    ``closed-forms.csv``; a run stopped early has the objects it finished): ``(summary, files)``.
+    The filmstrip is drawn when ``images`` (the run's objects) are given.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> report(tempfile.mkdtemp())
+    Traceback (most recent call last):
+    ...
+    FileNotFoundError: no trials.csv in ...
+    """
+    out = Path(out)
+    settings = VALIDATIONS[settings] if isinstance(settings, str) else settings
+    if not (out / "trials.csv").is_file() or not (out / "closed-forms.csv").is_file():
+        raise FileNotFoundError(f"no trials.csv in {out} (or no closed-forms.csv): not a validation run")
+    rows, closed = read_trials(out / "trials.csv"), read_closed_forms(out / "closed-forms.csv")
+    summary = summarise(rows)
+    md = out / "summary.md"
+    md.write_text(summary_markdown(summary, closed, settings, len({r["object"] for r in rows}),
+                                   math.nan if seconds is None else seconds, rows), encoding="utf-8")
+    files = [md] + plot_all(out, rows, closed, settings.physics.floor, settings.outside_max,
+                            {"default": settings.physics.label(), "fine": FINE.label()})
+    if images is not None:
+        film = filmstrip(subjects(images), rows, settings)
+        if film is not None:
+            files += plot_filmstrip(out, film[0], film[1].outline, settings.physics.finger_radius, film[1].length,
+                                    film[2])
+    return summary, files
 
 
 def filmstrip(items: Sequence[Subject], rows: list[dict], settings: Validation):
