@@ -11,9 +11,10 @@ no table friction, no damping of the object (it slides freely once it slips).
   (:func:`pymunk.autogeometry.convex_decomposition` with tolerance 0: the pieces' union is the
   polygon, checked by :func:`convex_pieces`); its mass ``Physics.mass`` spread uniformly over the
   polygon (moment of inertia of the whole polygon). Only the pieces within ``Physics.reach`` of a
-  finger are given to the engine (the object moves less than the slip tolerance before a trial
-  ends, so the others can never touch a finger; a polygon of hundreds of pieces would cost 30
-  times more per step).
+  finger are given to the engine, each clipped to the square of half-side ``reach`` around the
+  finger (still convex): the object moves less than ``reach / 2`` before a trial ends, so the rest
+  can never touch a finger, and a polygon of hundreds of pieces, or a piece of a thousand
+  vertices (a disc), would cost 3 to 30 times more per step.
 * **Fingers.** Small discs of radius ``Physics.finger_radius`` that do not rotate, each on a
   frictionless groove along its **approach line** (the direction it moves in, towards the
   object): a rigid gripper holds it sideways. Along the groove a position-controlled spring pushes
@@ -30,8 +31,11 @@ The trial
 ---------
 1. **Squeeze** (:func:`squeeze`): the fingers start a finger radius short of the object along their
    approach lines; their targets move in over ``Physics.ramp`` seconds, then the world settles for
-   ``Physics.settle`` seconds. If the object moved by more than the slip tolerance meanwhile, the
-   squeeze alone pushed it out (``ejected``).
+   ``Physics.settle`` seconds, and longer (up to ``Physics.settle_max``) until the object is at
+   rest (its speed, centroid plus ``L`` times angular, below ``Physics.rest``). Equal preloads are
+   rarely an internal force the grasp balances as they are: the object shifts or turns a little
+   until the springs balance, and is then held there. If it is not at rest by then, or moved
+   more than ``reach / 2``, the squeeze alone pushed it out (``ejected``).
 2. **Disturbance** (:func:`hold`): a wrench ``w (fx, fy, tau / L)`` applied at the centroid in the
    object's frame (the force turns with the object; ``L`` the object's radius about its centroid,
    the torque scaling of certify's epsilon), ramped in over ``Physics.ramp`` seconds and then held
@@ -95,9 +99,11 @@ class Physics:
         Finger disc radius.
     slop : float
         Penetration Chipmunk allows before correcting it.
-    ramp, settle : float
-        Seconds over which the squeeze (and a disturbance) is ramped in; seconds of settling after
-        the squeeze ramp.
+    ramp, settle, settle_max : float
+        Seconds over which the squeeze (and a disturbance) is ramped in; least and most seconds of
+        settling after the squeeze ramp.
+    rest : float
+        Largest speed of an object at rest (size per second).
     slip : float
         Slip tolerance: largest displacement of the object (centroid plus ``L`` times rotation)
         still counted as held.
@@ -112,8 +118,8 @@ class Physics:
     precision : float
         Ratio of the bisection's final bracket.
     reach : float
-        Convex pieces of the object farther than this from every finger are left out of the
-        engine.
+        The engine gets the object's convex pieces within this distance of a finger, clipped to
+        the square of this half-side around it.
     """
 
     dt: float = 1e-3
@@ -127,6 +133,8 @@ class Physics:
     slop: float = 1e-5
     ramp: float = 0.05
     settle: float = 0.15
+    settle_max: float = 0.5
+    rest: float = 0.01
     slip: float = 0.01
     detect: float = 0.1
     hold_min: float = 0.1
@@ -301,6 +309,11 @@ class World:
         p = self.body.position
         return float(p.x), float(p.y), float(self.body.angle)
 
+    def speed(self) -> float:
+        """Object speed: centroid speed plus ``L`` times the angular speed."""
+        v = self.body.velocity
+        return math.hypot(v.x, v.y) + self.obj.length * abs(self.body.angular_velocity)
+
     def finger_positions(self) -> np.ndarray:
         """``(m, 2)`` finger centres."""
         return np.array([[f.position.x, f.position.y] for f in self.fingers])
@@ -340,11 +353,12 @@ def _build(obj: PlanarObject, fingers: Sequence[Finger], mu: float, ph: Physics)
     if obj.circle:
         space.add(_shape(pymunk.Circle(body, 0.5)))
     else:
-        touches = shapely.points(np.array([f.touch for f in fingers], dtype=float))
-        near = [p for p, s in zip(obj.pieces, obj.shapes)
-                if np.min(shapely.distance(s, touches)) <= ph.reach]
-        for p in near:
-            space.add(_shape(pymunk.Poly(body, [tuple(v) for v in p])))
+        for f in fingers:
+            x, y = f.touch
+            square = shapely.box(x - ph.reach, y - ph.reach, x + ph.reach, y + ph.reach)
+            for part in shapely.intersection(np.asarray(obj.shapes, dtype=object), square):
+                if isinstance(part, Polygon) and part.area > 1e-12:
+                    space.add(_shape(pymunk.Poly(body, [tuple(v) for v in np.asarray(part.exterior.coords)[:-1]])))
     bodies, starts, approaches = [], [], []
     r = ph.finger_radius
     for f in fingers:
@@ -379,7 +393,7 @@ class Hold:
     held : bool
         The object moved less than the slip tolerance (squeeze and disturbance).
     ejected : bool
-        The squeeze alone moved it beyond the tolerance.
+        The squeeze alone pushed it out (module notes).
     displacement : float
         Largest displacement of the object from its squeezed pose during the disturbance (from
         its initial pose when ejected), fraction of the size.
@@ -399,7 +413,8 @@ class Hold:
 def squeeze(obj: PlanarObject, fingers: Sequence[Finger], mu: float, physics: Physics = Physics(),
             frames: list | None = None, every: int = 10) -> tuple[World, float]:
     """Build the world and squeeze (module notes): ``(world, displacement)`` with the object's
-    displacement from its initial pose, fraction of the size.
+    largest displacement from its initial pose, fraction of the size (``world.speed()`` tells
+    whether it came to rest).
 
     Examples
     --------
@@ -415,15 +430,18 @@ def squeeze(obj: PlanarObject, fingers: Sequence[Finger], mu: float, physics: Ph
     world = _build(obj, fingers, mu, physics)
     origin = world.pose()
     ramp = max(1, round(physics.ramp / physics.dt))
-    total = ramp + max(1, round(physics.settle / physics.dt))
+    least = ramp + max(1, round(physics.settle / physics.dt))
+    most = ramp + max(1, round(physics.settle_max / physics.dt))
     lift = physics.finger_radius * physics.stiffness  # the start is a radius short of the touch
     moved = 0.0
-    for i in range(total):
+    for i in range(most):
         a = min(1.0, (i + 1) / ramp)
         world.step(-lift + a * (1.0 + lift))
         if frames is not None and i % every == 0:
             frames.append((world.time, world.pose(), world.finger_positions(), (0.0, 0.0, 0.0)))
         moved = max(moved, _displacement(world.pose(), origin, obj.length))
+        if i + 1 >= least and world.speed() <= physics.rest:
+            break
     return world, moved
 
 
@@ -462,7 +480,7 @@ def hold(obj: PlanarObject, fingers: Sequence[Finger], mu: float, wrench, physic
     """
     frames: list | None = [] if record else None
     world, moved = squeeze(obj, fingers, mu, physics, frames, record or 10)
-    if moved > physics.slip:
+    if moved > physics.reach / 2 or world.speed() > physics.rest:
         return Hold(False, True, moved, 0.0, tuple(frames or ()))
     w = np.asarray(wrench, dtype=float)
     magnitude = float(np.linalg.norm(w))

@@ -301,7 +301,8 @@ def explain(row: dict, physics: Physics = Physics()) -> str:
     or started inside the true object; the executed grasp is not certified on the true object
     (the image's contour differs from it there: a vision error); its epsilon on the true object is
     below what the floor disturbance needs (``eps_true < floor / (fingers * max_force)``: even
-    ideal fingers pressing ``max_force`` could not resist the floor); or ``unexplained``.
+    ideal fingers pressing ``max_force`` could not resist the floor); the squeeze pushed the object
+    out although the grasp is certified (the equal preloads found no balance); or ``unexplained``.
 
     Examples
     --------
@@ -316,6 +317,8 @@ def explain(row: dict, physics: Physics = Physics()) -> str:
         return "a finger started inside the true object"
     if not row.get("certified_true"):
         return "not certified on the true object (vision error)"
+    if row.get("ejected"):
+        return "certified on the true object, but the squeeze alone pushed it out (the preloads have no balance)"
     need = physics.floor / (row.get("fingers", 1) * physics.max_force)
     if row.get("eps_true", 0.0) < need:
         return f"epsilon on the true object {row.get('eps_true', 0.0):.3g} below {need:.3g}: too weak for the floor"
