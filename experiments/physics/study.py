@@ -29,10 +29,12 @@ Physical trials (:mod:`qualgrasp.experiments.physics.planar`)
   whether the floor is resisted (``held``);
 * **placements** (grasps with a certified tolerance): each finger ``i`` moved along the perceived
   outline by ``s_i = e delta_i sigma_i`` from its planned contact (``delta_i`` its certified
-  tolerance, ``sigma_i`` a random sign, ``e`` the **placement error** in units of the tolerance:
-  uniform in ``(0, 1]``, **inside** the certified regions, for ``inside`` placements, and in
-  ``(1, outside_max]``, **outside**, for ``outside`` placements); the finger approaches the moved
-  point along its planned normal and meets the true object; ``held`` as above.
+  tolerance, ``sigma_i`` a random sign, ``e`` uniform in ``(0, 1]`` for ``inside`` placements and
+  in ``(1, outside_max]`` for ``outside`` ones); an inside placement stops at the finger's limits
+  (its feasible region, where the certified regions stop too, less one boundary step), so it stays
+  **inside the certified regions**; an outside one is beyond them. The **placement error** is
+  ``max |s_i| / delta_i``. The finger approaches the moved point along its planned normal and meets
+  the true object; ``held`` as above.
 
 Summary (:func:`summarise`)
 ---------------------------
@@ -353,13 +355,18 @@ def validate_object(subject: Subject, settings: Validation = QUICK_VALIDATION, r
         if plan.tolerance is None or plan.status != "robust":
             continue
         deltas, positions = plan.tolerance.deltas, plan.tolerance.positions
+        step = arc.perimeter / len(arc.points)  # curved regions' limits are rounded inward to points
         for kind, count, lo, hi in (("inside", settings.inside, 0.0, 1.0),
                                     ("outside", settings.outside, 1.0, settings.outside_max)):
             for _ in range(count):
                 e = float(hi - (hi - lo) * rng.random())  # in (lo, hi]
                 signs = rng.choice((-1.0, 1.0), size=len(deltas))
                 shifts = [e * d * s for d, s in zip(deltas, signs)]
-                row = {**base, "placement": kind, "error": e, "error_fraction": e * max(deltas) / truth.size,
+                if kind == "inside":  # the certified regions stop at each finger's limits (its feasible region)
+                    shifts = [min(max(x + p, a + step), b - step) - p if b - a > 2 * step else 0.0
+                              for x, p, (a, b) in zip(shifts, positions, plan.tolerance.limits)]
+                    e = max(abs(x) / d for x, d in zip(shifts, deltas))
+                row = {**base, "placement": kind, "error": e, "error_fraction": max(abs(x) for x in shifts) / truth.size,
                        "setting": "default",
                        **_trial(plan, _moved(g, arc, positions, shifts), truth, obj, perceived, settings,
                                 settings.physics, False)}
