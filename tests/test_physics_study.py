@@ -113,3 +113,34 @@ def test_validate_on_a_folder_of_images(tmp_path):
     rows = read_trials(out / "trials.csv")
     assert {r["object"] for r in rows} == {"square"}
     assert any(r["source"] == "qualitative" and r["held"] for r in rows)
+
+
+def test_placements_inside_stay_on_the_certified_regions():
+    """On figure3 the baseline's 2-finger grasp has a tolerance longer than the straight edge it
+    sits on: a placement inside must stop at the edge's end, where its certified region stops."""
+    import itertools
+
+    import numpy as np
+    from shapely.geometry import LineString, Point
+
+    from qualgrasp.certify.region_boundary import Boundary
+    from qualgrasp.experiments.physics.study import grasps_of, placement
+    from qualgrasp.experiments.study import subjects
+    from qualgrasp.qualitative.independent import outline_boundary
+
+    subject = subjects(["figure3"])[0]
+    planned, outline = grasps_of(subject, TINY)
+    arc = Boundary.of(*outline_boundary(outline))
+    step = arc.perimeter / len(arc.points)
+    robust = [p for p in planned if p.status == "robust"]
+    assert {p.source for p in robust} == {"qualitative", "baseline"}
+    clipped = 0
+    for plan in robust:
+        t = plan.tolerance
+        lines = [LineString([r.a, r.b]) if hasattr(r, "a") else LineString(r.points) for r in t.regions.regions]
+        for signs in itertools.product((-1.0, 1.0), repeat=len(t.deltas)):
+            shifts = placement(t.deltas, t.positions, t.limits, 1.0, signs, step)
+            clipped += sum(abs(x) < d - 1e-9 for x, d in zip(shifts, t.deltas))
+            for line, p, x in zip(lines, t.positions, shifts):
+                assert line.distance(Point(arc.point_at(p + x))) < 1e-6
+    assert clipped > 0  # some finger's tolerance reaches past its limits

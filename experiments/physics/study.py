@@ -81,7 +81,7 @@ from .planar import DIRECTIONS, Finger, Physics, PlanarObject, hold, holds, resi
 from .plots import plot_all, plot_filmstrip
 
 __all__ = ["COLUMNS", "FINE", "Validation", "QUICK_VALIDATION", "FULL_VALIDATION", "VALIDATIONS",
-           "ValidationResult", "grasps_of", "validate_object", "explain", "summarise", "summary_markdown",
+           "ValidationResult", "grasps_of", "placement", "validate_object", "explain", "summarise", "summary_markdown",
            "read_trials", "read_closed_forms", "filmstrip", "report", "validate"]
 
 FINE = Physics(dt=5e-4, iterations=40, stiffness=1000.0)
@@ -275,6 +275,29 @@ def _moved(grasp: Grasp, arc: ArcBoundary, positions, shifts) -> Grasp:
     return Grasp(contacts, center=grasp.center, length=grasp.length, id=grasp.id, meta=dict(grasp.meta))
 
 
+def placement(deltas: Sequence[float], positions: Sequence[float], limits, error: float, signs: Sequence[float],
+              step: float = 0.0) -> list[float]:
+    """Shifts along the outline (arc length) of a placement: ``error * delta_i * sign_i`` for finger
+    ``i``, stopped at its limits ``(lo, hi)`` less ``step`` when ``limits`` are given (a placement
+    inside the certified regions, which stop there too); a finger whose limits are narrower than
+    ``2 step`` stays put.
+
+    Examples
+    --------
+    A finger at arc length 10 with tolerance 4 and limits (8, 20) slides back at most to 8:
+
+    >>> placement([4.0, 4.0], [10.0, 50.0], [(8.0, 20.0), (40.0, 60.0)], 1.0, [-1, 1])
+    [-2.0, 4.0]
+    >>> placement([4.0, 4.0], [10.0, 50.0], None, 2.0, [-1, 1])
+    [-8.0, 8.0]
+    """
+    shifts = [error * d * s for d, s in zip(deltas, signs)]
+    if limits is None:
+        return shifts
+    return [min(max(x + p, a + step), b - step) - p if b - a > 2 * step else 0.0
+            for x, p, (a, b) in zip(shifts, positions, limits)]
+
+
 def _trial(plan: _Planned, grasp: Grasp, truth: Boundary, obj: PlanarObject, perceived: np.ndarray,
            settings: Validation, physics: Physics, nominal: bool) -> dict:
     """Execute one (possibly moved) grasp on the true object and in physics: the outcome columns."""
@@ -361,11 +384,9 @@ def validate_object(subject: Subject, settings: Validation = QUICK_VALIDATION, r
             for _ in range(count):
                 e = float(hi - (hi - lo) * rng.random())  # in (lo, hi]
                 signs = rng.choice((-1.0, 1.0), size=len(deltas))
-                shifts = [e * d * s for d, s in zip(deltas, signs)]
-                if kind == "inside":  # the certified regions stop at each finger's limits (its feasible region)
-                    shifts = [min(max(x + p, a + step), b - step) - p if b - a > 2 * step else 0.0
-                              for x, p, (a, b) in zip(shifts, positions, plan.tolerance.limits)]
-                    e = max(abs(x) / d for x, d in zip(shifts, deltas))
+                shifts = placement(deltas, positions, plan.tolerance.limits if kind == "inside" else None, e,
+                                   signs, step)
+                e = max(abs(x) / d for x, d in zip(shifts, deltas))
                 row = {**base, "placement": kind, "error": e, "error_fraction": max(abs(x) for x in shifts) / truth.size,
                        "setting": "default",
                        **_trial(plan, _moved(g, arc, positions, shifts), truth, obj, perceived, settings,
