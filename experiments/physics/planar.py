@@ -391,7 +391,8 @@ class Hold:
     Attributes
     ----------
     held : bool
-        The object moved less than the slip tolerance (squeeze and disturbance).
+        The squeeze brought the object to rest and the disturbance moved it less than the slip
+        tolerance from there.
     ejected : bool
         The squeeze alone pushed it out (module notes).
     displacement : float
