@@ -104,3 +104,19 @@ def test_closed_form_cases_within_the_trials_resolution(physics):
             assert -0.05 <= r.error <= 0.12, r
         else:
             assert r.measured == 0.0, r
+
+
+def test_a_weak_frictionless_grasp_is_soft_not_loose():
+    """A FormGrasp placement on the nut (inside its certified regions, epsilon 0.022 on the true
+    object): the floor load moves it past the slip tolerance with the default springs, to a new rest
+    pose; with fingers twice as stiff it holds in every direction."""
+    from qualgrasp.experiments.study import subjects
+
+    nut = PlanarObject.from_polygon(subjects(["nut"])[0].geometry)
+    fingers = [Finger((0.41805327, -0.14193590), (-0.86609531, 0.49987890)),
+               Finger((-0.38116904, 0.20582125), (0.86578838, -0.50041031)),
+               Finger((-0.38075880, -0.20653182), (0.86609724, 0.49987556)),
+               Finger((0.38075832, 0.20653264), (-0.86579525, -0.50039842))]
+    soft = hold(nut, fingers, 0.0, 0.02 * DIRECTIONS[0])
+    assert not soft.held and not soft.ejected and soft.displacement < 1.5 * Physics().slip
+    assert holds(nut, fingers, 0.0, physics=Physics(stiffness=1000.0)) == (True, None)

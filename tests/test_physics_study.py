@@ -66,6 +66,7 @@ def test_explain_names_the_cause():
     assert explain({**base, "eps_true": 1e-4}).startswith("epsilon on the true object")
     assert explain({**base, "eps_true": 0.2}) == "unexplained"
     assert explain({**base, "executed": "collision"}) == "a finger started inside the true object"
+    assert explain({**base, "eps_true": 0.2, "held_stiff": True}).startswith("compliance")
 
 
 def _app():

@@ -57,7 +57,7 @@ import math
 import time
 import zlib
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence
 
@@ -80,13 +80,17 @@ from . import closed_forms
 from .planar import DIRECTIONS, Finger, Physics, PlanarObject, hold, holds, resistance
 from .plots import plot_all, plot_filmstrip
 
-__all__ = ["COLUMNS", "FINE", "Validation", "QUICK_VALIDATION", "FULL_VALIDATION", "VALIDATIONS",
+__all__ = ["COLUMNS", "FINE", "STIFF", "Validation", "QUICK_VALIDATION", "FULL_VALIDATION", "VALIDATIONS",
            "ValidationResult", "grasps_of", "placement", "validate_object", "explain", "summarise", "summary_markdown",
            "read_trials", "read_closed_forms", "filmstrip", "report", "validate"]
 
 FINE = Physics(dt=5e-4, iterations=40, stiffness=1000.0)
 """The second physics setting: half the time step, twice the solver iterations, twice the
 finger stiffness."""
+
+STIFF = 1000.0
+"""Finger stiffness (``F0`` per size) of the re-check of a placement inside that did not hold
+(:func:`explain`: compliance)."""
 
 COLUMNS = ("object", "source", "route", "procedure", "fingers", "mu", "grasp", "certified", "eps",
            "delta_fraction", "tolerance", "placement", "error", "error_fraction", "executed",
@@ -327,7 +331,11 @@ def explain(row: dict, physics: Physics = Physics()) -> str:
     (the image's contour differs from it there: a vision error); its epsilon on the true object is
     below what the floor disturbance needs (``eps_true < floor / (fingers * max_force)``: even
     ideal fingers pressing ``max_force`` could not resist the floor); the squeeze pushed the object
-    out although the grasp is certified (the equal preloads found no balance); or ``unexplained``.
+    out although the grasp is certified (the equal preloads found no balance); **compliance**: the
+    same placement holds with fingers of stiffness :data:`STIFF` (the row's ``held_stiff``, which
+    :func:`validate_object` fills in for such rows): a weak grasp is soft, and the floor load
+    moves the object past the slip tolerance to a new rest pose without it escaping; or
+    ``unexplained``.
 
     Examples
     --------
@@ -347,6 +355,9 @@ def explain(row: dict, physics: Physics = Physics()) -> str:
     need = physics.floor / (row.get("fingers", 1) * physics.max_force)
     if row.get("eps_true", 0.0) < need:
         return f"epsilon on the true object {row.get('eps_true', 0.0):.3g} below {need:.3g}: too weak for the floor"
+    if row.get("held_stiff"):
+        return (f"compliance: the fingers' springs let the object move past the slip tolerance to a new rest pose; "
+                f"held with fingers {STIFF / physics.stiffness:g} times stiffer")
     return "unexplained"
 
 
@@ -393,6 +404,10 @@ def validate_object(subject: Subject, settings: Validation = QUICK_VALIDATION, r
                                 settings.physics, False)}
                 if kind == "inside" and not row["held"]:
                     row["explanation"] = explain(row, settings.physics)
+                    if row["explanation"] == "unexplained":
+                        stiff = _trial(plan, _moved(g, arc, positions, shifts), truth, obj, perceived, settings,
+                                       replace(settings.physics, stiffness=STIFF), False)
+                        row["explanation"] = explain({**row, "held_stiff": stiff["held"]}, settings.physics)
                 rows.append(row)
     return [{c: r.get(c) for c in COLUMNS} for r in rows]
 
