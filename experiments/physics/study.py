@@ -330,7 +330,10 @@ def explain(row: dict, physics: Physics = Physics()) -> str:
     or started inside the true object; the executed grasp is not certified on the true object
     (the image's contour differs from it there: a vision error); its epsilon on the true object is
     below what the floor disturbance needs (``eps_true < floor / (fingers * max_force)``: even
-    ideal fingers pressing ``max_force`` could not resist the floor); the squeeze pushed the object
+    ideal fingers pressing ``max_force`` could not resist the floor; ``eps_true < floor / fingers``:
+    the squeeze's total normal force, ``fingers * F0``, resists a ball of wrenches of radius
+    ``eps_true * fingers`` F0 only, smaller than the floor, and friction forces do not grow with a
+    push); the squeeze pushed the object
     out although the grasp is certified (the equal preloads found no balance); **compliance**: the
     same placement holds with fingers of stiffness :data:`STIFF` (the row's ``held_stiff``, which
     :func:`validate_object` fills in for such rows): a weak grasp is soft, and the floor load
@@ -352,9 +355,12 @@ def explain(row: dict, physics: Physics = Physics()) -> str:
         return "not certified on the true object (vision error)"
     if row.get("ejected"):
         return "certified on the true object, but the squeeze alone pushed it out (the preloads have no balance)"
-    need = physics.floor / (row.get("fingers", 1) * physics.max_force)
-    if row.get("eps_true", 0.0) < need:
-        return f"epsilon on the true object {row.get('eps_true', 0.0):.3g} below {need:.3g}: too weak for the floor"
+    eps, m = row.get("eps_true", 0.0), row.get("fingers", 1)
+    if eps < physics.floor / (m * physics.max_force):
+        return f"epsilon on the true object {eps:.3g}: too weak for the floor even at the largest finger force"
+    if eps < physics.floor / m:
+        return (f"epsilon on the true object {eps:.3g}: too weak for the floor at the squeeze force "
+                f"(eps x {m} F0 = {eps * m:.3g} F0 < {physics.floor:g} F0)")
     if row.get("held_stiff"):
         return (f"compliance: the fingers' springs let the object move past the slip tolerance to a new rest pose; "
                 f"held with fingers {STIFF / physics.stiffness:g} times stiffer")
