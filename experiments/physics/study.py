@@ -629,6 +629,8 @@ def validate(images: Iterable[Any], out: str | Path, *, settings: str | Validati
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     closed = {"default": closed_forms.cases(settings.physics), "fine": closed_forms.cases(FINE)}
+    closed_file = _write_csv(out / "closed-forms.csv", ("setting", "case", "formula", "exact", "measured", "error",
+                                                        "unit"), _closed_rows(closed))
     say("closed-form cases")
     tasks = [(s, settings, k < settings.recheck) for k, s in enumerate(items)]
     rows: list[dict] = []
@@ -646,9 +648,7 @@ def validate(images: Iterable[Any], out: str | Path, *, settings: str | Validati
             say(f"objects {k + 1}/{len(tasks)}")
     seconds = time.perf_counter() - start
     summary = summarise(rows)
-    files = [trials,
-             _write_csv(out / "closed-forms.csv", ("setting", "case", "formula", "exact", "measured", "error", "unit"),
-                        _closed_rows(closed))]
+    files = [trials, closed_file]
     pairs = _setting_pairs(rows)
     files.append(_write_csv(out / "settings.csv", ("object", "route", "grasp", "held_default", "held_fine",
                                                    "resisted_default", "resisted_fine"),
