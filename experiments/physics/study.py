@@ -353,14 +353,14 @@ def explain(row: dict, physics: Physics = Physics()) -> str:
         return "a finger started inside the true object"
     if not row.get("certified_true"):
         return "not certified on the true object (vision error)"
-    if row.get("ejected"):
-        return "certified on the true object, but the squeeze alone pushed it out (the preloads have no balance)"
     eps, m = row.get("eps_true", 0.0), row.get("fingers", 1)
     if eps < physics.floor / (m * physics.max_force):
         return f"epsilon on the true object {eps:.3g}: too weak for the floor even at the largest finger force"
     if eps < physics.floor / m:
         return (f"epsilon on the true object {eps:.3g}: too weak for the floor at the squeeze force "
                 f"(eps x {m} F0 = {eps * m:.3g} F0 < {physics.floor:g} F0)")
+    if row.get("ejected"):
+        return "certified on the true object, but the squeeze alone pushed it out (the preloads have no balance)"
     if row.get("held_stiff"):
         return (f"compliance: the fingers' springs let the object move past the slip tolerance to a new rest pose; "
                 f"held with fingers {STIFF / physics.stiffness:g} times stiffer")
