@@ -78,9 +78,9 @@ def plot_placements(out: Path, rows: list[dict], outside_max: float) -> list[Pat
     with context():
         fig = new_figure(5.6, 3.1)
         ax = fig.subplots()
-        ax.axvspan(0, 1, color=GOOD, alpha=0.08, lw=0)
+        ax.axvspan(0, 1, ymin=0.15 / 1.23, color=GOOD, alpha=0.08, lw=0)
         ax.axvline(1.0, color=GOOD, lw=1.0, ls="--")
-        ax.text(0.5, 0.03, "inside the certified\nregions", ha="center", va="bottom", fontsize=8, color="darkgreen")
+        ax.text(0.5, 0.45, "inside the certified\nregions", ha="center", va="center", fontsize=8, color="darkgreen")
         ax.text(1.03, 1.03, "certified tolerance", ha="left", va="bottom", fontsize=8, color="darkgreen")
         for source in ("qualitative", "baseline"):
             sel = [r for r in moved if r["source"] == source]
@@ -93,17 +93,18 @@ def plot_placements(out: Path, rows: list[dict], outside_max: float) -> list[Pat
             count = np.array([(k == b).sum() for b in range(len(centres))])
             colour, marker = _SOURCE[source]
             ax.plot(centres, rate, marker=marker, color=colour, label=f"{source} ({len(sel)} placements)")
+            row = -0.13 if source == "qualitative" else -0.075  # trials per bin, in rows below the rates
             for x, y, c in zip(centres, rate, count):
                 if c and not math.isnan(y):
-                    ax.annotate(str(c), (x, y), textcoords="offset points", xytext=(0, 5 if source == "qualitative"
-                                                                                   else -11),
-                                ha="center", fontsize=6.5, color=colour)
-        ax.set_ylim(0, 1.08)
+                    ax.text(x, row, str(c), ha="center", va="bottom", fontsize=6.5, color=colour)
+        ax.set_ylim(-0.15, 1.08)
+        ax.set_yticks(np.linspace(0, 1, 6))
+        ax.axhline(0, color="0.75", lw=0.6)
         ax.set_xlim(0, edges[-1])
         ax.set_xlabel("placement error (x certified tolerance; each finger slid this far along the outline)")
         ax.set_ylabel("held rate")
         ax.legend(loc="upper right", bbox_to_anchor=(1.0, 0.93))
-        ax.set_title("Held rate of placements inside and outside the certified regions (trials per bin)")
+        ax.set_title("Held rate of placements inside and outside the certified regions\n(numbers below zero: trials per bin)")
         return save(fig, out, "physics-placements", _FORMATS)
 
 
