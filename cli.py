@@ -13,6 +13,7 @@ from qualgrasp import __version__
 from qualgrasp.certify import cli as certify_cli
 from qualgrasp.certify.meshes import cli as meshes_cli
 from qualgrasp.experiments import cli as experiments_cli
+from qualgrasp.experiments.physics import cli as physics_cli
 from qualgrasp.qualitative import cli as qualitative_cli
 
 __all__ = ["app", "main"]
@@ -38,6 +39,7 @@ certify_cli.register(app)
 meshes_cli.register(app)
 qualitative_cli.register(app)
 experiments_cli.register(app)
+physics_cli.register(app)
 
 
 def main() -> None:

@@ -37,7 +37,9 @@ def test_qualitative_grasps_of_the_square_hold_and_their_placements_inside_too(s
     _, result = square_run
     nominal = [r for r in result.rows if r["source"] == "qualitative" and r["placement"] == "nominal"
                and r["setting"] == "default"]
-    assert {r["fingers"] for r in nominal} == {2, 4}  # ForceGrasp finds no 3-finger grasp on a square
+    # ForceGrasp finds no 3-finger grasp on a square; PairGrasp adds a third finger to an opposed pair
+    assert {r["fingers"] for r in nominal} == {2, 3, 4}
+    assert {r["procedure"] for r in nominal if r["fingers"] == 3} == {"pairgrasp3"}
     for r in nominal:
         assert r["certified"] and r["certified_true"] and r["held"] and r["resisted"] > 0, r
         assert r["delta_fraction"] > 0 and r["tolerance"] == "robust"

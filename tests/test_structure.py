@@ -12,12 +12,12 @@ import pytest
 import qualgrasp
 
 ROOT = pathlib.Path(qualgrasp.__file__).parent
-#: Imports allowed inside functions: optional dependencies (dask.distributed, h5py for ACRONYM
+#: Imports allowed inside functions: optional dependencies (dask.distributed, pymunk, h5py for ACRONYM
 #: pose files, embreex and trimesh's embree route where embreex installs), a platform module
 #: (resource), and cvxpy's reference route (1.5 s to import; only ``make_solver("reference")``
 #: needs it).
 LAZY = {"distributed", "resource", "qualgrasp.certify.solvers.reference", "h5py", "embreex",
-        "trimesh.ray.ray_pyembree"}
+        "trimesh.ray.ray_pyembree", "pymunk"}
 
 
 def _modules():
