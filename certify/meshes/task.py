@@ -78,8 +78,9 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Sequence
 
-import cvxpy as cp
+import clarabel
 import numpy as np
+import scipy.sparse as sp
 import trimesh
 
 from .. import cones
@@ -88,6 +89,7 @@ from ..certificates import Check
 from ..evidence import cycle_check, exact_face
 from ..grasp import Grasp
 from ..problem import Block, grasp_system
+from ..solvers.clarabel_direct import settings
 from ..wrench import to_exact, wrench
 
 __all__ = ["G", "GripBound", "SlipCertificate", "EveryDirection", "gravity_wrench", "least_grip",
@@ -186,45 +188,72 @@ def _normal_rows(blocks: Sequence[Block], k: int) -> np.ndarray:
 
 
 class _Programs:
-    """The two programmes of one grasp, built once (cvxpy Parameters for the weight)."""
+    """The two programmes of one grasp, in clarabel's form ``min q'z : A z + s = b, s in K``
+    (:func:`qualgrasp.certify.solvers.clarabel_direct.settings`), over ``z = (x, theta)`` or ``(x,
+    t)``. The cone rows are built once; the weight and the budget change per solve."""
 
     def __init__(self, grasp: Grasp) -> None:
         C, blocks, _ = grasp_system(grasp, socp=True)
         self.C, self.blocks = np.asarray(C, dtype=float), blocks
         d, k = self.C.shape
         self.N = _normal_rows(blocks, k)
-        self.w = cp.Parameter(d)
-        self.budget = cp.Parameter(nonneg=True)
-        x, theta, t = cp.Variable(k), cp.Variable(), cp.Variable()
-        self.x, self.theta, self.t = x, theta, t
-        cone_h = self._cones(x, 0)
-        self.equilibrium = self.C @ x + theta * self.w == 0
-        self.normal = self.N @ x <= 1
-        self.least = cp.Problem(cp.Maximize(theta), [self.equilibrium, self.normal, theta >= 0, *cone_h])
-        # strict forces at a budget: maximise the smallest slack of the cones and of the budget
-        self.interior = cp.Problem(cp.Maximize(t), [self.C @ x + self.w == 0, self.N @ x <= self.budget - t,
-                                                    t <= self.budget, *self._cones(x, t)])
-
-    def _cones(self, x, t) -> list:
-        out = []
-        for b in self.blocks:
+        # per block: the rows of -(its cone's slack) in x, and how the margin variable enters its first row
+        rows, tcol, cones = [], [], []
+        for b in blocks:
             if b.cone == "ray":
-                out.append(x[b.cols[0]] >= t)
+                r = np.zeros((1, k))
+                r[0, b.cols[0]] = -1.0
+                rows.append(r), tcol.append([1.0]), cones.append(clarabel.NonnegativeConeT(1))
                 continue
             dim = len(b.n)
             n = np.array([float(v) for v in b.n])
-            f = x[list(b.cols[:dim])]
-            fn = n @ f
-            parts = [f - fn * n] + [x[j] / float(b.g) for j in b.cols[dim:]]
-            out.append(cp.SOC(float(b.mu) * fn - t, cp.hstack(parts)))
-        return out
+            r = np.zeros((1 + len(b.cols), k))  # (mu n.f, tangent part of f, moments / g)
+            f = list(b.cols[:dim])
+            r[0, f] = -float(b.mu) * n
+            r[1:dim + 1, f] = -(np.eye(dim) - np.outer(n, n))
+            for i, j in enumerate(b.cols[dim:]):
+                r[dim + 1 + i, j] = -1.0 / float(b.g)
+            rows.append(r), tcol.append([1.0] + [0.0] * (len(r) - 1)), cones.append(clarabel.SecondOrderConeT(len(r)))
+        self.cone_A = np.vstack(rows) if rows else np.zeros((0, k))
+        self.cone_t = np.concatenate(tcol) if tcol else np.zeros(0)
+        self.cones = cones
 
-    def solve(self, problem: cp.Problem) -> bool:
+    def _solve(self, A: np.ndarray, b: np.ndarray, cones: list):
+        n = A.shape[1]
+        q = np.zeros(n)
+        q[-1] = -1.0
         try:
-            problem.solve(solver=cp.CLARABEL)
-        except cp.error.SolverError:
-            return False
-        return problem.status in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE)
+            sol = clarabel.DefaultSolver(sp.csc_matrix((n, n)), q, sp.csc_matrix(A), b, cones, settings()).solve()
+        except (ValueError, RuntimeError):  # clarabel refuses malformed data; not seen on grasps
+            return None
+        return sol if str(sol.status) in ("Solved", "AlmostSolved") else None
+
+    def least(self, w: np.ndarray) -> tuple[float, np.ndarray] | None:
+        """``max theta : C x + theta w = 0, N x <= 1, theta >= 0, x in K``: ``theta*`` and the
+        dual of the equilibrium rows, or None when the solver fails."""
+        d, k = self.C.shape
+        m = len(self.N)
+        A = np.vstack([np.column_stack([self.C, w]), np.column_stack([self.N, np.zeros(m)]),
+                       np.concatenate([np.zeros(k), [-1.0]])[None], np.column_stack([self.cone_A, np.zeros(len(self.cone_A))])])
+        b = np.concatenate([np.zeros(d), np.ones(m), [0.0], np.zeros(len(self.cone_A))])
+        sol = self._solve(A, b, [clarabel.ZeroConeT(d), clarabel.NonnegativeConeT(m + 1), *self.cones])
+        if sol is None:
+            return None
+        return float(np.asarray(sol.x)[-1]), np.asarray(sol.z)[:d]
+
+    def interior(self, w: np.ndarray, budget: float) -> tuple[np.ndarray, float] | None:
+        """``max t : C x + w = 0, N x <= budget - t, t <= budget``, every cone's slack ``>= t``:
+        forces ``x`` and ``t``, or None when the solver fails."""
+        d, k = self.C.shape
+        m = len(self.N)
+        A = np.vstack([np.column_stack([self.C, np.zeros(d)]), np.column_stack([self.N, np.ones(m)]),
+                       np.concatenate([np.zeros(k), [1.0]])[None], np.column_stack([self.cone_A, self.cone_t])])
+        b = np.concatenate([-w, np.full(m + 1, budget), np.zeros(len(self.cone_A))])
+        sol = self._solve(A, b, [clarabel.ZeroConeT(d), clarabel.NonnegativeConeT(m + 1), *self.cones])
+        if sol is None:
+            return None
+        z = np.asarray(sol.x)
+        return z[:-1], float(z[-1])
 
 
 def _multipliers(C: np.ndarray, blocks: Sequence[Block], y: np.ndarray, tight: tuple[int, ...],
@@ -260,14 +289,12 @@ def _multipliers(C: np.ndarray, blocks: Sequence[Block], y: np.ndarray, tight: t
 _MARGINS = (1e-10, 1e-7, 1e-4)
 
 
-def _slip(programs: _Programs, grasp: Grasp, mass: float, com, direction, w: np.ndarray,
+def _slip(programs: _Programs, y_eq: np.ndarray, grasp: Grasp, mass: float, com, direction, w: np.ndarray,
           cap: float) -> tuple[SlipCertificate | None, float]:
-    """A slip certificate from the dual direction of the homogeneous programme and the grip force
+    """A slip certificate from the dual ``y_eq`` of the homogeneous programme's equilibrium (either
+    sign) and the grip force
     ``lo`` it proves, at most ``cap`` (``inf`` when it proves that no grip force holds); ``(None,
     0)`` when none re-checks. Every certificate returned has passed :func:`check_slips`."""
-    y_eq = programs.equilibrium.dual_value
-    if y_eq is None:
-        return None, 0.0
     C, blocks = programs.C, programs.blocks
     scale = np.abs(C).max()
     for sign in (1.0, -1.0):
@@ -303,11 +330,12 @@ def _holding(programs: _Programs, grasp: Grasp, mass: float, com, direction,
     """Forces holding the weight at grip force ``budget``, or at the least of two wider budgets
     that re-checks, with that budget; ``(inf, None)`` when none re-checks. Every pair returned has
     passed :func:`check_holds`."""
+    w = gravity_wrench(grasp, mass, com, direction)
     for widen in (1.0, 1 + 1e-4, 1 + 1e-2):
-        programs.budget.value = budget * widen
-        if not (programs.solve(programs.interior) and programs.t.value is not None and programs.t.value > 0):
+        got = programs.interior(w, budget * widen)
+        if got is None or not got[1] > 0:
             continue
-        forces = tuple(float(v) for v in programs.x.value)
+        forces = tuple(float(v) for v in got[0])
         if check_holds(grasp, mass, com, direction, budget * widen, forces):
             return budget * widen, forces
     return math.inf, None
@@ -349,13 +377,13 @@ def least_grip(grasp: Grasp, mass: float, com: Sequence[float], direction: Seque
     programs = programs or _Programs(grasp)
     d = tuple(float(v) for v in direction)
     w = gravity_wrench(grasp, mass, com, d)
-    programs.w.value = w
-    if not programs.solve(programs.least):
+    got = programs.least(w)
+    if got is None:
         return GripBound(d, 0.0, math.inf, None, None, "the solver failed: no bound stated")
-    theta = float(programs.theta.value)
+    theta, y_eq = got
     s_star = 1.0 / theta if theta > 0 else math.inf
     cap = s_star * (1 - _BRACKET)
-    slip, lo = _slip(programs, grasp, mass, com, d, w, cap)
+    slip, lo = _slip(programs, y_eq, grasp, mass, com, d, w, cap)
     notes = []
     if slip is None:
         notes.append("no lower bound: no slip certificate re-checked")
