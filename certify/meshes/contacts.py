@@ -183,14 +183,22 @@ def rim_touch(local: np.ndarray, edges: np.ndarray, gripper: ParallelJaw, side: 
     """
     a, b = gripper.pad_width / 2, gripper.pad_height / 2
     disc = gripper.pad_shape == "disc"
-    travel = w / 2 - side * local[:, 0]
     if disc:
-        inside = local[:, 1] ** 2 + local[:, 2] ** 2 <= a * a
-    else:
-        inside = (np.abs(local[:, 1]) <= a) & (np.abs(local[:, 2]) <= b)
-    inside &= (travel >= 0) & (travel <= w)
+        b = a
+    y, z = local[:, 1], local[:, 2]
+    # which side of each of the prism's bounding planes a vertex lies on: an edge whose two ends lie
+    # beyond the same plane cannot meet the prism, and one with both ends inside crosses no side
+    low_y, high_y, low_z, high_z = y < -a, y > a, z < -b, z > b
+    out = low_y | high_y | low_z | high_z
+    if disc:
+        out |= y * y + z * z > a * a
+    travel = w / 2 - side * local[:, 0]
+    inside = ~out & (travel >= 0) & (travel <= w)
     cands = [local[inside]]
-    P0, D = local[edges[:, 0]], local[edges[:, 1]] - local[edges[:, 0]]
+    i, j = edges[:, 0], edges[:, 1]
+    keep = ((out[i] | out[j]) & ~(low_y[i] & low_y[j]) & ~(high_y[i] & high_y[j])
+            & ~(low_z[i] & low_z[j]) & ~(high_z[i] & high_z[j]))
+    P0, D = local[i[keep]], local[j[keep]] - local[i[keep]]
     if disc:  # |(P0 + s D)_yz|^2 = a^2, a quadratic in s
         qa = D[:, 1] ** 2 + D[:, 2] ** 2
         qb = 2 * (P0[:, 1] * D[:, 1] + P0[:, 2] * D[:, 2])
@@ -200,15 +208,15 @@ def rim_touch(local: np.ndarray, edges: np.ndarray, gripper: ParallelJaw, side: 
         root = np.sqrt(np.where(ok, disc_, 0.0))
         for sgn in (-1.0, 1.0):
             s = np.where(ok, (-qb + sgn * root) / np.where(ok, 2 * qa, 1.0), -1.0)
-            keep = (s >= 0) & (s <= 1)
-            cands.append(P0[keep] + s[keep, None] * D[keep])
+            hit = (s >= 0) & (s <= 1)
+            cands.append(P0[hit] + s[hit, None] * D[hit])
     else:
         for axis, bound, other, obound in ((1, a, 2, b), (2, b, 1, a)):
             for c in (-bound, bound):
                 ok = D[:, axis] != 0
                 s = np.where(ok, (c - P0[:, axis]) / np.where(ok, D[:, axis], 1.0), -1.0)
-                keep = (s >= 0) & (s <= 1)
-                pts = P0[keep] + s[keep, None] * D[keep]
+                hit = (s >= 0) & (s <= 1)
+                pts = P0[hit] + s[hit, None] * D[hit]
                 pts[:, axis] = c  # exactly on the side plane
                 cands.append(pts[np.abs(pts[:, other]) <= obound])
     pts = np.vstack(cands)
@@ -237,9 +245,14 @@ def approach_collision(mesh: trimesh.Trimesh, caster: RayCaster, T: np.ndarray, 
                         w: float) -> str | None:
     """The part that meets the object while approaching, or None (module docstring, step 2)."""
     R, o = T[:3, :3], T[:3, 3]
-    local = (mesh.vertices - o) @ R  # vertices in gripper coordinates
+    V = mesh.vertices.view(np.ndarray)  # a plain array: trimesh's tracked one hashes itself on every use
+    boxes = _sweep_boxes(gripper, w)
+    # only vertices across the prisms' lateral extent can lie inside one
+    reach = max(float(np.abs(box[1]).max()) for _, box, _ in boxes)
+    near = np.abs((V - o) @ R[:, 1]) <= reach
+    local = (V[near] - o) @ R  # those vertices in gripper coordinates
     origins, parts = [], []
-    for part, box, top in _sweep_boxes(gripper, w):
+    for part, box, top in boxes:
         inside = ((local[:, 0] >= box[0, 0]) & (local[:, 0] <= box[0, 1]) & (local[:, 1] >= box[1, 0])
                   & (local[:, 1] <= box[1, 1]) & (local[:, 2] <= top))
         if inside.any():
@@ -312,7 +325,7 @@ def jaw_contacts(mesh: trimesh.Trimesh, gripper: ParallelJaw, poses: np.ndarray,
     caster = caster or RayCaster(mesh)
     uv, cell = pad_grid(gripper, resolution)
     rim = pad_rim(gripper, resolution)
-    edges = np.asarray(mesh.edges_unique)
+    edges = np.asarray(mesh.edges_unique).view(np.ndarray)
     cell_area = gripper.pad_width * gripper.pad_height / resolution ** 2
     out = []
     for T, w in zip(np.asarray(poses, dtype=float), np.asarray(widths, dtype=float)):
@@ -329,7 +342,7 @@ def jaw_contacts(mesh: trimesh.Trimesh, gripper: ParallelJaw, poses: np.ndarray,
             out.append(Outcome(reason="collision", message=f"the {part} meets the object while approaching"))
             continue
         R, o = T[:3, :3], T[:3, 3]
-        vertices = (mesh.vertices - o) @ R  # in gripper coordinates
+        vertices = (mesh.vertices.view(np.ndarray) - o) @ R  # in gripper coordinates
         patches = []
         for name, side in (("A", 1.0), ("B", -1.0)):
             patch = _pad_patch(mesh, caster, R, o, vertices, edges, gripper, side, w, uv, rim,
