@@ -93,7 +93,8 @@ from ..solvers.clarabel_direct import settings
 from ..wrench import to_exact, wrench
 
 __all__ = ["G", "GripBound", "SlipCertificate", "EveryDirection", "gravity_wrench", "least_grip",
-           "check_holds", "check_slips", "check_bound", "direction_polytope", "every_direction", "check_every_direction",
+           "check_holds", "check_slips", "check_bound", "direction_polytope", "every_direction",
+           "check_every_direction",
            "hold_verdict"]
 
 #: Standard gravity, m/s^2.
@@ -233,8 +234,9 @@ class _Programs:
         dual of the equilibrium rows, or None when the solver fails."""
         d, k = self.C.shape
         m = len(self.N)
-        A = np.vstack([np.column_stack([self.C, w]), np.column_stack([self.N, np.zeros(m)]),
-                       np.concatenate([np.zeros(k), [-1.0]])[None], np.column_stack([self.cone_A, np.zeros(len(self.cone_A))])])
+        theta_row = np.concatenate([np.zeros(k), [-1.0]])[None]  # -theta <= 0
+        A = np.vstack([np.column_stack([self.C, w]), np.column_stack([self.N, np.zeros(m)]), theta_row,
+                       np.column_stack([self.cone_A, np.zeros(len(self.cone_A))])])
         b = np.concatenate([np.zeros(d), np.ones(m), [0.0], np.zeros(len(self.cone_A))])
         sol = self._solve(A, b, [clarabel.ZeroConeT(d), clarabel.NonnegativeConeT(m + 1), *self.cones])
         if sol is None:
