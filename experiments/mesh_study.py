@@ -233,12 +233,11 @@ def real_study(args) -> dict:
               "verdicts": {"holds": 0, "slips": 0, "undecided": 0}, "edge8_differs": 0, "edge8_optimistic": 0,
               "edge8_pessimistic": 0, "optimistic_forces_outside_exact_cones": 0, "per_mesh": {}, "messages": [],
               "notes": []}
-    for left, (name, (mesh, source)) in zip(range(len(meshes), 0, -1), meshes.items()):
+    per = max(1, args.poses // max(1, len(meshes)))  # a mesh that offers fewer is not made up for
+    for name, (mesh, source) in meshes.items():
         report["sources"][source] = report["sources"].get(source, 0) + 1
         caster = RayCaster(mesh)
-        # an even share of the poses still wanted: a mesh that offers fewer leaves more to the rest
-        want = max(1, -(-(args.poses - report["poses"]) // left))
-        poses = sample_poses(mesh, gripper, want, mu=args.mu, seed=2, caster=caster)
+        poses = sample_poses(mesh, gripper, per, mu=args.mu, seed=2, caster=caster)
         props = mass_properties(mesh, mass=args.mass)
         mine = {"poses": len(poses), "contacts": 0, "holds": 0}
         for p in poses:
