@@ -68,3 +68,22 @@ def test_a_pad_whose_cells_meet_the_object_is_unchanged():
     a = out.patches[0]
     assert a.travel == pytest.approx(0.01) and a.area == pytest.approx(PANDA.pad_width * PANDA.pad_height)
     assert len(a.points) == 21 * 21
+
+
+def test_a_thin_wall_through_the_pad_is_a_collision():
+    """A 0.2 mm wall between the cells' rays and the approach test's rays, passing through pad A's
+    face: no vertex in the finger's prism, no ray starting inside, yet the pad cuts into it."""
+    mesh = bar((0.0, 0.0005, -0.005), (0.05, 0.0007, 0.005))
+    out = jaw_contacts(mesh, PANDA, np.eye(4)[None], np.array([W]))[0]
+    assert out.reason == "collision" and "pad A cuts into the object" in out.message
+
+
+def test_sampled_poses_do_not_cut_into_a_curved_object():
+    """On a capsule the sampler's 5 mm clearance does not always clear a pad's corner (a cell of
+    pad B once started inside it): such approaches are not kept."""
+    from qualgrasp.certify.meshes.sampling import sample_poses
+
+    mesh = trimesh.creation.capsule(0.05, 0.02)
+    poses = sample_poses(mesh, PANDA, 25, mu=0.5, seed=0)
+    out = jaw_contacts(mesh, PANDA, np.array([p.T for p in poses]), np.array([p.width for p in poses]))
+    assert len(poses) == 25 and all(o.ok for o in out)

@@ -25,8 +25,9 @@ Parallel jaws (:func:`jaw_contacts`), in the ``qualgrasp`` pose convention
    edge crossings solved on the cylinder). The pad is also sampled on a ``resolution x
    resolution`` grid of cells (a disc pad keeps the cells whose centre lies inside it); each
    cell casts a ray along the closing direction. A pad that meets nothing is an error row
-   (``no_contact``); a ray that starts inside the object (its first face is met from behind) is
-   a ``collision``.
+   (``no_contact``); a ray that starts inside the object (its first face is met from behind), or
+   a mesh edge passing through the pad's face (:func:`pierces_pad`: a thin wall between the
+   approach test's rays cuts into the pad) is a ``collision``.
 4. **Patch.** The cells whose ray meets the mesh within ``tolerance`` beyond the first touch
    form the patch: the pad pressed ``tolerance`` into the object would penetrate there (the
    pad's compliance). Its points are the ray hits. When no cell does (the object touches only
@@ -63,8 +64,8 @@ import trimesh
 from .gripper import ParallelJaw, PointHand
 from .rays import RayCaster
 
-__all__ = ["TOLERANCE", "RESOLUTION", "Patch", "Outcome", "pad_grid", "pad_rim", "rim_touch", "approach_collision",
-           "jaw_contacts", "fingertip_contacts", "REASONS"]
+__all__ = ["TOLERANCE", "RESOLUTION", "Patch", "Outcome", "pad_grid", "pad_rim", "rim_touch", "pierces_pad",
+           "approach_collision", "jaw_contacts", "fingertip_contacts", "REASONS"]
 
 #: Default penetration tolerance, m (a rubber pad's compliance).
 TOLERANCE = 5e-4
@@ -228,6 +229,33 @@ def rim_touch(local: np.ndarray, edges: np.ndarray, gripper: ParallelJaw, side: 
     return float(t[i]), pts[i]
 
 
+def pierces_pad(local: np.ndarray, edges: np.ndarray, gripper: ParallelJaw, side: float, w: float) -> bool:
+    """Does a mesh edge pass through the pad's face (one end in front of it, the other behind,
+    crossing inside the pad's outline)? The object then cuts into the pad: a thin wall can do so
+    between the approach test's rays and with no vertex in the finger's prism.
+
+    Examples
+    --------
+    >>> from qualgrasp.certify.meshes.gripper import load_gripper
+    >>> wall = np.array([[0.02, 0.001, 0.0], [0.05, 0.001, 0.0]])  # an edge through pad A's face at x = 0.03
+    >>> pierces_pad(wall, np.array([[0, 1]]), load_gripper("franka_panda"), 1.0, 0.06)
+    True
+    >>> pierces_pad(wall - [0.0, 0.02, 0.0], np.array([[0, 1]]), load_gripper("franka_panda"), 1.0, 0.06)
+    False
+    """
+    travel = w / 2 - side * local[:, 0]
+    i, j = edges[:, 0], edges[:, 1]
+    cross = (travel[i] < 0) != (travel[j] < 0)
+    cross &= (travel[i] != 0) & (travel[j] != 0)  # an end on the face touches, it does not cut
+    i, j = i[cross], j[cross]
+    s = travel[i] / (travel[i] - travel[j])
+    yz = local[i, 1:] + s[:, None] * (local[j, 1:] - local[i, 1:])
+    a, b = gripper.pad_width / 2, gripper.pad_height / 2
+    if gripper.pad_shape == "disc":
+        return bool((yz[:, 0] ** 2 + yz[:, 1] ** 2 < a * a).any())
+    return bool(((np.abs(yz[:, 0]) < a) & (np.abs(yz[:, 1]) < b)).any())
+
+
 def _grid(a: float, b: float, n: int) -> np.ndarray:
     return (np.arange(n) + 0.5) / n * (b - a) + a
 
@@ -347,10 +375,8 @@ def jaw_contacts(mesh: trimesh.Trimesh, gripper: ParallelJaw, poses: np.ndarray,
         for name, side in (("A", 1.0), ("B", -1.0)):
             patch = _pad_patch(mesh, caster, R, o, vertices, edges, gripper, side, w, uv, rim,
                                tolerance, cell, cell_area)
-            if isinstance(patch, str):
-                patches = Outcome(reason=patch, message=f"pad {name} " + ("meets nothing within the opening"
-                                                                         if patch == "no_contact"
-                                                                         else "starts inside the object"))
+            if isinstance(patch, tuple):
+                patches = Outcome(reason=patch[0], message=f"pad {name} {patch[1]}")
                 break
             patches.append(patch)
         out.append(patches if isinstance(patches, Outcome) else Outcome(tuple(patches)))
@@ -358,20 +384,22 @@ def jaw_contacts(mesh: trimesh.Trimesh, gripper: ParallelJaw, poses: np.ndarray,
 
 
 def _pad_patch(mesh, caster, R, o, vertices, edges, gripper, side, w, uv, rim, tolerance, cell,
-               cell_area) -> Patch | str:
-    """One pad's patch (module docstring, steps 3 and 4), or the reason it has none."""
+               cell_area) -> Patch | tuple[str, str]:
+    """One pad's patch (module docstring, steps 3 and 4), or the reason it has none and why."""
     yz = np.vstack([uv, rim])
     origins = np.column_stack([np.full(len(yz), side * w / 2), yz]) @ R.T + o
     direction = -side * R[:, 0]
     hits = caster.first_hits(origins, np.broadcast_to(direction, origins.shape))
     reach = hits.hit & (hits.t <= w)
+    if pierces_pad(vertices, edges, gripper, side, w):
+        return "collision", "cuts into the object (an edge of the mesh passes through the pad's face)"
     t_exact, point = rim_touch(vertices, edges, gripper, side, w)
     if not reach.any() and point is None:
-        return "no_contact"
+        return "no_contact", "meets nothing within the opening"
     if reach.any():
         first = np.flatnonzero(reach)[np.argmin(hits.t[reach])]
         if mesh.face_normals[hits.face[first]] @ direction > 0:
-            return "collision"
+            return "collision", "starts inside the object"
     t_ray = hits.t[reach].min() if reach.any() else np.inf
     t0 = float(min(t_ray, t_exact))
     cells = reach[:len(uv)] & (hits.t[:len(uv)] <= t0 + tolerance)
