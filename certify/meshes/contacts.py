@@ -16,14 +16,25 @@ Parallel jaws (:func:`jaw_contacts`), in the ``qualgrasp`` pose convention
    modelled beyond its cross-section.
 3. **Closing.** Each pad then closes along the closing axis on its own (the object is taken to
    stay put: a compliant or floating hand, as Dex-Net's and ACRONYM's contact models assume),
-   until its first point touches the mesh. The pad is sampled on a ``resolution x resolution``
-   grid of cells (a disc pad keeps the cells whose centre lies inside it); each cell casts a ray
-   along the closing direction, at most the opening width long. A pad none of whose rays meets
-   the mesh is an error row (``no_contact``); a ray that starts inside the object (its first
-   face is met from behind) is a ``collision``.
+   until its first point touches the mesh, at most the opening width. The contact area is the
+   pad's whole face, rim included, and the first touch is found exactly on it: the smallest
+   travel of a linear function over the surface inside the pad's prism is reached at a corner of
+   some triangle's piece in the prism, that is at a mesh vertex inside the prism, at a mesh edge
+   crossing one of the prism's side planes, or where a prism edge (a ray from a pad corner)
+   meets a face (:func:`rim_touch`; a disc pad's rim is sampled by ``8 resolution`` rays and its
+   edge crossings solved on the cylinder). The pad is also sampled on a ``resolution x
+   resolution`` grid of cells (a disc pad keeps the cells whose centre lies inside it); each
+   cell casts a ray along the closing direction. A pad that meets nothing is an error row
+   (``no_contact``); a ray that starts inside the object (its first face is met from behind), or
+   a mesh edge passing through the pad's face (:func:`pierces_pad`: a thin wall between the
+   approach test's rays cuts into the pad) is a ``collision``.
 4. **Patch.** The cells whose ray meets the mesh within ``tolerance`` beyond the first touch
    form the patch: the pad pressed ``tolerance`` into the object would penetrate there (the
-   pad's compliance). Its points are the ray hits.
+   pad's compliance). Its points are the ray hits. When no cell does (the object touches only
+   the outer half-cell rim of the pad: a vertex, an edge or a face seen only by the rim), the
+   patch is the touching point alone, with no area, the one-cell torsion floor below, and the
+   pad's normal (a flat pad pressing a vertex or an edge of the object) or, for a pad's corner
+   on a face, the face's.
 
 Patch contact model (certify's ``soft`` contact, until a registry model ``patch`` replaces it):
 the contact point is the patch's centroid, the normal the mean of the inward face normals at its
@@ -53,8 +64,8 @@ import trimesh
 from .gripper import ParallelJaw, PointHand
 from .rays import RayCaster
 
-__all__ = ["TOLERANCE", "RESOLUTION", "Patch", "Outcome", "pad_grid", "approach_collision", "jaw_contacts",
-           "fingertip_contacts", "REASONS"]
+__all__ = ["TOLERANCE", "RESOLUTION", "Patch", "Outcome", "pad_grid", "pad_rim", "rim_touch", "pierces_pad",
+           "approach_collision", "jaw_contacts", "fingertip_contacts", "REASONS"]
 
 #: Default penetration tolerance, m (a rubber pad's compliance).
 TOLERANCE = 5e-4
@@ -131,6 +142,120 @@ def pad_grid(gripper: ParallelJaw, resolution: int = RESOLUTION) -> tuple[np.nda
     return uv, max(hy, hz)
 
 
+def pad_rim(gripper: ParallelJaw, resolution: int = RESOLUTION) -> np.ndarray:
+    """Points ``(y, z)`` on the pad's rim whose rays (with the exact rim test) cover it: a
+    rectangle's four corners, or ``8 resolution`` points around a disc.
+
+    Examples
+    --------
+    >>> from qualgrasp.certify.meshes.gripper import load_gripper
+    >>> pad_rim(load_gripper("franka_panda")).tolist()
+    [[-0.00875, -0.00925], [-0.00875, 0.00925], [0.00875, -0.00925], [0.00875, 0.00925]]
+    """
+    a, b = gripper.pad_width / 2, gripper.pad_height / 2
+    if gripper.pad_shape == "disc":
+        phi = np.arange(8 * resolution) * (2 * np.pi / (8 * resolution))
+        return np.column_stack([a * np.cos(phi), a * np.sin(phi)])
+    return np.array([(-a, -b), (-a, b), (a, -b), (a, b)])
+
+
+def rim_touch(local: np.ndarray, edges: np.ndarray, gripper: ParallelJaw, side: float,
+              w: float) -> tuple[float, np.ndarray | None]:
+    """The exact first touch of a pad from the mesh's vertices inside its prism and its edges'
+    crossings of the prism's side surface (module docstring, step 3): ``(travel, point)`` in
+    gripper coordinates, ``(inf, None)`` when neither lies within the opening.
+
+    Parameters
+    ----------
+    local : ndarray, shape (v, 3)
+        Mesh vertices in gripper coordinates.
+    edges : ndarray, shape (e, 2)
+        Vertex indices of the mesh's edges.
+    side : float
+        ``+1`` for pad A (at ``x = +w/2``, closing along ``-x``), ``-1`` for pad B.
+
+    Examples
+    --------
+    >>> from qualgrasp.certify.meshes.gripper import load_gripper
+    >>> V = np.array([[0.025, 0.0095, 0.0], [0.0, 0.0, 0.0]])  # an edge entering the pad's prism
+    >>> t, p = rim_touch(V, np.array([[0, 1]]), load_gripper("franka_panda"), 1.0, 0.06)
+    >>> round(t, 6), p.round(6).tolist()     # it crosses the rim y = 0.00875 nearest to pad A (x = 0.03)
+    (0.006974, [0.023026, 0.00875, 0.0])
+    """
+    a, b = gripper.pad_width / 2, gripper.pad_height / 2
+    disc = gripper.pad_shape == "disc"
+    if disc:
+        b = a
+    y, z = local[:, 1], local[:, 2]
+    # which side of each of the prism's bounding planes a vertex lies on: an edge whose two ends lie
+    # beyond the same plane cannot meet the prism, and one with both ends inside crosses no side
+    low_y, high_y, low_z, high_z = y < -a, y > a, z < -b, z > b
+    out = low_y | high_y | low_z | high_z
+    if disc:
+        out |= y * y + z * z > a * a
+    travel = w / 2 - side * local[:, 0]
+    inside = ~out & (travel >= 0) & (travel <= w)
+    cands = [local[inside]]
+    i, j = edges[:, 0], edges[:, 1]
+    keep = ((out[i] | out[j]) & ~(low_y[i] & low_y[j]) & ~(high_y[i] & high_y[j])
+            & ~(low_z[i] & low_z[j]) & ~(high_z[i] & high_z[j]))
+    P0, D = local[i[keep]], local[j[keep]] - local[i[keep]]
+    if disc:  # |(P0 + s D)_yz|^2 = a^2, a quadratic in s
+        qa = D[:, 1] ** 2 + D[:, 2] ** 2
+        qb = 2 * (P0[:, 1] * D[:, 1] + P0[:, 2] * D[:, 2])
+        qc = P0[:, 1] ** 2 + P0[:, 2] ** 2 - a * a
+        disc_ = qb * qb - 4 * qa * qc
+        ok = (qa > 0) & (disc_ >= 0)
+        root = np.sqrt(np.where(ok, disc_, 0.0))
+        for sgn in (-1.0, 1.0):
+            s = np.where(ok, (-qb + sgn * root) / np.where(ok, 2 * qa, 1.0), -1.0)
+            hit = (s >= 0) & (s <= 1)
+            cands.append(P0[hit] + s[hit, None] * D[hit])
+    else:
+        for axis, bound, other, obound in ((1, a, 2, b), (2, b, 1, a)):
+            for c in (-bound, bound):
+                ok = D[:, axis] != 0
+                s = np.where(ok, (c - P0[:, axis]) / np.where(ok, D[:, axis], 1.0), -1.0)
+                hit = (s >= 0) & (s <= 1)
+                pts = P0[hit] + s[hit, None] * D[hit]
+                pts[:, axis] = c  # exactly on the side plane
+                cands.append(pts[np.abs(pts[:, other]) <= obound])
+    pts = np.vstack(cands)
+    t = w / 2 - side * pts[:, 0]
+    pts, t = pts[(t >= 0) & (t <= w)], t[(t >= 0) & (t <= w)]
+    if not len(t):
+        return np.inf, None
+    i = int(np.argmin(t))
+    return float(t[i]), pts[i]
+
+
+def pierces_pad(local: np.ndarray, edges: np.ndarray, gripper: ParallelJaw, side: float, w: float) -> bool:
+    """Does a mesh edge pass through the pad's face (one end in front of it, the other behind,
+    crossing inside the pad's outline)? The object then cuts into the pad: a thin wall can do so
+    between the approach test's rays and with no vertex in the finger's prism.
+
+    Examples
+    --------
+    >>> from qualgrasp.certify.meshes.gripper import load_gripper
+    >>> wall = np.array([[0.02, 0.001, 0.0], [0.05, 0.001, 0.0]])  # an edge through pad A's face at x = 0.03
+    >>> pierces_pad(wall, np.array([[0, 1]]), load_gripper("franka_panda"), 1.0, 0.06)
+    True
+    >>> pierces_pad(wall - [0.0, 0.02, 0.0], np.array([[0, 1]]), load_gripper("franka_panda"), 1.0, 0.06)
+    False
+    """
+    travel = w / 2 - side * local[:, 0]
+    i, j = edges[:, 0], edges[:, 1]
+    cross = (travel[i] < 0) != (travel[j] < 0)
+    cross &= (travel[i] != 0) & (travel[j] != 0)  # an end on the face touches, it does not cut
+    i, j = i[cross], j[cross]
+    s = travel[i] / (travel[i] - travel[j])
+    yz = local[i, 1:] + s[:, None] * (local[j, 1:] - local[i, 1:])
+    a, b = gripper.pad_width / 2, gripper.pad_height / 2
+    if gripper.pad_shape == "disc":
+        return bool((yz[:, 0] ** 2 + yz[:, 1] ** 2 < a * a).any())
+    return bool(((np.abs(yz[:, 0]) < a) & (np.abs(yz[:, 1]) < b)).any())
+
+
 def _grid(a: float, b: float, n: int) -> np.ndarray:
     return (np.arange(n) + 0.5) / n * (b - a) + a
 
@@ -148,9 +273,14 @@ def approach_collision(mesh: trimesh.Trimesh, caster: RayCaster, T: np.ndarray, 
                         w: float) -> str | None:
     """The part that meets the object while approaching, or None (module docstring, step 2)."""
     R, o = T[:3, :3], T[:3, 3]
-    local = (mesh.vertices - o) @ R  # vertices in gripper coordinates
+    V = mesh.vertices.view(np.ndarray)  # a plain array: trimesh's tracked one hashes itself on every use
+    boxes = _sweep_boxes(gripper, w)
+    # only vertices across the prisms' lateral extent can lie inside one
+    reach = max(float(np.abs(box[1]).max()) for _, box, _ in boxes)
+    near = np.abs((V - o) @ R[:, 1]) <= reach
+    local = (V[near] - o) @ R  # those vertices in gripper coordinates
     origins, parts = [], []
-    for part, box, top in _sweep_boxes(gripper, w):
+    for part, box, top in boxes:
         inside = ((local[:, 0] >= box[0, 0]) & (local[:, 0] <= box[0, 1]) & (local[:, 1] >= box[1, 0])
                   & (local[:, 1] <= box[1, 1]) & (local[:, 2] <= top))
         if inside.any():
@@ -166,9 +296,13 @@ def approach_collision(mesh: trimesh.Trimesh, caster: RayCaster, T: np.ndarray, 
     return None
 
 
+def _point_patch(point: np.ndarray, normal: np.ndarray, cell: float, travel: float) -> Patch:
+    """A touch seen only by the pad's rim: the point alone, no area, the one-cell torsion floor."""
+    return Patch(point, normal + 0.0, 0.0, 0.0, float(cell / np.sqrt(6)), point[None], travel)
+
+
 def _patch(mesh: trimesh.Trimesh, origins: np.ndarray, direction: np.ndarray, t: np.ndarray, face: np.ndarray,
-           tolerance: float, cell: float, cell_area: float) -> Patch:
-    first = float(t.min())
+           tolerance: float, cell: float, cell_area: float, first: float) -> Patch:
     keep = t <= first + tolerance
     points = origins[keep] + t[keep, None] * direction
     centroid = points.mean(axis=0)
@@ -218,6 +352,8 @@ def jaw_contacts(mesh: trimesh.Trimesh, gripper: ParallelJaw, poses: np.ndarray,
     """
     caster = caster or RayCaster(mesh)
     uv, cell = pad_grid(gripper, resolution)
+    rim = pad_rim(gripper, resolution)
+    edges = np.asarray(mesh.edges_unique).view(np.ndarray)
     cell_area = gripper.pad_width * gripper.pad_height / resolution ** 2
     out = []
     for T, w in zip(np.asarray(poses, dtype=float), np.asarray(widths, dtype=float)):
@@ -234,24 +370,46 @@ def jaw_contacts(mesh: trimesh.Trimesh, gripper: ParallelJaw, poses: np.ndarray,
             out.append(Outcome(reason="collision", message=f"the {part} meets the object while approaching"))
             continue
         R, o = T[:3, :3], T[:3, 3]
+        vertices = (mesh.vertices.view(np.ndarray) - o) @ R  # in gripper coordinates
         patches = []
         for name, side in (("A", 1.0), ("B", -1.0)):
-            local = np.column_stack([np.full(len(uv), side * w / 2), uv])
-            origins = local @ R.T + o
-            direction = -side * R[:, 0]
-            hits = caster.first_hits(origins, np.broadcast_to(direction, origins.shape))
-            reach = hits.hit & (hits.t <= w)
-            if not reach.any():
-                patches = Outcome(reason="no_contact", message=f"pad {name} meets nothing within the opening")
+            patch = _pad_patch(mesh, caster, R, o, vertices, edges, gripper, side, w, uv, rim,
+                               tolerance, cell, cell_area)
+            if isinstance(patch, tuple):
+                patches = Outcome(reason=patch[0], message=f"pad {name} {patch[1]}")
                 break
-            first = np.flatnonzero(reach)[np.argmin(hits.t[reach])]
-            if mesh.face_normals[hits.face[first]] @ direction > 0:
-                patches = Outcome(reason="collision", message=f"pad {name} starts inside the object")
-                break
-            patches.append(_patch(mesh, origins[reach], direction, hits.t[reach], hits.face[reach],
-                                  tolerance, cell, cell_area))
+            patches.append(patch)
         out.append(patches if isinstance(patches, Outcome) else Outcome(tuple(patches)))
     return out
+
+
+def _pad_patch(mesh, caster, R, o, vertices, edges, gripper, side, w, uv, rim, tolerance, cell,
+               cell_area) -> Patch | tuple[str, str]:
+    """One pad's patch (module docstring, steps 3 and 4), or the reason it has none and why."""
+    yz = np.vstack([uv, rim])
+    origins = np.column_stack([np.full(len(yz), side * w / 2), yz]) @ R.T + o
+    direction = -side * R[:, 0]
+    hits = caster.first_hits(origins, np.broadcast_to(direction, origins.shape))
+    reach = hits.hit & (hits.t <= w)
+    if pierces_pad(vertices, edges, gripper, side, w):
+        return "collision", "cuts into the object (an edge of the mesh passes through the pad's face)"
+    t_exact, point = rim_touch(vertices, edges, gripper, side, w)
+    if not reach.any() and point is None:
+        return "no_contact", "meets nothing within the opening"
+    if reach.any():
+        first = np.flatnonzero(reach)[np.argmin(hits.t[reach])]
+        if mesh.face_normals[hits.face[first]] @ direction > 0:
+            return "collision", "starts inside the object"
+    t_ray = hits.t[reach].min() if reach.any() else np.inf
+    t0 = float(min(t_ray, t_exact))
+    cells = reach[:len(uv)] & (hits.t[:len(uv)] <= t0 + tolerance)
+    if cells.any():
+        return _patch(mesh, origins[:len(uv)][cells], direction, hits.t[:len(uv)][cells],
+                      hits.face[:len(uv)][cells], tolerance, cell, cell_area, t0)
+    if t_exact <= t_ray:  # a vertex or an edge of the object against the flat pad
+        return _point_patch(point @ R.T + o, direction, cell, t0)
+    j = len(uv) + int(np.argmin(np.where(reach[len(uv):], hits.t[len(uv):], np.inf)))  # a pad corner on a face
+    return _point_patch(origins[j] + hits.t[j] * direction, -mesh.face_normals[hits.face[j]], cell, t0)
 
 
 def fingertip_contacts(mesh: trimesh.Trimesh, hand: PointHand, fingertips: np.ndarray, *,

@@ -11,7 +11,9 @@ so that a user with only a mesh gets a grasp set.
 4. The pose: closing axis ``x`` from ``p2`` to ``p1`` (pad A touches ``p1``), origin at the
    midpoint, opening ``min(max opening, |p2 - p1| + 2 clearance)``; the approach axis ``z`` is
    drawn uniformly around ``x``, up to ``approaches`` times, and the first approach free of
-   collisions (:func:`qualgrasp.certify.meshes.contacts.approach_collision`) is kept.
+   collisions (:func:`qualgrasp.certify.meshes.contacts.approach_collision`) whose open pads do
+   not cut into the object (:func:`~qualgrasp.certify.meshes.contacts.pierces_pad`: on a curved
+   surface the clearance may not clear a pad's corner) is kept.
 
 Poses are returned in the ``qualgrasp`` convention; whether each pose then yields contacts, and
 holds the object, is for ``qualgrasp contacts`` to say.
@@ -24,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 import trimesh
 
-from .contacts import approach_collision
+from .contacts import approach_collision, pierces_pad
 from .gripper import ParallelJaw
 from .rays import RayCaster
 
@@ -88,6 +90,7 @@ def sample_poses(mesh: trimesh.Trimesh, gripper: ParallelJaw, n: int, *, mu: flo
     (5, True)
     """
     caster = caster or RayCaster(mesh)
+    vertices, edges = mesh.vertices.view(np.ndarray), np.asarray(mesh.edges_unique).view(np.ndarray)
     rng = np.random.default_rng(seed)
     half = np.arctan(mu)
     out: list[SampledPose] = []
@@ -117,7 +120,9 @@ def sample_poses(mesh: trimesh.Trimesh, gripper: ParallelJaw, n: int, *, mu: flo
                 z = _perpendicular(x, rng)
                 T = np.eye(4)
                 T[:3, 0], T[:3, 1], T[:3, 2], T[:3, 3] = x, np.cross(z, x), z, (p1 + p2) / 2
-                if approach_collision(mesh, caster, T, gripper, width) is None:
+                if approach_collision(mesh, caster, T, gripper, width) is None and not any(
+                        pierces_pad((vertices - T[:3, 3]) @ T[:3, :3], edges, gripper, side, width)
+                        for side in (1.0, -1.0)):
                     out.append(SampledPose(T, width, p1, p2))
                     break
             if len(out) == n:

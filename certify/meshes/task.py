@@ -34,8 +34,19 @@ lambda_b nu_b(x_b) <= s sum_b lambda_b``, a contradiction. With ``lambda = 0`` i
 grip force at all holds the weight (for example two point contacts and a weight off the line
 through them: a torque about that line no contact can resist).
 
+Making the certificates (solver side)
+-------------------------------------
 The least grip force is reported as a certified bracket ``lo <= s* <= hi``: forces at ``hi`` and
-a Farkas certificate at ``lo``, ``hi / lo - 1`` about ``2e-6``.
+a Farkas certificate at ``lo``, ``hi / lo - 1`` about ``2e-6``. The functional ``y`` is the dual of
+the equilibrium; the multipliers are not the solver's duals of ``nu_b <= 1`` (their error on a
+lightly loaded contact exceeds any fixed margin) but computed from ``y``: the least ``lambda_b``
+putting ``a_b`` in the polar cone is ``(c_n + mu norm((c_t, c_m g))) / |n|^2`` for ``c = C_b' y``
+(subtracting ``lambda_b n_b`` moves only the normal part), raised by a small multiple of
+``norm(c)`` to make it strict. The ``lo`` stated is then what ``y`` proves, ``-y . w / sum
+lambda_b`` (a hair less), at most ``s*(1 - 1e-6)``. Both certificates are re-checked exactly
+before a bound is stated: a failing slip certificate is retried with larger margins, failing
+forces at wider budgets (``1e-4``, ``1e-2``), and an end that still does not re-check is withdrawn
+(``lo = 0`` or ``hi = inf``). :attr:`GripBound.note` says when an end was widened or withdrawn.
 
 Every direction
 ---------------
@@ -67,8 +78,9 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Sequence
 
-import cvxpy as cp
+import clarabel
 import numpy as np
+import scipy.sparse as sp
 import trimesh
 
 from .. import cones
@@ -77,10 +89,12 @@ from ..certificates import Check
 from ..evidence import cycle_check, exact_face
 from ..grasp import Grasp
 from ..problem import Block, grasp_system
+from ..solvers.clarabel_direct import settings
 from ..wrench import to_exact, wrench
 
 __all__ = ["G", "GripBound", "SlipCertificate", "EveryDirection", "gravity_wrench", "least_grip",
-           "check_holds", "check_slips", "direction_polytope", "every_direction", "check_every_direction",
+           "check_holds", "check_slips", "check_bound", "direction_polytope", "every_direction",
+           "check_every_direction",
            "hold_verdict"]
 
 #: Standard gravity, m/s^2.
@@ -120,7 +134,11 @@ class GripBound:
         Forces on the certificate columns holding the weight at grip force ``hi`` (None when
         ``hi`` is ``inf``).
     slip : SlipCertificate or None
-        Certificate that grip force ``lo`` does not hold (None when ``lo`` is 0).
+        Certificate that grip force ``lo`` does not hold (None when ``lo`` is 0); when ``lo`` is
+        ``inf`` its multipliers are all 0, which proves it at every grip force.
+    note : str
+        Empty, or why an end is wider than the solver's bracket or not stated (an end whose
+        certificate did not re-check exactly is widened or withdrawn, never stated unproved).
     """
 
     direction: tuple[float, ...]
@@ -128,12 +146,13 @@ class GripBound:
     hi: float
     forces: tuple[float, ...] | None
     slip: SlipCertificate | None
+    note: str = ""
 
     def to_json(self) -> dict:
         return {"direction": list(self.direction), "lo": None if math.isinf(self.lo) else self.lo,
                 "hi": None if math.isinf(self.hi) else self.hi,
                 "forces": None if self.forces is None else list(self.forces),
-                "slip": None if self.slip is None else self.slip.to_json()}
+                "slip": None if self.slip is None else self.slip.to_json(), "note": self.note}
 
 
 def gravity_wrench(grasp: Grasp, mass: float, com: Sequence[float], direction: Sequence[float], *,
@@ -170,73 +189,158 @@ def _normal_rows(blocks: Sequence[Block], k: int) -> np.ndarray:
 
 
 class _Programs:
-    """The two programmes of one grasp, built once (cvxpy Parameters for the weight)."""
+    """The two programmes of one grasp, in clarabel's form ``min q'z : A z + s = b, s in K``
+    (:func:`qualgrasp.certify.solvers.clarabel_direct.settings`), over ``z = (x, theta)`` or ``(x,
+    t)``. The cone rows are built once; the weight and the budget change per solve."""
 
     def __init__(self, grasp: Grasp) -> None:
         C, blocks, _ = grasp_system(grasp, socp=True)
         self.C, self.blocks = np.asarray(C, dtype=float), blocks
         d, k = self.C.shape
         self.N = _normal_rows(blocks, k)
-        self.w = cp.Parameter(d)
-        self.budget = cp.Parameter(nonneg=True)
-        x, theta, t = cp.Variable(k), cp.Variable(), cp.Variable()
-        self.x, self.theta, self.t = x, theta, t
-        cone_h = self._cones(x, 0)
-        self.equilibrium = self.C @ x + theta * self.w == 0
-        self.normal = self.N @ x <= 1
-        self.least = cp.Problem(cp.Maximize(theta), [self.equilibrium, self.normal, theta >= 0, *cone_h])
-        # strict forces at a budget: maximise the smallest slack of the cones and of the budget
-        self.interior = cp.Problem(cp.Maximize(t), [self.C @ x + self.w == 0, self.N @ x <= self.budget - t,
-                                                    t <= self.budget, *self._cones(x, t)])
-
-    def _cones(self, x, t) -> list:
-        out = []
-        for b in self.blocks:
+        # per block: the rows of -(its cone's slack) in x, and how the margin variable enters its first row
+        rows, tcol, cones = [], [], []
+        for b in blocks:
             if b.cone == "ray":
-                out.append(x[b.cols[0]] >= t)
+                r = np.zeros((1, k))
+                r[0, b.cols[0]] = -1.0
+                rows.append(r), tcol.append([1.0]), cones.append(clarabel.NonnegativeConeT(1))
                 continue
             dim = len(b.n)
             n = np.array([float(v) for v in b.n])
-            f = x[list(b.cols[:dim])]
-            fn = n @ f
-            parts = [f - fn * n] + [x[j] / float(b.g) for j in b.cols[dim:]]
-            out.append(cp.SOC(float(b.mu) * fn - t, cp.hstack(parts)))
-        return out
+            r = np.zeros((1 + len(b.cols), k))  # (mu n.f, tangent part of f, moments / g)
+            f = list(b.cols[:dim])
+            r[0, f] = -float(b.mu) * n
+            r[1:dim + 1, f] = -(np.eye(dim) - np.outer(n, n))
+            for i, j in enumerate(b.cols[dim:]):
+                r[dim + 1 + i, j] = -1.0 / float(b.g)
+            rows.append(r), tcol.append([1.0] + [0.0] * (len(r) - 1)), cones.append(clarabel.SecondOrderConeT(len(r)))
+        self.cone_A = np.vstack(rows) if rows else np.zeros((0, k))
+        self.cone_t = np.concatenate(tcol) if tcol else np.zeros(0)
+        self.cones = cones
 
-    def solve(self, problem: cp.Problem) -> bool:
+    def _solve(self, A: np.ndarray, b: np.ndarray, cones: list):
+        n = A.shape[1]
+        q = np.zeros(n)
+        q[-1] = -1.0
         try:
-            problem.solve(solver=cp.CLARABEL)
-        except cp.error.SolverError:
-            return False
-        return problem.status in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE)
+            sol = clarabel.DefaultSolver(sp.csc_matrix((n, n)), q, sp.csc_matrix(A), b, cones, settings()).solve()
+        except (ValueError, RuntimeError):  # clarabel refuses malformed data; not seen on grasps
+            return None
+        return sol if str(sol.status) in ("Solved", "AlmostSolved") else None
+
+    def least(self, w: np.ndarray) -> tuple[float, np.ndarray] | None:
+        """``max theta : C x + theta w = 0, N x <= 1, theta >= 0, x in K``: ``theta*`` and the
+        dual of the equilibrium rows, or None when the solver fails."""
+        d, k = self.C.shape
+        m = len(self.N)
+        theta_row = np.concatenate([np.zeros(k), [-1.0]])[None]  # -theta <= 0
+        A = np.vstack([np.column_stack([self.C, w]), np.column_stack([self.N, np.zeros(m)]), theta_row,
+                       np.column_stack([self.cone_A, np.zeros(len(self.cone_A))])])
+        b = np.concatenate([np.zeros(d), np.ones(m), [0.0], np.zeros(len(self.cone_A))])
+        sol = self._solve(A, b, [clarabel.ZeroConeT(d), clarabel.NonnegativeConeT(m + 1), *self.cones])
+        if sol is None:
+            return None
+        return float(np.asarray(sol.x)[-1]), np.asarray(sol.z)[:d]
+
+    def interior(self, w: np.ndarray, budget: float) -> tuple[np.ndarray, float] | None:
+        """``max t : C x + w = 0, N x <= budget - t, t <= budget``, every cone's slack ``>= t``:
+        forces ``x`` and ``t``, or None when the solver fails."""
+        d, k = self.C.shape
+        m = len(self.N)
+        A = np.vstack([np.column_stack([self.C, np.zeros(d)]), np.column_stack([self.N, np.ones(m)]),
+                       np.concatenate([np.zeros(k), [1.0]])[None], np.column_stack([self.cone_A, self.cone_t])])
+        b = np.concatenate([-w, np.full(m + 1, budget), np.zeros(len(self.cone_A))])
+        sol = self._solve(A, b, [clarabel.ZeroConeT(d), clarabel.NonnegativeConeT(m + 1), *self.cones])
+        if sol is None:
+            return None
+        z = np.asarray(sol.x)
+        return z[:-1], float(z[-1])
 
 
-def _slip(programs: _Programs, w: np.ndarray, theta: float, budget: float) -> SlipCertificate | None:
-    """A Farkas certificate at ``budget`` from the duals of the homogeneous programme, made
-    strict (module docstring); None when it does not check."""
-    y_eq = programs.equilibrium.dual_value
-    lam = programs.normal.dual_value
-    if y_eq is None or lam is None:
-        return None
-    lam = np.maximum(np.asarray(lam, dtype=float).ravel(), 0.0)
-    scale = np.abs(programs.C).max()
+def _multipliers(C: np.ndarray, blocks: Sequence[Block], y: np.ndarray, tight: tuple[int, ...],
+                 rel: float) -> np.ndarray:
+    """The least ``lambda_b >= 0`` putting each non-tight contact's functional ``C_b' y - lambda_b
+    n_b`` in the polar cone, plus ``rel`` times the functional's size (strict; float).
+
+    Subtracting ``lambda_b n_b`` moves only the normal part ``a_n`` of the functional, so the least
+    multiplier is ``(c_n + mu norm((c_t, c_m g))) / |n|^2`` for ``c = C_b' y``: the support of the
+    contact's unit-normal-force wrenches along ``y``, computed here from ``y`` itself rather than
+    taken from the solver's duals (whose error on a lightly loaded contact can exceed any fixed
+    margin)."""
+    lam = np.zeros(len(blocks))
+    for i, b in enumerate(blocks):
+        if i in tight:
+            continue
+        c = C[:, list(b.cols)].T @ y
+        if b.cone == "ray":
+            need = c[0]
+        else:
+            n = np.array([float(v) for v in b.n])
+            nn, dim = n @ n, len(n)
+            cn = c[:dim] @ n
+            ct = c[:dim] - cn / nn * n  # explicit tangent: nn |c|^2 - cn^2 cancels when c is near n
+            tang = nn * (ct @ ct) + float(np.sum((c[dim:] * float(b.g)) ** 2))
+            need = (cn + float(b.mu) * math.sqrt(tang)) / nn
+        need += rel * np.abs(c).max()
+        lam[i] = need if need > 0 else 0.0
+    return lam
+
+
+#: Relative margins tried, in turn, to make a slip certificate's multipliers strict.
+_MARGINS = (1e-10, 1e-7, 1e-4)
+
+
+def _slip(programs: _Programs, y_eq: np.ndarray, grasp: Grasp, mass: float, com, direction, w: np.ndarray,
+          cap: float) -> tuple[SlipCertificate | None, float]:
+    """A slip certificate from the dual ``y_eq`` of the homogeneous programme's equilibrium (either
+    sign) and the grip force
+    ``lo`` it proves, at most ``cap`` (``inf`` when it proves that no grip force holds); ``(None,
+    0)`` when none re-checks. Every certificate returned has passed :func:`check_slips`."""
+    C, blocks = programs.C, programs.blocks
+    scale = np.abs(C).max()
     for sign in (1.0, -1.0):
         y = sign * np.asarray(y_eq, dtype=float).ravel()
         if not -y @ w > 0:
             continue
         y = y / -(y @ w)  # normalise: -y . w = 1, so lam's sum is about theta*
-        A = programs.C.T @ y
-        tight = tuple(i for i, b in enumerate(programs.blocks)
-                      if np.abs(A[list(b.cols)]).max() <= 1e-9 * scale * np.abs(y).max())
-        lam_b = np.where(np.isin(np.arange(len(lam)), tight), 0.0, lam / max(lam.sum(), 1e-300) * theta)
-        # use half the slack 1 - budget sum(lam) to push every functional strictly into its polar cone
-        room = 1.0 - budget * lam_b.sum()
-        if room <= 0:
+        A = C.T @ y
+        tight = tuple(i for i, b in enumerate(blocks) if np.abs(A[list(b.cols)]).max() <= 1e-9 * scale * np.abs(y).max())
+        cols = [j for i in tight for j in blocks[i].cols]
+        if cols:  # as the checker will, exactly: y orthogonal to the tight contacts
+            B = C[:, cols]
+            y = y - B @ np.linalg.lstsq(B, y, rcond=None)[0]
+        for rel in _MARGINS:
+            lam = _multipliers(C, blocks, y, tight, rel)
+            total = lam.sum()
+            if total > 0:
+                # the budget the certificate proves, a hair below -y.w / sum(lam); the check is exact
+                lo = min(cap, float(-(y @ w)) / total * (1 - 1e-12))
+                if not lo > 0:
+                    continue
+            else:
+                lo = math.inf
+            cert = SlipCertificate(0.0 if math.isinf(lo) else lo, tuple(float(v) for v in y),
+                                   tuple(float(v) for v in lam), tight)
+            if check_slips(grasp, mass, com, direction, cert):
+                return cert, lo
+    return None, 0.0
+
+
+def _holding(programs: _Programs, grasp: Grasp, mass: float, com, direction,
+             budget: float) -> tuple[float, tuple[float, ...] | None]:
+    """Forces holding the weight at grip force ``budget``, or at the least of two wider budgets
+    that re-checks, with that budget; ``(inf, None)`` when none re-checks. Every pair returned has
+    passed :func:`check_holds`."""
+    w = gravity_wrench(grasp, mass, com, direction)
+    for widen in (1.0, 1 + 1e-4, 1 + 1e-2):
+        got = programs.interior(w, budget * widen)
+        if got is None or not got[1] > 0:
             continue
-        lam_b = lam_b + np.where(np.isin(np.arange(len(lam)), tight), 0.0, room / (2 * max(budget, 1e-300) * len(lam)))
-        cert = SlipCertificate(float(budget), tuple(float(v) for v in y), tuple(float(v) for v in lam_b), tight)
-        return cert
-    return None
+        forces = tuple(float(v) for v in got[0])
+        if check_holds(grasp, mass, com, direction, budget * widen, forces):
+            return budget * widen, forces
+    return math.inf, None
 
 
 def least_grip(grasp: Grasp, mass: float, com: Sequence[float], direction: Sequence[float], *,
@@ -258,8 +362,10 @@ def least_grip(grasp: Grasp, mass: float, com: Sequence[float], direction: Seque
     Returns
     -------
     GripBound
-        Its certificates still need :func:`check_holds` / :func:`check_slips` (they are made
-        here from floating-point solver output; the checks are exact).
+        Each end is stated only when its certificate has passed the exact re-check
+        (:func:`check_holds`, :func:`check_slips`; :func:`check_bound` repeats both): an end whose
+        certificate does not re-check is widened to what a certificate proves (``lo`` lower,
+        ``hi`` higher), or withdrawn (``lo = 0``, ``hi = inf``), and ``note`` says so.
 
     Examples
     --------
@@ -267,30 +373,33 @@ def least_grip(grasp: Grasp, mass: float, com: Sequence[float], direction: Seque
     >>> g = Grasp((Contact((0.05, 0, 0), (-1, 0, 0), "point", 0.5),
     ...            Contact((-0.05, 0, 0), (1, 0, 0), "point", 0.5)), center=(0, 0, 0))
     >>> b = least_grip(g, 1.0, (0, 0, 0), (0, 0, -1))
-    >>> b.lo <= 9.80665 <= b.hi, round(b.hi / b.lo - 1, 6)      # m g / (2 mu) = 9.80665 N
-    (True, 2e-06)
+    >>> b.lo <= 9.80665 <= b.hi, round(b.hi / b.lo - 1, 6), b.note      # m g / (2 mu) = 9.80665 N
+    (True, 2e-06, '')
     """
     programs = programs or _Programs(grasp)
     d = tuple(float(v) for v in direction)
     w = gravity_wrench(grasp, mass, com, d)
-    programs.w.value = w
-    if not programs.solve(programs.least):
-        return GripBound(d, 0.0, math.inf, None, None)
-    theta = float(programs.theta.value)
-    if theta <= 0:
-        slip = _slip(programs, w, 0.0, 1.0)
-        return GripBound(d, 0.0 if slip is None else math.inf, math.inf, None, slip)
-    s_star = 1.0 / theta
-    lo, hi = s_star * (1 - _BRACKET), s_star * (1 + _BRACKET)
-    slip = _slip(programs, w, theta, lo)
-    if slip is not None and sum(slip.lam) == 0:
-        # theta* is a rounding residue: the certificate separates the weight at every grip force
-        return GripBound(d, math.inf, math.inf, None, slip)
-    programs.budget.value = hi
-    forces = None
-    if programs.solve(programs.interior) and programs.t.value is not None and programs.t.value > 0:
-        forces = tuple(float(v) for v in programs.x.value)
-    return GripBound(d, lo if slip is not None else 0.0, hi if forces is not None else math.inf, forces, slip)
+    got = programs.least(w)
+    if got is None:
+        return GripBound(d, 0.0, math.inf, None, None, "the solver failed: no bound stated")
+    theta, y_eq = got
+    s_star = 1.0 / theta if theta > 0 else math.inf
+    cap = s_star * (1 - _BRACKET)
+    slip, lo = _slip(programs, y_eq, grasp, mass, com, d, w, cap)
+    notes = []
+    if slip is None:
+        notes.append("no lower bound: no slip certificate re-checked")
+    elif lo < cap and math.isfinite(s_star):
+        notes.append(f"lower end widened to {lo!r} N, what the slip certificate proves (solver: {s_star!r} N)")
+    if math.isinf(lo) or math.isinf(s_star):
+        return GripBound(d, lo, math.inf, None, slip, "; ".join(notes))
+    hi, forces = _holding(programs, grasp, mass, com, d, s_star * (1 + _BRACKET))
+    if forces is None:
+        notes.append("no upper bound: no holding forces re-checked")
+    elif hi > s_star * (1 + _BRACKET):
+        notes.append(f"upper end widened to {hi!r} N, the least grip force whose forces re-checked "
+                     f"(solver: {s_star!r} N)")
+    return GripBound(d, lo, hi, forces, slip, "; ".join(notes))
 
 
 # --- the checker side (exact, no solver) -------------------------------------------------------
@@ -398,6 +507,45 @@ def check_slips(grasp: Grasp, mass: float, com: Sequence[float], direction: Sequ
     return Check(True)
 
 
+def _check_lower(grasp: Grasp, mass: float, com, direction, lo: float, slip: SlipCertificate | None) -> Check:
+    """Does ``slip`` prove the stated lower end ``lo`` (``inf``: every grip force fails)?"""
+    if lo == 0:
+        return Check(True)
+    if slip is None:
+        return Check(False, "no slip certificate at the stated lower end")
+    if math.isinf(lo) and any(v != 0 for v in slip.lam):
+        return Check(False, "a lower end of inf needs multipliers that are all 0")
+    if not math.isinf(lo) and slip.budget != lo:
+        return Check(False, "the slip certificate is not at the stated lower end")
+    return check_slips(grasp, mass, com, direction, slip)
+
+
+def check_bound(grasp: Grasp, mass: float, com: Sequence[float], bound: GripBound) -> Check:
+    """Re-check both stated ends of a :class:`GripBound` exactly: the forces at ``hi`` (when
+    finite, :func:`check_holds`) and the slip certificate at ``lo`` (when positive,
+    :func:`check_slips`; at ``inf`` its multipliers must all be 0).
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import Contact, Grasp
+    >>> g = Grasp((Contact((0.05, 0, 0), (-1, 0, 0), "point", 0.5),
+    ...            Contact((-0.05, 0, 0), (1, 0, 0), "point", 0.5)), center=(0, 0, 0))
+    >>> b = least_grip(g, 1.0, (0, 0, 0), (0, 0, -1))
+    >>> bool(check_bound(g, 1.0, (0, 0, 0), b))
+    True
+    >>> import dataclasses
+    >>> check_bound(g, 1.0, (0, 0, 0), dataclasses.replace(b, lo=b.lo * 1.01)).reason
+    'lower end: the slip certificate is not at the stated lower end'
+    """
+    d = bound.direction
+    if not math.isinf(bound.hi):
+        got = check_holds(grasp, mass, com, d, bound.hi, bound.forces)
+        if not got:
+            return Check(False, f"upper end: {got.reason}")
+    got = _check_lower(grasp, mass, com, d, bound.lo, bound.slip)
+    return got if got else Check(False, f"lower end: {got.reason}")
+
+
 # --- every direction -----------------------------------------------------------------------
 
 def direction_polytope(level: int) -> tuple[np.ndarray, np.ndarray, float]:
@@ -437,6 +585,9 @@ class EveryDirection:
         Its inradius ``r``: the vertices ``u_j / r`` carry the hold certificates.
     vertices : tuple of GripBound
         The bound at every ``u_j / r`` (its forces prove ``hi``).
+    note : str
+        Empty, or how many of the bounds behind ``lo`` and ``hi`` were widened or withdrawn
+        because a certificate did not re-check (:attr:`GripBound.note`), with the first reason.
     """
 
     lo: float
@@ -445,6 +596,7 @@ class EveryDirection:
     level: int
     radius: float
     vertices: tuple[GripBound, ...]
+    note: str = ""
 
 
 def every_direction(grasp: Grasp, mass: float, com: Sequence[float], *, level: int = 1) -> EveryDirection:
@@ -478,7 +630,9 @@ def every_direction(grasp: Grasp, mass: float, com: Sequence[float], *, level: i
         vertices.append(least_grip(grasp, mass, com, v, programs=programs))
     hi = max(b.hi for b in vertices)
     worst_lo = max(at_u, key=lambda b: b.lo)
-    return EveryDirection(lo, hi, worst_lo if worst_lo.lo >= worst.lo else worst, level, r, tuple(vertices))
+    noted = [b.note for b in (worst_lo, *vertices) if b.note]
+    note = f"{len(noted)} of {len(vertices) + 1} bounds widened or withdrawn: {noted[0]}" if noted else ""
+    return EveryDirection(lo, hi, worst_lo if worst_lo.lo >= worst.lo else worst, level, r, tuple(vertices), note)
 
 
 def check_every_direction(grasp: Grasp, mass: float, com: Sequence[float], result: EveryDirection) -> Check:
@@ -490,12 +644,9 @@ def check_every_direction(grasp: Grasp, mass: float, com: Sequence[float], resul
     u = result.worst.direction
     if sum(Fraction(v) ** 2 for v in u) > 1:
         return Check(False, "the worst direction is longer than 1")
-    if result.lo > 0:
-        if result.worst.slip is None or result.worst.slip.budget != result.lo:
-            return Check(False, "no slip certificate at the stated lower bound")
-        got = check_slips(grasp, mass, com, u, result.worst.slip)
-        if not got:
-            return Check(False, f"lower bound: {got.reason}")
+    got = _check_lower(grasp, mass, com, u, result.lo, result.worst.slip)
+    if not got:
+        return Check(False, f"lower bound: {got.reason}")
     if math.isinf(result.hi):
         return Check(True)
     V = np.array([b.direction for b in result.vertices])
