@@ -13,10 +13,10 @@ re-checked column by column (:func:`qualgrasp.certify.report.verify_row`).
 'closure'
 """
 
-from .certificates import Certificate, Check, Tolerances, verify, verify_span
-from .closure import Verdict, force_closure, form_closure, positive_span
+from .core.certificates import Certificate, Check, Tolerances, verify, verify_span
+from .core.closure import Verdict, force_closure, form_closure, positive_span
 from .errors import CertificateError, CertifyError, GraspError, GraspFileError, SolverError
-from .grasp import Contact, Grasp, grasp_from_dict, grasp_to_dict
+from .core.grasp import Contact, Grasp, grasp_from_dict, grasp_to_dict
 from .report import Report, certify_grasp
 from .chunk import Options, certify_arrow
 

@@ -19,12 +19,12 @@ from typing import Any, Callable, Iterator, Sequence
 import numpy as np
 import pyarrow as pa
 
-from .certificates import Tolerances
+from .core.certificates import Tolerances
 from .chunk import STATUSES, Options, Quality, verify_chunk
 from .engine import RunSummary, run
 from .errors import CertifyError
 from .table import Chunk, chunk_values, count_grasps, input_format, is_parquet, iter_chunks
-from .validation import show
+from .core.validation import show
 
 __all__ = ["Summary", "certify_file", "verify_file"]
 

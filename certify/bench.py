@@ -6,7 +6,7 @@ grasps (a prefix of them for the slow routes):
 * **qualgrasp batch**: :func:`qualgrasp.certify.fastpath.certify_table` on an Arrow table of the grasps,
   the path ``qualgrasp certify`` takes on Parquet input, per worker process. It does more than the
   others: force *and* form closure, both certificates and their rigorous re-check (epsilon off).
-* **per-grasp fast route**: :func:`qualgrasp.certify.closure.force_closure` with the fast solver.
+* **per-grasp fast route**: :func:`qualgrasp.certify.core.closure.force_closure` with the fast solver.
 * **clarabel direct**: the same programme through clarabel's API with prebuilt structure.
 * **scipy linprog (HiGHS)**: polyhedral kinds only.
 * **cvxpy + Parameters** (the reference route) and **cvxpy rebuilt per grasp**.
@@ -32,11 +32,11 @@ from rich.console import Console
 from rich.progress import Progress
 from rich.table import Table
 
-from .certificates import verify
+from .core.certificates import verify
 from .chunk import Options
-from .closure import force_closure, form_closure
+from .core.closure import force_closure, form_closure
 from .fastpath import certify_table
-from .grasp import grasp_to_dict
+from .core.grasp import grasp_to_dict
 from .quality import epsilon, epsilon_linearised, epsilons
 from .report import certify_grasp
 from .samples import random_grasps

@@ -27,7 +27,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
-from .certificates import Tolerances
+from .core.certificates import Tolerances
 from .columns import GraspColumns, extra_columns, grasp_columns, value_columns
 from .errors import CertifyError, GraspFileError
 from .fastpath import certify_table

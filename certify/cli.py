@@ -25,7 +25,7 @@ from .errors import CertifyError
 from .regions import DEFAULT_BUDGET, certify_region_file, verify_region_file
 from .samples import write_random_grasp_file
 from .table import count_grasps
-from .validation import MAX_CONTACTS
+from .core.validation import MAX_CONTACTS
 
 __all__ = ["register"]
 

@@ -4,7 +4,7 @@
 :func:`value_columns` a list of parsed JSON values, into the same :class:`GraspColumns`: one row
 per grasp, contacts kept flat (padded only for the rows of one contact pattern, so one row with
 many contacts costs its own size, not the chunk's), every rule of
-:mod:`qualgrasp.certify.validation` applied once, vectorised, with its messages. The columnar
+:mod:`qualgrasp.certify.core.validation` applied once, vectorised, with its messages. The columnar
 kernels take the valid rows from the arrays; :meth:`GraspColumns.grasps` builds
 :class:`qualgrasp.certify.Grasp` objects of any valid rows for the per-grasp route, and
 :meth:`GraspColumns.message` gives the error of an invalid one. Both routes therefore read every
@@ -27,10 +27,10 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from . import models as registry
-from .grasp import Grasp, grasps_from_checked
+from .core.grasp import Grasp, grasps_from_checked
 from .table import READ_ERROR
-from .validation import (ABSENT, MAX_CONTACTS, TOP_LEVEL, UNKNOWN, CheckedGrasps, ContactData, GraspData, check_grasps,
-                         grasp_data, show)
+from .core.validation import (ABSENT, MAX_CONTACTS, TOP_LEVEL, UNKNOWN, CheckedGrasps, ContactData, GraspData, check_grasps,
+                              grasp_data, show)
 
 __all__ = ["GraspColumns", "grasp_columns", "value_columns", "extra_columns"]
 

@@ -46,7 +46,7 @@ from .errors import CertifyError, GraspFileError
 from .outputs import check_output, lock_output, write_error
 from .results import RESULT_SCHEMA, RESULT_WRITE_OPTIONS, carried_clash
 from .table import Chunk, input_format, is_parquet, iter_chunks, rows_to_table, table_to_rows
-from .validation import TOP_LEVEL
+from .core.validation import TOP_LEVEL
 
 __all__ = ["RunSummary", "run", "check_paths", "certify_chunk", "parts_folder", "MADE_BY"]
 

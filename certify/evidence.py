@@ -71,13 +71,13 @@ from typing import Any, Sequence
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
-from . import cones
+from .core import cones
 from ._kernels.planar import planar_generators
 from ._kernels.surface import cycle_code, face_bounds, leibniz_tables, planar_h_bounds
-from .certificates import Check
-from .grasp import Grasp
-from .problem import grasp_system
-from .wrench import force_column_errors, generator_layout, grasp_arrays, to_exact, variants_of
+from .core.certificates import Check
+from .core.grasp import Grasp
+from .core.problem import grasp_system
+from .core.wrench import force_column_errors, generator_layout, grasp_arrays, to_exact, variants_of
 
 __all__ = ["EPS_TOL", "SHRINK", "KINDS", "Evidence", "ConicSupport", "surface_faces",
            "exact_face", "surface_minimum", "stated_lo", "planar_generator_arrays",
@@ -345,7 +345,7 @@ def _within(stated: float, proved2: Fraction, what: str, proved2_hi: Fraction | 
 def planar_generator_arrays(grasp: Grasp):
     """Generator wrenches ``W`` (3, k) of a planar grasp, bounds ``E`` on their distance to the
     exact values (:func:`qualgrasp.certify._kernels.planar.planar_generators`: the floats of
-    :func:`qualgrasp.certify.problem.grasp_system`), and the owner contact of each (sorted)."""
+    :func:`qualgrasp.certify.core.problem.grasp_system`), and the owner contact of each (sorted)."""
     P, N, mu, params, c, L = grasp_arrays(grasp)
     models = tuple(ct.model for ct in grasp.contacts)
     owner, offset, friction = generator_layout(models, variants_of(grasp), 2)
@@ -428,7 +428,7 @@ class ConicSupport:
     Parameters
     ----------
     grasp : Grasp
-        A spatial grasp; its conic system (:func:`qualgrasp.certify.problem.grasp_system`,
+        A spatial grasp; its conic system (:func:`qualgrasp.certify.core.problem.grasp_system`,
         ``socp=True``) gives the columns of every contact block.
     """
 
@@ -500,7 +500,7 @@ class ConicSupport:
 
     def inside(self, b: int, x: np.ndarray) -> bool:
         """Is the block value ``x`` strictly inside block ``b``'s cone? Exact
-        (:func:`qualgrasp.certify.cones.inside`)."""
+        (:func:`qualgrasp.certify.core.cones.inside`)."""
         cols, n, nh, mu, g, rn = self.data[b]
         if n is None:
             return bool(x[0] > 0)

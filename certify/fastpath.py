@@ -32,12 +32,12 @@ from ._kernels.barrier import barrier_batch
 from ._kernels.linalg import projection_bound, world_values
 from ._kernels.planar import planar_batch, planar_generators
 from ._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
-from .certificates import Tolerances, verify
-from .closure import decide, farkas_from_arrays
+from .core.certificates import Tolerances, verify
+from .core.closure import decide, farkas_from_arrays
 from .columns import GraspColumns, extra_columns, grasp_columns
-from .cones import LORENTZ, cone_code
-from .grasp import Contact, Grasp
-from .problem import Block, ClosureProblem, System, conic_columns, grasp_problem, grasp_system
+from .core.cones import LORENTZ, cone_code
+from .core.grasp import Contact, Grasp
+from .core.problem import Block, ClosureProblem, System, conic_columns, grasp_problem, grasp_system
 from .quality import planar_epsilons
 from .results import CERTIFICATE, RESULT_SCHEMA, carried_name, result_table
 from .solvers import BARRIER_NEAR_ZERO, FastSolver, make_solver
@@ -46,7 +46,7 @@ from .solvers.enumeration import FEAS, bases
 from .solvers.squeeze import squeeze_farkas
 from .table import rows_to_table
 from . import models as registry
-from .wrench import force_column_errors, force_columns, generator_columns, generator_layout
+from .core.wrench import force_column_errors, force_columns, generator_columns, generator_layout
 
 __all__ = ["certify_table", "PlanarScreen", "planar_screen"]
 
@@ -264,7 +264,7 @@ def _polyhedral_rows(P, N, c, L, W, E, options, tol: Tolerances):
     it (same problem, same fast solver, same certificate), with the certificate then proved by
     the rigorous float kernels instead of rationals (the exact checker only where floats cannot
     decide). ``W`` and ``E`` are the frictionless generator columns and their error bounds
-    (:func:`qualgrasp.certify.wrench.force_column_errors`). Returns ``(code, t, lam, basis, y)`` and the tight blocks of
+    (:func:`qualgrasp.certify.core.wrench.force_column_errors`). Returns ``(code, t, lam, basis, y)`` and the tight blocks of
     code-4 rows."""
     B, m, d = P.shape
     zeros = np.zeros((B, m))

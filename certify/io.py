@@ -1,7 +1,7 @@
 """Reading and writing grasp sets and results, JSON Lines or Parquet by file extension.
 
 Grasp line: ``{"id": "g1", "contacts": [{"p": [x, y], "n": [nx, ny], "model": "point", "mu": 0.5}],
-"center": [cx, cy], "length": 1.0}`` (see :func:`qualgrasp.certify.grasp.grasp_from_dict`); Parquet holds
+"center": [cx, cy], "length": 1.0}`` (see :func:`qualgrasp.certify.core.grasp.grasp_from_dict`); Parquet holds
 the same fields (:data:`qualgrasp.certify.table.GRASP_SCHEMA`). In JSON Lines, blank lines are skipped and
 line numbers count from 1 and include them; in Parquet the line number is the row number.
 Files are written by the rules of :mod:`qualgrasp.certify.outputs` (nothing lost).
@@ -14,7 +14,7 @@ from typing import Any, Iterable, Iterator
 
 import pyarrow.parquet as pq
 
-from .grasp import Grasp, grasp_to_dict
+from .core.grasp import Grasp, grasp_to_dict
 from .errors import GraspFileError
 from .outputs import atomic_output, write_lines
 from .results import RESULT_WRITE_OPTIONS

@@ -13,7 +13,7 @@ at most 1). Epsilon is the radius of the largest ball centred at the origin insi
 Torque scaling is explicit: wrenches are ``(f, (p - center) x f / length)``, so epsilon depends on
 ``center`` and ``length`` (every :class:`Epsilon` states both). Scaling the object, the contacts,
 ``center`` and ``length`` together leaves epsilon unchanged; dividing ``length`` by ``s`` multiplies
-the torque coordinates by ``s``. The min-weight margin of :mod:`qualgrasp.certify.closure` depends on neither.
+the torque coordinates by ``s``. The min-weight margin of :mod:`qualgrasp.certify.core.closure` depends on neither.
 
 Every :class:`Epsilon` states rigorous bounds ``lo <= epsilon <= hi`` and carries
 :class:`~qualgrasp.certify.evidence.Evidence` that :mod:`qualgrasp.certify.evidence` re-checks
@@ -79,12 +79,12 @@ from ._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, supp
 from ._kernels.jit import BOOL, F1, F2, FLOAT, I1, I2, INT, precompile
 from ._kernels.planar import planar_generators
 from ._kernels.surface import cycle_code, face_bounds
-from .closure import Verdict, force_closure
+from .core.closure import Verdict, force_closure
 from .evidence import (EPS_TOL, ConicSupport, Evidence, planar_generator_arrays,
                        planar_support_vertices, stated_lo, sum_errors, surface_faces,
                        surface_minimum)
-from .grasp import Grasp
-from .problem import System, grasp_system
+from .core.grasp import Grasp
+from .core.problem import System, grasp_system
 from .solvers.clarabel_direct import settings
 
 __all__ = ["NORMS", "Epsilon", "epsilon", "epsilons", "planar_epsilon", "planar_epsilons",
@@ -562,7 +562,7 @@ class _Pieces:
             dim = len(n)
             self.p[i] = n_hat @ cols[:dim]
             T = cols[:dim] - np.outer(n_hat, self.p[i])
-            if len(b.cols) > dim:  # moment columns, weighted as in qualgrasp.certify.cones.polar
+            if len(b.cols) > dim:  # moment columns, weighted as in qualgrasp.certify.core.cones.polar
                 T = np.vstack([T, float(b.g) / rn * cols[dim:]])
             rows.append(T)
             self.kappa[i] = float(b.mu)

@@ -26,14 +26,14 @@ import pyarrow as pa
 from . import models as registry
 from ._kernels.planar import planar_generators
 from ._kernels.recheck import null_rows, verify_farkas_general, verify_interior_general
-from .certificates import Tolerances, margin_of, margin_tolerance
+from .core.certificates import Tolerances, margin_of, margin_tolerance
 from .columns import GraspColumns
-from .cones import CONES, cone_code
+from .core.cones import CONES, cone_code
 from .evidence import EPS_COLUMNS, Evidence, verify_bounds
-from .problem import Block
+from .core.problem import Block
 from .report import GEOMETRY_TOL
 from .results import RESULT_SCHEMA
-from .wrench import force_column_errors, force_columns, generator_columns, generator_layout
+from .core.wrench import force_column_errors, force_columns, generator_columns, generator_layout
 
 __all__ = ["recheck_table", "generator_errors", "schema_matches"]
 
@@ -257,7 +257,7 @@ def generator_errors(P, N, params, models, variants, c, L, *, frictionless: bool
     """Generator columns (B, d, k) of a group of grasps and bounds on their distance to the
     exact values on the same data: the planar kernel's
     (:func:`qualgrasp.certify._kernels.planar.planar_generators`) or, in space, those of
-    frictionless force columns (:func:`qualgrasp.certify.wrench.force_column_errors`)."""
+    frictionless force columns (:func:`qualgrasp.certify.core.wrench.force_column_errors`)."""
     B, m, dim = P.shape
     if dim == 2:
         owner, offset, friction = generator_layout(models, variants, 2, frictionless=frictionless)

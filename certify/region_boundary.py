@@ -37,9 +37,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .closure import Verdict, force_closure
+from .core.closure import Verdict, force_closure
 from .errors import GraspError
-from .grasp import Contact, Grasp
+from .core.grasp import Contact, Grasp
 from .region_certify import RegionVerdict, certify_regions
 from .region_data import CurvedRegion, RegionTuple, StraightRegion
 

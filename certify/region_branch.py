@@ -66,9 +66,9 @@ import numpy as np
 
 from . import models as registry
 from ._kernels.regions import piece_bounds
-from .certificates import Check, verify
-from .closure import force_closure
-from .grasp import Contact, Grasp
+from .core.certificates import Check, verify
+from .core.closure import force_closure
+from .core.grasp import Contact, Grasp
 from .region_data import RegionTuple, StraightRegion
 from .region_exact import region_variant
 

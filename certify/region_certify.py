@@ -36,10 +36,10 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .certificates import Certificate, Check, verify
-from .closure import Verdict, force_closure
+from .core.certificates import Certificate, Check, verify
+from .core.closure import Verdict, force_closure
 from .errors import CertificateError, GraspError
-from .grasp import Contact, Grasp, grasp_from_dict, grasp_to_dict
+from .core.grasp import Contact, Grasp, grasp_from_dict, grasp_to_dict
 from .region_branch import DEFAULT_BUDGET, cells_certificate, check_cells, decide_branch
 from .region_data import RegionTuple, StraightRegion
 from .region_exact import (check_faces, check_faces_float, faces_certificate, generator_rows, on_segment,

@@ -27,7 +27,7 @@ is ``c tan(a_hi) tan(-a_lo) / (tan(a_hi) + tan(-a_lo))`` (``c`` the chord length
 with that set. A curved region of one point is a point contact (with ``normal_tol``, its normal
 varies).
 
-Validation follows :mod:`qualgrasp.certify.validation`: numbers must be numbers, the model's
+Validation follows :mod:`qualgrasp.certify.core.validation`: numbers must be numbers, the model's
 parameters are required and in their ranges, reductions apply (``mu = 0``: frictionless, a pad
 of width 0: point), normals are normalised, and every message names the field:
 ``regions[1].a: expected 2 finite numbers, got "x"``.
@@ -51,9 +51,9 @@ import numpy as np
 
 from . import models as registry
 from .errors import GraspError
-from .grasp import Contact
+from .core.grasp import Contact
 from .models import MAX_LENGTH, MIN_LENGTH
-from .validation import check_contacts, contact_data, number, numbers, show
+from .core.validation import check_contacts, contact_data, number, numbers, show
 
 __all__ = ["MAX_NORMAL_TOL", "MAX_TURN", "MAX_REGIONS", "MAX_POINTS", "StraightRegion", "CurvedRegion",
            "Region", "RegionTuple", "region_from_dict", "region_to_dict", "tuple_from_dict",

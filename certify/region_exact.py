@@ -2,7 +2,7 @@
 
 Notation: region ``i`` is the segment ``q_i(s) = a_i + s (b_i - a_i)``, ``0 <= s <= 1``, with
 inward normal ``n_i`` and tangent ``t_i`` (``n_i`` turned +90 degrees). Every generator ``g`` of
-the contact model (:func:`qualgrasp.certify.wrench.generator_layout`) is the force
+the contact model (:func:`qualgrasp.certify.core.wrench.generator_layout`) is the force
 ``f_g = n_i + friction_g mu_i t_i`` applied at ``q_i(s) + offset_g width_i t_i``, so with
 certify's torque scaling (``center`` c, ``length`` L) its wrench is
 ``w_g(s) = (f_g, tau0_g + s beta_g)``, ``tau0_g = ((a_i + offset_g width_i t_i - c) x f_g) / L``,
@@ -54,10 +54,10 @@ import scipy.sparse as sp
 from scipy.optimize import linprog
 
 from . import models as registry
-from .certificates import Check, verify
-from .closure import force_closure
+from .core.certificates import Check, verify
+from .core.closure import force_closure
 from .errors import SolverError
-from .grasp import Grasp
+from .core.grasp import Grasp
 from .region_data import RegionTuple
 
 __all__ = ["FACES", "FaceSolution", "Dyadic", "generator_rows", "scaled_rows", "face_box", "solve_faces", "check_faces",

@@ -49,7 +49,7 @@ from .region_certify import DEFAULT_TOL, STATUSES, RegionVerdict, certify_region
 from .region_data import (CurvedRegion, RegionTuple, StraightRegion, region_from_dict, region_to_dict,
                           tuple_from_dict, tuple_to_dict)
 from .table import input_format, json_lines
-from .validation import id_problem, show
+from .core.validation import id_problem, show
 
 __all__ = [
     "StraightRegion", "CurvedRegion", "RegionTuple", "region_from_dict", "region_to_dict",

@@ -16,11 +16,11 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from .certificates import Certificate, Check, Tolerances, verify
+from .core.certificates import Certificate, Check, Tolerances, verify
 from .errors import CertificateError
-from .closure import Verdict, form_closure, force_closure
+from .core.closure import Verdict, form_closure, force_closure
 from .evidence import verify_epsilon
-from .grasp import Grasp
+from .core.grasp import Grasp
 from .quality import Epsilon, epsilons
 from .results import NAMES, result_row
 
@@ -152,7 +152,7 @@ def verify_row(grasp: Grasp, row: dict[str, Any], tol: Tolerances = Tolerances()
     * ``status`` and ``form_status`` agree with ``force_closure`` and ``form_closure`` and are
       proved by their certificates (:func:`qualgrasp.certify.verify`, exact rationals); each
       margin is 0 without closure and otherwise the margin the certificate's values certify, to
-      within :func:`qualgrasp.certify.certificates.margin_tolerance` either way;
+      within :func:`qualgrasp.certify.core.certificates.margin_tolerance` either way;
     * the epsilon columns are proved by their evidence
       (:func:`qualgrasp.certify.evidence.verify_epsilon`).
 

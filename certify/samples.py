@@ -9,7 +9,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from . import models as registry
-from .grasp import Contact, Grasp
+from .core.grasp import Contact, Grasp
 from .outputs import atomic_output
 from .table import CONTACT, GRASP_SCHEMA, is_parquet
 

@@ -28,9 +28,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import GraspError
-from .grasp import Contact, Grasp
+from .core.grasp import Contact, Grasp
 from .quality import epsilon, epsilon_of_points
-from .problem import grasp_system
+from .core.problem import grasp_system
 
 __all__ = ["Efficiency", "polygon_frame", "edge_samples", "boundary_contacts", "boundary_epsilon",
            "steinitz_bound", "efficiency"]

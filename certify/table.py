@@ -34,7 +34,7 @@ import pyarrow.parquet as pq
 from .errors import GraspFileError
 from .outputs import file_kind
 from .results import RESULT_SCHEMA
-from .validation import param_names
+from .core.validation import param_names
 
 __all__ = ["CONTACT", "GRASP_SCHEMA", "MAX_LINE_BYTES", "READ_ERROR", "SNIFF_BYTES", "is_parquet", "input_format",
            "column_problem", "json_lines", "Chunk",

@@ -46,12 +46,12 @@ from typing import Any, Callable
 import numpy as np
 
 from ..certify.errors import CertifyError, GraspError
-from ..certify.grasp import Grasp, grasp_from_dict
+from ..certify.core.grasp import Grasp, grasp_from_dict
 from ..certify.outputs import atomic_output, check_output
 from ..certify.region_boundary import SEARCH_BUDGET, IndependentRegions, bisection_tol, independent_regions
 from ..certify.region_data import tuple_to_dict
 from ..certify.table import json_lines
-from ..certify.validation import id_problem, number, show
+from ..certify.core.validation import id_problem, number, show
 from .errors import QualitativeError
 from .outline import DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_contour, outline_image
 from .regions import ALPHA, ALPHA_MAX, FINGER_WIDTH, MARGIN, Region, feasible_regions

@@ -76,7 +76,7 @@ import shapely
 from shapely.geometry import MultiPoint
 from shapely.geometry.base import BaseGeometry
 
-from ..certify.wrench import cross, wrench
+from ..certify.core.wrench import cross, wrench
 
 from .errors import ZoneError
 

@@ -8,7 +8,7 @@ from qualgrasp.certify.batch import verify_file
 from qualgrasp.certify.chunk import Options, certify_values
 from qualgrasp.certify.table import table_values
 from qualgrasp.certify.fastpath import certify_table
-from qualgrasp.certify.grasp import grasp_to_dict
+from qualgrasp.certify.core.grasp import grasp_to_dict
 from qualgrasp.certify.samples import random_grasp_table, random_grasps, textbook_grasps
 from qualgrasp.certify.table import grasps_table, rows_to_table, table_to_rows
 

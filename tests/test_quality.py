@@ -76,7 +76,7 @@ def test_planar_epsilon_equals_qhull():
         for g in random_grasps(21, 150, dim=2, **kw):
             if force_closure(g).status != "closure":
                 continue
-            from qualgrasp.certify.wrench import generator_columns, grasp_arrays
+            from qualgrasp.certify.core.wrench import generator_columns, grasp_arrays
 
             P, N, mu, _, c, L = grasp_arrays(g)
             W, owner = generator_columns(P, N, mu, tuple(x.model for x in g.contacts), c, L)

@@ -124,7 +124,7 @@ _NO_COMPILE_UNDER_THE_CLOCK = """
 import importlib, pkgutil
 import qualgrasp.certify._kernels as kernels
 from qualgrasp.certify import quality
-from qualgrasp.certify.closure import force_closure
+from qualgrasp.certify.core.closure import force_closure
 from qualgrasp.certify.samples import random_grasps
 
 grasps = (random_grasps(8, 4, dim=2, n_contacts=21, model="point") + random_grasps(7, 4, dim=2, n_contacts=3, model="pad")

@@ -60,7 +60,7 @@ def _imports():
 
 
 def test_modules_are_found():
-    assert {"qualgrasp.certify.grasp", "qualgrasp.qualitative.synthesis", "qualgrasp.experiments.study",
+    assert {"qualgrasp.certify.core.grasp", "qualgrasp.qualitative.synthesis", "qualgrasp.experiments.study",
             "qualgrasp.cli", "qualgrasp.certify.models.pad"} <= set(MODULES)
 
 

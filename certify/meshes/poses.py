@@ -37,9 +37,9 @@ from typing import Any, Iterator
 import numpy as np
 
 from ..errors import GraspFileError
-from ..grasp import Contact, Grasp
+from ..core.grasp import Contact, Grasp
 from ..table import chunk_values, iter_chunks
-from ..validation import number, numbers, show
+from ..core.validation import number, numbers, show
 from .contacts import Outcome
 from .errors import PoseError, PoseFileError
 from .gripper import CONVENTIONS, Gripper, ParallelJaw, check_pose, to_qualgrasp
@@ -219,7 +219,7 @@ def grasp_of(outcome: Outcome, mu: float, model: str, props: MassProperties, gid
 def contact_row(row: PoseRow, outcome: Outcome, grasp: Grasp, gripper: Gripper, props: MassProperties, *,
                 points: bool = True) -> dict:
     """The output row of a pose with contacts (module docstring, "Output rows")."""
-    from ..grasp import grasp_to_dict
+    from ..core.grasp import grasp_to_dict
 
     out = grasp_to_dict(grasp)
     patches = []

@@ -71,13 +71,13 @@ import cvxpy as cp
 import numpy as np
 import trimesh
 
-from .. import cones
-from .. import exact as ex
-from ..certificates import Check
+from ..core import cones
+from ..core import exact as ex
+from ..core.certificates import Check
 from ..evidence import cycle_check, exact_face
-from ..grasp import Grasp
-from ..problem import Block, grasp_system
-from ..wrench import to_exact, wrench
+from ..core.grasp import Grasp
+from ..core.problem import Block, grasp_system
+from ..core.wrench import to_exact, wrench
 
 __all__ = ["G", "GripBound", "SlipCertificate", "EveryDirection", "gravity_wrench", "least_grip",
            "check_holds", "check_slips", "direction_polytope", "every_direction", "check_every_direction",

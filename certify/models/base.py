@@ -30,7 +30,7 @@ the model's declaration, never re-stated elsewhere:
     the normal whose cone weight is that length parameter (the soft finger's torsional length).
     ``cone`` is the shape of the set of admissible values on those columns: ``"ray"``
     (non-negative multiples of the column) or ``"lorentz"`` (``norm((f_t, m |n| / g)) <= mu f_n``);
-    the cone tests themselves are written once per shape, in :mod:`qualgrasp.certify.cones`.
+    the cone tests themselves are written once per shape, in :mod:`qualgrasp.certify.core.cones`.
 ``frictionless``
     The model a contact becomes when friction is ignored (form closure).
 

@@ -1,4 +1,4 @@
-"""Solver routes for the closure programme of :mod:`qualgrasp.certify.problem`.
+"""Solver routes for the closure programme of :mod:`qualgrasp.certify.core.problem`.
 
 Every route solves the same programme and returns a :class:`Solution`
 (:func:`make_solver` by name):

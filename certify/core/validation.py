@@ -43,8 +43,8 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from . import models as registry
-from .models import MAX_LENGTH, MIN_LENGTH
+from .. import models as registry
+from ..models import MAX_LENGTH, MIN_LENGTH
 
 __all__ = ["MAX_CONTACTS", "MIN_NORMAL", "ABSENT", "UNKNOWN", "ContactData", "GraspData",
            "Checked", "show", "number", "numbers", "contact_data", "grasp_data",

@@ -1,6 +1,6 @@
 """Contact cones: the admissible values of one contact on its certificate columns.
 
-Every cone block of a closure programme (:mod:`qualgrasp.certify.problem`) has one of two shapes,
+Every cone block of a closure programme (:mod:`qualgrasp.certify.core.problem`) has one of two shapes,
 declared by the contact models (:mod:`qualgrasp.certify.models`):
 
 ``ray``

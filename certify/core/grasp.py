@@ -19,7 +19,7 @@ Conventions
   contact, or 1 when that distance is zero. Closure verdicts and the min-weight margin do not depend
   on either; quality measures such as epsilon do. The values used are always reported.
 
-Every rule and message is :mod:`qualgrasp.certify.validation`'s, for contacts built here, grasps
+Every rule and message is :mod:`qualgrasp.certify.core.validation`'s, for contacts built here, grasps
 read from JSON and columns read from Parquet alike.
 """
 
@@ -30,8 +30,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from . import models as registry
-from .errors import GraspError
+from .. import models as registry
+from ..errors import GraspError
 from .validation import (Checked, CheckedGrasps, GraspData, check_contacts, contact_data, grasp_data,
                          check_grasps, grasp_rules, number, numbers, param_names)
 
@@ -70,7 +70,7 @@ class Contact:
     Raises
     ------
     GraspError
-        A value breaks a rule of :mod:`qualgrasp.certify.validation` (the message names it).
+        A value breaks a rule of :mod:`qualgrasp.certify.core.validation` (the message names it).
 
     Examples
     --------
@@ -240,7 +240,7 @@ class Grasp:
 
 def grasps_from_checked(checked: CheckedGrasps, rows, ids=None, meta=None) -> list[Grasp]:
     """:class:`Grasp` objects of the valid ``rows`` of checked grasp arrays (no rule is applied
-    again: the arrays come from :func:`qualgrasp.certify.validation.check_grasps`)."""
+    again: the arrays come from :func:`qualgrasp.certify.core.validation.check_grasps`)."""
     out = []
     c = checked.contacts
     for i in rows:

@@ -1,7 +1,7 @@
 """Certificates of closure verdicts and their independent verification.
 
 A certificate is re-checked against the grasp with exact rational arithmetic on the float data
-(:mod:`qualgrasp.certify.exact`) and no solver:
+(:mod:`qualgrasp.certify.core.exact`) and no solver:
 
 ``interior`` (closure)
     Values ``x`` over the certificate columns ``C`` (generator weights, or world-frame contact
@@ -36,8 +36,8 @@ import numpy as np
 
 from . import cones
 from . import exact as ex
-from ._kernels.cones import polar_values as kernel_polar_values
-from .errors import CertificateError
+from .._kernels.cones import polar_values as kernel_polar_values
+from ..errors import CertificateError
 from .grasp import Grasp
 from .problem import Block, block_arrays, grasp_system, span_system
 from .wrench import to_exact
@@ -130,7 +130,7 @@ class Check:
         return self.ok
 
 
-# --- cone tests of a block (the formulas are :mod:`qualgrasp.certify.cones`') --------------------
+# --- cone tests of a block (the formulas are :mod:`qualgrasp.certify.core.cones`') --------------------
 
 def strictly_inside(block: Block, v: Sequence) -> bool:
     """Is the value ``v`` (on the block's columns) strictly inside the block's cone? Exact on
@@ -145,7 +145,7 @@ def strictly_polar(block: Block, a: Sequence) -> bool:
 
 
 def slack(block: Block, v: Sequence[float]) -> tuple[float, float]:
-    """Float ``(slack, normal force)`` of a value on the block (:func:`qualgrasp.certify.cones.slack`)."""
+    """Float ``(slack, normal force)`` of a value on the block (:func:`qualgrasp.certify.core.cones.slack`)."""
     return cones.slack(block.cone, v, block.n, block.mu, block.g)
 
 

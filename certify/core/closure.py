@@ -1,6 +1,6 @@
 """Closure verdicts: form closure, force closure and positive spanning, each with a certificate.
 
-Every verdict follows the same steps on the closure programme of :mod:`qualgrasp.certify.problem`:
+Every verdict follows the same steps on the closure programme of :mod:`qualgrasp.certify.core.problem`:
 
 1. Solve for ``t*``. With full rank and ``t* >= tol.margin``: ``closure`` (interior certificate).
    Otherwise, if the dual direction separates (strictly on every contact, or exactly orthogonal
@@ -24,12 +24,12 @@ import numpy as np
 
 from . import exact as ex
 from .certificates import Certificate, Tolerances
-from .errors import GraspError, SolverError
+from ..errors import GraspError, SolverError
 from .grasp import Grasp
-from ._kernels.cones import farkas_direction
-from ._kernels.linalg import null_direction, pivot_basis
+from .._kernels.cones import farkas_direction
+from .._kernels.linalg import null_direction, pivot_basis
 from .problem import ClosureProblem, block_arrays, grasp_problem, grasp_system, span_problem, span_system
-from .solvers import make_solver
+from ..solvers import make_solver
 
 __all__ = ["Verdict", "force_closure", "form_closure", "positive_span", "decide", "farkas_certificate",
            "farkas_from_arrays"]
@@ -45,7 +45,7 @@ class Verdict:
     margin : float
         Min-weight margin ``t*`` when in closure, else 0.
     certificate : Certificate
-        Evidence re-checkable by :func:`qualgrasp.certify.certificates.verify`.
+        Evidence re-checkable by :func:`qualgrasp.certify.core.certificates.verify`.
     """
 
     status: str
@@ -110,7 +110,7 @@ def farkas_certificate(C: np.ndarray, blocks, layout: str, y: np.ndarray,
     A ``y`` strictly separating every block is a certificate as it is. Otherwise blocks on which
     ``y`` vanishes (relative to ``rel``) are declared tight and ``y`` is projected off their
     columns; every other block must then be strictly separated (float check with a margin; the
-    exact check is :func:`qualgrasp.certify.certificates.verify`). Compiled:
+    exact check is :func:`qualgrasp.certify.core.certificates.verify`). Compiled:
     :func:`qualgrasp.certify._kernels.cones.farkas_direction`.
     """
     dim = max((len(b.n) for b in blocks), default=2) or 2
@@ -120,7 +120,7 @@ def farkas_certificate(C: np.ndarray, blocks, layout: str, y: np.ndarray,
 def farkas_from_arrays(C: np.ndarray, arrays, layout: str, y: np.ndarray,
                        rel: float = 1e-7) -> Certificate | None:
     """:func:`farkas_certificate` with the blocks given as ``(cone, first, width, n, mu, g)``
-    arrays (:func:`qualgrasp.certify.problem.block_arrays`), as the columnar path holds them."""
+    arrays (:func:`qualgrasp.certify.core.problem.block_arrays`), as the columnar path holds them."""
     ok, y, tight = farkas_direction(np.ascontiguousarray(C, dtype=float), *arrays,
                                     np.ascontiguousarray(y, dtype=float), rel)
     if not ok:
@@ -136,7 +136,7 @@ def force_closure(grasp: Grasp, *, method: str = "fast", solver=None, socp: bool
 
     Planar contacts are exact polyhedral cones (an LP: friction cones are their two edges, a pad's
     cone the edges at its two ends); spatial point and soft contacts exact second-order cones (an
-    SOCP). The closure programme and the verdict rules are those of :mod:`qualgrasp.certify.problem`
+    SOCP). The closure programme and the verdict rules are those of :mod:`qualgrasp.certify.core.problem`
     and :func:`decide`.
 
     Parameters

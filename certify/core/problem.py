@@ -26,8 +26,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from .grasp import Grasp
-from . import models as registry
-from ._kernels.linalg import world_values
+from .. import models as registry
+from .._kernels.linalg import world_values
 from .cones import cone_code
 from .wrench import (contact_frame, force_columns, generator_columns, grasp_arrays, tangent,
                      to_exact, variants_of, wrench)
@@ -39,7 +39,7 @@ __all__ = ["Block", "block_arrays", "System", "ClosureProblem", "grasp_problem",
 @dataclass(frozen=True)
 class Block:
     """One cone block over certificate columns ``cols``: its shape ``cone`` (``'ray'`` or
-    ``'lorentz'``, :mod:`qualgrasp.certify.cones`), the stored normal ``n``, friction ``mu`` and
+    ``'lorentz'``, :mod:`qualgrasp.certify.core.cones`), the stored normal ``n``, friction ``mu`` and
     moment length ``g`` of a Lorentz block (0 for none), and the ``contact`` it belongs to."""
 
     cone: str
@@ -252,7 +252,7 @@ def grasp_system(grasp: Grasp, *, frictionless: bool = False, socp: bool = False
 
     Polyhedral programmes (:func:`is_polyhedral`) are written over the generator wrenches, one
     ray block per generator; the others over world-frame force (and moment) columns
-    (:func:`qualgrasp.certify.wrench.force_columns`), one block per contact with the model's cone.
+    (:func:`qualgrasp.certify.core.wrench.force_columns`), one block per contact with the model's cone.
     """
     P, N, mu, params, c, L = grasp_arrays(grasp, exact)
     models = tuple(contact.model for contact in grasp.contacts)

@@ -15,8 +15,8 @@ from typing import Sequence
 
 import numpy as np
 
-from . import models as registry
-from ._kernels.linalg import ETA
+from .. import models as registry
+from .._kernels.linalg import ETA
 from .grasp import Grasp
 from .validation import param_names
 
