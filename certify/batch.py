@@ -23,7 +23,7 @@ from .core.certificates import Tolerances
 from .chunk import STATUSES, Options, Quality, verify_chunk
 from .engine import RunSummary, run
 from .errors import CertifyError
-from .table import Chunk, chunk_values, count_grasps, input_format, is_parquet, iter_chunks
+from .files.reader import Chunk, chunk_values, count_grasps, input_format, is_parquet, iter_chunks
 from .core.validation import show
 
 __all__ = ["Summary", "certify_file", "verify_file"]

@@ -41,7 +41,7 @@ from .quality import epsilon, epsilon_linearised, epsilons
 from .report import certify_grasp
 from .samples import random_grasps
 from .solvers import make_solver
-from .table import grasps_table
+from .files.reader import grasps_table
 
 __all__ = ["KINDS", "BenchRow", "run_bench", "print_bench", "CONTACTS", "ContactsRow",
            "run_contacts_bench", "print_contacts_bench"]

@@ -12,7 +12,7 @@ Rules
   the writer knows when the format comes from the suffix (a figure without ``.png`` is refused,
   not silently renamed), a name its folder allows, and lives in a folder that exists or can be
   created and can be written; the folder is created. How it is then written (a temporary name, a
-  lock, a rename) is :mod:`qualgrasp.certify.outputs`.
+  lock, a rename) is :mod:`qualgrasp.certify.files.outputs`.
 * An output folder is a folder or does not exist yet (it is created); an existing file there is
   refused, and so is an input folder of the run.
 * An input file is a regular file (a FIFO or ``/dev/zero`` is refused, never read), within its
@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Iterable
 
 from .errors import OptionError
-from .outputs import check_name_length, check_output, file_kind, inside, same_file, writable_folder
+from .files.outputs import check_name_length, check_output, file_kind, inside, same_file, writable_folder
 
 __all__ = ["OptionError", "FIGURE_SUFFIXES", "output_file", "output_folder", "input_file", "number_in",
            "count_in", "optional_number_in"]
@@ -42,10 +42,10 @@ def output_file(path: str | Path, flag: str, *, suffixes: Iterable[str] | None =
                 reads: Iterable[str | Path] = ()) -> Path:
     """Check (and prepare the folder of) an output file; return it as a :class:`~pathlib.Path`.
 
-    The rules of :func:`qualgrasp.certify.outputs.check_output`: not a folder, not an existing
+    The rules of :func:`qualgrasp.certify.files.outputs.check_output`: not a folder, not an existing
     FIFO, device or socket, not an input (by inode: symbolic and hard links are seen through), a
     name the folder allows, a folder that can be created and written. Write the file itself with
-    :func:`qualgrasp.certify.outputs.atomic_output` (temporary name, lock, rename).
+    :func:`qualgrasp.certify.files.outputs.atomic_output` (temporary name, lock, rename).
 
     Parameters
     ----------
@@ -89,7 +89,7 @@ def output_folder(path: str | Path, flag: str, *, reads: Iterable[str | Path] = 
     Refused: an existing path that is not a folder (a file, a FIFO, a device; symbolic links
     followed), a folder that is one of ``reads`` (an input folder or file of the run), holds one
     of them, or cannot be created or written. Write each file in it with
-    :func:`qualgrasp.certify.outputs.atomic_output`.
+    :func:`qualgrasp.certify.files.outputs.atomic_output`.
 
     Raises
     ------

@@ -1,13 +1,13 @@
 """One chunk of a grasp set, certified or re-checked, whichever its format.
 
-A chunk (:class:`qualgrasp.certify.table.Chunk`) holds JSON Lines text or an Arrow table. Either
-is read into checked columns (:mod:`qualgrasp.certify.columns`: one validation, the same rules and
+A chunk (:class:`qualgrasp.certify.files.reader.Chunk`) holds JSON Lines text or an Arrow table. Either
+is read into checked columns (:mod:`qualgrasp.certify.files.columns`: one validation, the same rules and
 messages for both). An Arrow chunk goes through the columnar path
 (:func:`qualgrasp.certify.fastpath.certify_table`); every row it does not settle, like every row
 of a JSON chunk, goes through the per-grasp path (:func:`certify_rows`). A bad row becomes an
 ``error`` row naming its line, the field and the problem: a chunk always gives exactly one
 results row per input row, in order. A grasp's extra top-level fields are carried through
-(:func:`qualgrasp.certify.results.carried_name`).
+(:func:`qualgrasp.certify.files.results.carried_name`).
 
 Re-checking (:func:`verify_chunk`) mirrors it: Arrow chunks with the results schema are proved
 in bulk by the rigorous floating-point kernels (:func:`qualgrasp.certify.recheck.recheck_table`),
@@ -28,14 +28,14 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from .core.certificates import Tolerances
-from .columns import GraspColumns, extra_columns, grasp_columns, value_columns
+from .files.columns import GraspColumns, extra_columns, grasp_columns, value_columns
 from .errors import CertifyError, GraspFileError
 from .fastpath import certify_table
 from .recheck import recheck_table, schema_matches
 from .report import certify_grasp, verify_row
-from .results import NAMES, carried_clash, carried_name, error_row
+from .files.results import NAMES, carried_clash, carried_name, error_row
 from .solvers import make_solver
-from .table import Chunk, chunk_values, column_problem, table_to_rows
+from .files.reader import Chunk, chunk_values, column_problem, table_to_rows
 
 __all__ = ["Options", "Quality", "certify_rows", "certify_values", "certify_chunk_results", "certify_arrow",
            "verify_rows", "verify_chunk", "status_counts", "STATUSES"]
@@ -128,7 +128,7 @@ def certify_arrow(data: Any, options: Options = Options(), tol: Tolerances = Tol
     any object with the Arrow PyCapsule stream interface (``__arrow_c_stream__``: pandas and
     polars data frames, DuckDB results, ...).
 
-    Any layout :func:`qualgrasp.certify.columns.grasp_columns` reads is accepted (list, large or
+    Any layout :func:`qualgrasp.certify.files.columns.grasp_columns` reads is accepted (list, large or
     fixed-size lists of any float or integer width, dictionary or large strings, optional
     fields absent); extra columns are carried through.
 
@@ -144,7 +144,7 @@ def certify_arrow(data: Any, options: Options = Options(), tol: Tolerances = Tol
     Returns
     -------
     pyarrow.Table
-        The results (:data:`qualgrasp.certify.results.RESULT_SCHEMA`, then the carried columns),
+        The results (:data:`qualgrasp.certify.files.results.RESULT_SCHEMA`, then the carried columns),
         one row per input row; ``line`` is the row number (1-based).
 
     Raises
@@ -188,7 +188,7 @@ def _status_of(row: Any) -> str:
 
 def _id_text(gid: Any) -> Any:
     """The id as a Parquet results file stores it (a string; see
-    :func:`qualgrasp.certify.table.rows_to_table`)."""
+    :func:`qualgrasp.certify.files.reader.rows_to_table`)."""
     if gid is None or isinstance(gid, str):
         return gid
     return str(gid) if isinstance(gid, (int, float)) and not isinstance(gid, bool) else json.dumps(gid)

@@ -24,7 +24,7 @@ from .bench import (print_bench, print_contacts_bench, print_quality_bench, run_
 from .errors import CertifyError
 from .regions import DEFAULT_BUDGET, certify_region_file, verify_region_file
 from .samples import write_random_grasp_file
-from .table import count_grasps
+from .files.reader import count_grasps
 from .core.validation import MAX_CONTACTS
 
 __all__ = ["register"]

@@ -1,6 +1,6 @@
 """Resumable, parallel certification of large grasp sets.
 
-The input is read in chunks of a fixed number of grasps (:func:`qualgrasp.certify.table.iter_chunks`).
+The input is read in chunks of a fixed number of grasps (:func:`qualgrasp.certify.files.reader.iter_chunks`).
 Each chunk is certified by a worker (local processes by default, or a dask.distributed cluster)
 and its results are written to ``RESULTS.parts/part-NNNNNN.EXT`` under a temporary name, renamed
 atomically when complete, with ``part-NNNNNN.EXT.sum`` stating its rows, bytes and CRC-32 (local
@@ -18,7 +18,7 @@ deterministic). ``RESULTS.parts/manifest.json`` records the input and the option
 folder as this output's (:data:`MADE_BY`); a resume with a different input, chunk size or options
 is refused, and a ``RESULTS.parts`` that no run for this output made is never reused nor removed.
 
-Nothing is lost (:mod:`qualgrasp.certify.outputs`): the output is checked before any work (never
+Nothing is lost (:mod:`qualgrasp.certify.files.outputs`): the output is checked before any work (never
 an input, a FIFO or a device), one run at a time writes it (a second is refused), and a write that
 fails (full disk, file-size limit, read-only folder) ends the run with a one-line
 :class:`CertifyError` that keeps every finished part for ``--resume``.
@@ -43,9 +43,9 @@ import pyarrow.parquet as pq
 
 from .chunk import Options, certify_chunk_results, status_counts
 from .errors import CertifyError, GraspFileError
-from .outputs import check_output, lock_output, write_error
-from .results import RESULT_SCHEMA, RESULT_WRITE_OPTIONS, carried_clash
-from .table import Chunk, input_format, is_parquet, iter_chunks, rows_to_table, table_to_rows
+from .files.outputs import check_output, lock_output, write_error
+from .files.results import RESULT_SCHEMA, RESULT_WRITE_OPTIONS, carried_clash
+from .files.reader import Chunk, input_format, is_parquet, iter_chunks, rows_to_table, table_to_rows
 from .core.validation import TOP_LEVEL
 
 __all__ = ["RunSummary", "run", "check_paths", "certify_chunk", "parts_folder", "MADE_BY"]
@@ -372,7 +372,7 @@ class _DaskPool:
 
 def check_paths(grasps: Path, results: Path, chunk_size: int = 1) -> None:
     """Refuse a run before any work: an input that is not a grasp set, a chunk size below 1, and
-    an output that :func:`qualgrasp.certify.outputs.check_output` refuses (a folder, a FIFO or
+    an output that :func:`qualgrasp.certify.files.outputs.check_output` refuses (a folder, a FIFO or
     device, the input itself through any link, a checkpoint folder ``RESULTS.parts`` that is or
     holds the input, a name too long for that folder, a folder that cannot be created or
     written). The output's folder is created if needed.

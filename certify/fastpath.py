@@ -1,7 +1,7 @@
 """Columnar certification of a chunk of grasps: compiled kernels for whole groups at once.
 
-:func:`certify_table` takes a grasp table (any layout :func:`qualgrasp.certify.columns.grasp_columns`
-reads) and returns the results table (:data:`qualgrasp.certify.results.RESULT_SCHEMA`), row for
+:func:`certify_table` takes a grasp table (any layout :func:`qualgrasp.certify.files.columns.grasp_columns`
+reads) and returns the results table (:data:`qualgrasp.certify.files.results.RESULT_SCHEMA`), row for
 row equal to what :func:`qualgrasp.certify.certify_grasp` gives grasp by grasp. Valid grasps are
 grouped by contact pattern (dimension, contact count, each contact's model and variant):
 
@@ -34,17 +34,17 @@ from ._kernels.planar import planar_batch, planar_generators
 from ._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
 from .core.certificates import Tolerances, verify
 from .core.closure import decide, farkas_from_arrays
-from .columns import GraspColumns, extra_columns, grasp_columns
+from .files.columns import GraspColumns, extra_columns, grasp_columns
 from .core.cones import LORENTZ, cone_code
 from .core.grasp import Contact, Grasp
 from .core.problem import Block, ClosureProblem, System, conic_columns, grasp_problem, grasp_system
 from .quality import planar_epsilons
-from .results import CERTIFICATE, RESULT_SCHEMA, carried_name, result_table
+from .files.results import CERTIFICATE, RESULT_SCHEMA, carried_name, result_table
 from .solvers import BARRIER_NEAR_ZERO, FastSolver, make_solver
 from .solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
 from .solvers.enumeration import FEAS, bases
 from .solvers.squeeze import squeeze_farkas
-from .table import rows_to_table
+from .files.reader import rows_to_table
 from . import models as registry
 from .core.wrench import force_column_errors, force_columns, generator_columns, generator_layout
 

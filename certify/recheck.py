@@ -1,7 +1,7 @@
 """Columnar re-check of a results table against its grasps: the independent checker at scale.
 
 :func:`recheck_table` re-checks every row of a results table
-(:data:`qualgrasp.certify.results.RESULT_SCHEMA`) against the checked grasp columns it came from.
+(:data:`qualgrasp.certify.files.results.RESULT_SCHEMA`) against the checked grasp columns it came from.
 The common certificates are proved in bulk with the rigorous floating-point kernels of
 :mod:`qualgrasp.certify._kernels.recheck` (error bounds instead of rationals):
 planar generator certificates (interior, strict Farkas, null space) and spatial ones (interior
@@ -27,12 +27,12 @@ from . import models as registry
 from ._kernels.planar import planar_generators
 from ._kernels.recheck import null_rows, verify_farkas_general, verify_interior_general
 from .core.certificates import Tolerances, margin_of, margin_tolerance
-from .columns import GraspColumns
+from .files.columns import GraspColumns
 from .core.cones import CONES, cone_code
 from .evidence import EPS_COLUMNS, Evidence, verify_bounds
 from .core.problem import Block
 from .report import GEOMETRY_TOL
-from .results import RESULT_SCHEMA
+from .files.results import RESULT_SCHEMA
 from .core.wrench import force_column_errors, force_columns, generator_columns, generator_layout
 
 __all__ = ["recheck_table", "generator_errors", "schema_matches"]

@@ -42,13 +42,13 @@ from pathlib import Path
 from typing import Any, Callable, Iterator
 
 from .errors import CertifyError, GraspError, OptionError
-from .outputs import atomic_output
+from .files.outputs import atomic_output
 from .region_boundary import Boundary, IndependentRegions, enclosing_diameter, independent_regions
 from .region_branch import DEFAULT_BUDGET
 from .region_certify import DEFAULT_TOL, STATUSES, RegionVerdict, certify_regions, in_region, verify_regions
 from .region_data import (CurvedRegion, RegionTuple, StraightRegion, region_from_dict, region_to_dict,
                           tuple_from_dict, tuple_to_dict)
-from .table import input_format, json_lines
+from .files.reader import input_format, json_lines
 from .core.validation import id_problem, show
 
 __all__ = [
@@ -68,7 +68,7 @@ def error_row(message: str, *, id: Any = None, line: int | None = None) -> dict[
 
 def read_region_lines(path: str | Path) -> Iterator[tuple[int, Any]]:
     """``(line number, tuple or (id, message))`` for every non-blank line of a region set, read
-    by the toolkit's one line reader (:func:`qualgrasp.certify.table.json_lines`: regular files
+    by the toolkit's one line reader (:func:`qualgrasp.certify.files.reader.json_lines`: regular files
     only, the same limits and messages as grasp sets; line numbers count from 1 and include
     blank lines); a line that cannot be read gives its id (where one can be read) and an error
     message naming the line and the field instead of a tuple.
@@ -124,7 +124,7 @@ def certify_region_file(in_path: str | Path, out_path: str | Path, *, budget: in
         Region set, JSON Lines.
     out_path : path
         Results file (JSON Lines), written through a temporary file renamed at the end, one run
-        at a time (:func:`qualgrasp.certify.outputs.atomic_output`); never the input, a FIFO or a
+        at a time (:func:`qualgrasp.certify.files.outputs.atomic_output`); never the input, a FIFO or a
         device.
     budget, tol
         As for :func:`certify_regions`.

@@ -1,7 +1,7 @@
 """Certify one grasp end to end: force and form closure, certificates, independent re-check.
 
 :func:`certify_grasp` returns a :class:`Report`; :meth:`Report.row` is the results-file row
-(:data:`qualgrasp.certify.results.COLUMNS`): the force and form closure verdicts, margins and
+(:data:`qualgrasp.certify.files.results.COLUMNS`): the force and form closure verdicts, margins and
 certificates, whether both certificates re-checked, the ``center`` and ``length`` used, and the
 Ferrari-Canny epsilon bounds with their evidence (:mod:`qualgrasp.certify.evidence`; 0 and no
 evidence when not in force closure; null when quality was not asked for). ``status`` refers to
@@ -22,7 +22,7 @@ from .core.closure import Verdict, form_closure, force_closure
 from .evidence import verify_epsilon
 from .core.grasp import Grasp
 from .quality import Epsilon, epsilons
-from .results import NAMES, result_row
+from .files.results import NAMES, result_row
 
 __all__ = ["Report", "certify_grasp", "verify_row", "GEOMETRY_TOL"]
 
@@ -48,7 +48,7 @@ class Report:
         return float(self.epsilons["L1"].hi) if self.certified and self.epsilons else 0.0
 
     def row(self, line: int | None = None) -> dict[str, Any]:
-        """The results-file row of this grasp (:data:`qualgrasp.certify.results.COLUMNS`)."""
+        """The results-file row of this grasp (:data:`qualgrasp.certify.files.results.COLUMNS`)."""
         g = self.grasp
         eps = {}
         for norm, key in (("L1", "l1"), ("Linf", "linf")):

@@ -10,8 +10,8 @@ import pyarrow.parquet as pq
 
 from . import models as registry
 from .core.grasp import Contact, Grasp
-from .outputs import atomic_output
-from .table import CONTACT, GRASP_SCHEMA, is_parquet
+from .files.outputs import atomic_output
+from .files.reader import CONTACT, GRASP_SCHEMA, is_parquet
 
 __all__ = ["RANGES", "random_grasp", "random_grasps", "textbook_grasps", "random_grasp_table", "write_random_grasp_file"]
 
@@ -123,7 +123,7 @@ def random_grasp_table(seed: int, count: int, *, dim: int = 2, n_contacts: int =
                        torsion: tuple[float, float] = RANGES["torsion"],
                        width: tuple[float, float] = RANGES["width"], spread: float = 0.7,
                        start: int = 0):
-    """An Arrow grasp table (:data:`qualgrasp.certify.table.GRASP_SCHEMA`) of ``count`` random grasps drawn
+    """An Arrow grasp table (:data:`qualgrasp.certify.files.reader.GRASP_SCHEMA`) of ``count`` random grasps drawn
     like :func:`random_grasp` (same distribution, vectorised; not the same draws), ids
     ``r{start}, r{start+1}, ...``; ``center`` and ``length`` left to their defaults."""
 
@@ -151,7 +151,7 @@ def random_grasp_table(seed: int, count: int, *, dim: int = 2, n_contacts: int =
 def write_random_grasp_file(path, count: int, *, seed: int = 0, chunk: int = 500_000, **kwargs) -> int:
     """Write ``count`` random grasps (:func:`random_grasp_table`) to a Parquet or JSON Lines file,
     ``chunk`` at a time, so that memory stays bounded; return how many were written. The file is
-    written by :func:`qualgrasp.certify.outputs.atomic_output` (a temporary renamed at the end,
+    written by :func:`qualgrasp.certify.files.outputs.atomic_output` (a temporary renamed at the end,
     one writer at a time, never a FIFO or a device).
 
     Raises

@@ -9,9 +9,9 @@ from pathlib import Path
 import typer
 
 from ..certify.checks import FIGURE_SUFFIXES, number_in, optional_number_in, output_file
-from ..certify.outputs import atomic_output
+from ..certify.files import atomic_output
 from ..certify.errors import CertifyError
-from ..certify.io import write_grasps
+from ..certify.files import write_grasps
 from ..certify.models import MAX_MU
 from ..certify.region_boundary import SEARCH_BUDGET
 from . import procedures

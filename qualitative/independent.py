@@ -46,11 +46,11 @@ from typing import Any, Callable
 import numpy as np
 
 from ..certify.errors import CertifyError, GraspError
-from ..certify.core.grasp import Grasp, grasp_from_dict
-from ..certify.outputs import atomic_output, check_output
+from ..certify.core import Grasp, grasp_from_dict
+from ..certify.files import atomic_output, check_output
 from ..certify.region_boundary import SEARCH_BUDGET, IndependentRegions, bisection_tol, independent_regions
 from ..certify.region_data import tuple_to_dict
-from ..certify.table import json_lines
+from ..certify.files import json_lines
 from ..certify.core.validation import id_problem, number, show
 from .errors import QualitativeError
 from .outline import DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_contour, outline_image

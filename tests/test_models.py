@@ -19,9 +19,9 @@ from qualgrasp.certify import models
 from qualgrasp.certify.bench import compare_routes
 from qualgrasp.certify.chunk import Options, certify_values
 from qualgrasp.certify.fastpath import certify_table
-from qualgrasp.certify.core.grasp import grasp_from_dict, grasp_to_dict
+from qualgrasp.certify.core import grasp_from_dict, grasp_to_dict
 from qualgrasp.certify.samples import random_grasp_table, random_grasps
-from qualgrasp.certify.table import grasps_table, rows_to_table, table_to_rows, table_values
+from qualgrasp.certify.files import grasps_table, rows_to_table, table_to_rows, table_values
 from qualgrasp.experiments.baseline import screen_grasps
 
 

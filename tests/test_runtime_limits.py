@@ -14,7 +14,7 @@ from qualgrasp.certify.evidence import verify_epsilon
 from qualgrasp.certify.fastpath import certify_table
 from qualgrasp.certify.quality import epsilons
 from qualgrasp.certify.samples import random_grasps
-from qualgrasp.certify.table import grasps_table, table_to_rows, table_values
+from qualgrasp.certify.files import grasps_table, table_to_rows, table_values
 
 # Planar grasps of every epsilon route: 21 point contacts (42 generators: the L-infinity sweep
 # and `support` evidence refined under the clock), pads, frictionless, few points; and spatial.
@@ -78,7 +78,7 @@ from qualgrasp.certify import grasp_to_dict
 from qualgrasp.certify.chunk import Options, certify_values
 from qualgrasp.certify.fastpath import certify_table
 from qualgrasp.certify.samples import random_grasps
-from qualgrasp.certify.table import grasps_table, rows_to_table, table_to_rows, table_values
+from qualgrasp.certify.files.reader import grasps_table, rows_to_table, table_to_rows, table_values
 
 dicts = [grasp_to_dict(g) for g in random_grasps(8, 6, dim=2, n_contacts=21, model="point")]
 dicts += [grasp_to_dict(g) for g in random_grasps(7, 4, dim=2, n_contacts=3, model="pad", mu=(0.1, 0.8))]

@@ -5,7 +5,7 @@ Grasps arrive as Python values (:class:`qualgrasp.certify.Contact` and
 columns (Parquet, in-memory tables). Both are turned into the same arrays, :class:`ContactData`
 (one row per contact) and :class:`GraspData` (one row per grasp), by a *reader* that only checks
 types: :func:`contact_data` and :func:`grasp_data` for Python values (numbers must be numbers:
-no string, boolean or mapping is coerced), :mod:`qualgrasp.certify.columns` for Arrow. Every rule
+no string, boolean or mapping is coerced), :mod:`qualgrasp.certify.files.columns` for Arrow. Every rule
 on the values is then applied here, vectorised, by :func:`check_contacts` and :func:`check_grasps`,
 with the same messages for every source. A message names the field and the problem:
 ``contacts[2].p: expected 2 or 3 finite numbers, got "abc"``.

@@ -38,7 +38,7 @@ import numpy as np
 
 from ..errors import GraspFileError
 from ..core.grasp import Contact, Grasp
-from ..table import chunk_values, iter_chunks
+from ..files.reader import chunk_values, iter_chunks
 from ..core.validation import number, numbers, show
 from .contacts import Outcome
 from .errors import PoseError, PoseFileError

@@ -1,32 +1,32 @@
-"""Reading and writing grasp sets and results, JSON Lines or Parquet by file extension.
+"""Writing grasp sets and results, JSON Lines or Parquet by file extension (read by
+:mod:`qualgrasp.certify.files.reader`).
 
 Grasp line: ``{"id": "g1", "contacts": [{"p": [x, y], "n": [nx, ny], "model": "point", "mu": 0.5}],
 "center": [cx, cy], "length": 1.0}`` (see :func:`qualgrasp.certify.core.grasp.grasp_from_dict`); Parquet holds
-the same fields (:data:`qualgrasp.certify.table.GRASP_SCHEMA`). In JSON Lines, blank lines are skipped and
+the same fields (:data:`qualgrasp.certify.files.reader.GRASP_SCHEMA`). In JSON Lines, blank lines are skipped and
 line numbers count from 1 and include them; in Parquet the line number is the row number.
-Files are written by the rules of :mod:`qualgrasp.certify.outputs` (nothing lost).
+Files are written by the rules of :mod:`qualgrasp.certify.files.outputs` (nothing lost).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Iterable, Iterator
+from typing import Any, Iterable
 
 import pyarrow.parquet as pq
 
-from .core.grasp import Grasp, grasp_to_dict
-from .errors import GraspFileError
+from ..core.grasp import Grasp, grasp_to_dict
 from .outputs import atomic_output, write_lines
 from .results import RESULT_WRITE_OPTIONS
-from .table import chunk_values, grasps_table, is_parquet, iter_chunks, rows_to_table, table_to_rows
+from .reader import grasps_table, is_parquet, rows_to_table
 
-__all__ = ["write_grasps", "read_results", "write_rows"]
+__all__ = ["write_grasps", "write_rows"]
 
 
 def write_grasps(path: str | Path, grasps: Iterable[Grasp], *, reads: Iterable[str | Path] = (),
                  flag: str = "-o") -> int:
     """Write grasps in the grasp-set schema (Parquet for a ``.parquet`` / ``.pq`` name, else JSON
-    Lines) through :func:`qualgrasp.certify.outputs.atomic_output` (never one of ``reads``, a
+    Lines) through :func:`qualgrasp.certify.files.outputs.atomic_output` (never one of ``reads``, a
     FIFO or a device; one writer at a time; the old file kept whole if the write fails); return
     how many were written.
 
@@ -36,24 +36,6 @@ def write_grasps(path: str | Path, grasps: Iterable[Grasp], *, reads: Iterable[s
         The output is refused or cannot be written (message naming ``flag``).
     """
     return _write(path, [grasp_to_dict(g) for g in grasps], grasps_table, reads=reads, flag=flag)
-
-
-def read_results(path: str | Path, chunk_size: int = 4096) -> Iterator[dict]:
-    """Yield the rows of a results file as dictionaries.
-
-    Raises
-    ------
-    GraspFileError
-        The file is refused as a whole, or a line cannot be read (the message names it).
-    """
-    for chunk in iter_chunks(path, chunk_size):
-        if isinstance(chunk.rows, list):
-            for line, value in zip(chunk.lines, chunk_values(chunk)):
-                if isinstance(value, Exception):
-                    raise GraspFileError(f"{path} line {line}: {value}")
-                yield value
-        else:
-            yield from table_to_rows(chunk.rows)
 
 
 def write_rows(path: str | Path, rows: Iterable[dict[str, Any]], *, reads: Iterable[str | Path] = (),

@@ -26,11 +26,11 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
-from . import models as registry
-from .core.grasp import Grasp, grasps_from_checked
-from .table import READ_ERROR
-from .core.validation import (ABSENT, MAX_CONTACTS, TOP_LEVEL, UNKNOWN, CheckedGrasps, ContactData, GraspData, check_grasps,
-                              grasp_data, show)
+from .. import models as registry
+from ..core.grasp import Grasp, grasps_from_checked
+from .reader import READ_ERROR
+from ..core.validation import (ABSENT, MAX_CONTACTS, TOP_LEVEL, UNKNOWN, CheckedGrasps, ContactData, GraspData, check_grasps,
+                               grasp_data, show)
 
 __all__ = ["GraspColumns", "grasp_columns", "value_columns", "extra_columns"]
 

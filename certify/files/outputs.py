@@ -31,7 +31,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Iterable, Iterator
 
-from .errors import OptionError, WriteError
+from ..errors import OptionError, WriteError
 
 __all__ = ["same_file", "inside", "check_output", "check_name_length", "OutputLock", "lock_output",
            "temporary_name", "atomic_output", "write_lines", "write_error", "file_kind", "writable_folder"]

@@ -1,12 +1,12 @@
 """Grasp sets and results as Arrow tables: the Parquet schema, and streaming in fixed-size chunks.
 
-Parquet files hold the same schema as the JSON Lines files of :mod:`qualgrasp.certify.io`:
+Parquet files hold the same schema as the JSON Lines files of :mod:`qualgrasp.certify.files.writers`:
 
 * grasps: ``id`` (string), ``contacts`` (list of struct ``p``, ``n`` (lists of float64),
   ``model`` (string), and one float64 field per model parameter: ``mu``, ``torsion``,
   ``width``, nullable), ``center`` (list of float64, nullable), ``length`` (float64, nullable).
-  Other layouts are read too (:mod:`qualgrasp.certify.columns`);
-* results: the columns of :data:`qualgrasp.certify.results.COLUMNS`, with ``certificate`` a
+  Other layouts are read too (:mod:`qualgrasp.certify.files.columns`);
+* results: the columns of :data:`qualgrasp.certify.files.results.COLUMNS`, with ``certificate`` a
   struct ``{force, form}`` of certificate structs.
 
 An input file's format is recognised by its content (Parquet's magic number, else JSON Lines
@@ -31,15 +31,16 @@ from typing import Any, Iterator, Sequence
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from .errors import GraspFileError
+from ..errors import GraspFileError
 from .outputs import file_kind
 from .results import RESULT_SCHEMA
-from .core.validation import param_names
+from ..core.validation import param_names
 
 __all__ = ["CONTACT", "GRASP_SCHEMA", "MAX_LINE_BYTES", "READ_ERROR", "SNIFF_BYTES", "is_parquet", "input_format",
            "column_problem", "json_lines", "Chunk",
            "iter_chunks", "count_grasps", "parse_line", "grasps_table", "rows_to_table", "table_to_rows",
-           "chunk_values", "table_values"]
+           "chunk_values", "table_values",
+           "read_results"]
 
 CONTACT = pa.struct([("p", pa.list_(pa.float64())), ("n", pa.list_(pa.float64())), ("model", pa.string())]
                     + [(name, pa.float64()) for name in param_names()])
@@ -461,3 +462,21 @@ def table_to_rows(table: pa.Table) -> list[dict]:
                 if isinstance(cert.get(key), dict):
                     cert[key] = {k: v for k, v in cert[key].items() if v is not None}
     return rows
+
+
+def read_results(path: str | Path, chunk_size: int = 4096) -> Iterator[dict]:
+    """Yield the rows of a results file as dictionaries.
+
+    Raises
+    ------
+    GraspFileError
+        The file is refused as a whole, or a line cannot be read (the message names it).
+    """
+    for chunk in iter_chunks(path, chunk_size):
+        if isinstance(chunk.rows, list):
+            for line, value in zip(chunk.lines, chunk_values(chunk)):
+                if isinstance(value, Exception):
+                    raise GraspFileError(f"{path} line {line}: {value}")
+                yield value
+        else:
+            yield from table_to_rows(chunk.rows)
