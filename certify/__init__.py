@@ -4,7 +4,7 @@ Form closure and positive spanning are linear programmes; force closure is a lin
 the plane (friction cones have exactly two edges) and a second-order-cone programme in space
 (exact Lorentz cones, no linearisation). Every verdict carries a certificate that
 :func:`verify` re-checks with exact rational arithmetic, without any solver, and every
-Ferrari-Canny epsilon bound its evidence (:mod:`qualgrasp.certify.evidence`); a results row is
+Ferrari-Canny epsilon bound its evidence (:mod:`qualgrasp.certify.quality.evidence`); a results row is
 re-checked column by column (:func:`qualgrasp.certify.report.verify_row`).
 
 >>> from qualgrasp.certify import Contact, Grasp, force_closure

@@ -8,7 +8,7 @@ grouped by contact pattern (dimension, contact count, each contact's model and v
 * planar groups go through :func:`qualgrasp.certify._kernels.planar.planar_batch`: the LP (the
   same kernel the per-grasp path calls), the certificate and its rigorous re-check in floating
   point with error bounds; with quality, the exact planar epsilon and its evidence of every
-  closure row by :func:`qualgrasp.certify.quality.planar_epsilons`, the per-grasp path's own
+  closure row by :func:`qualgrasp.certify.quality.bounds.planar_epsilons`, the per-grasp path's own
   function;
 * spatial groups through the compiled dual barrier method over exact cones, with clear verdicts
   proved columnar, and near-boundary rows decided by the per-grasp rules on the arrays already
@@ -38,7 +38,7 @@ from .files.columns import GraspColumns, extra_columns, grasp_columns
 from .core.cones import LORENTZ, cone_code
 from .core.grasp import Contact, Grasp
 from .core.problem import Block, ClosureProblem, System, conic_columns, grasp_problem, grasp_system
-from .quality import planar_epsilons
+from .quality.bounds import planar_epsilons
 from .files.results import CERTIFICATE, RESULT_SCHEMA, carried_name, result_table
 from .solvers import BARRIER_NEAR_ZERO, FastSolver, make_solver
 from .solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
@@ -231,7 +231,7 @@ def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances
 
 
 def _planar_quality(cols, rows, closure, P, N, mu, width, c, L, models, variants, options):
-    """Epsilon columns of a planar group: :func:`qualgrasp.certify.quality.planar_epsilons`
+    """Epsilon columns of a planar group: :func:`qualgrasp.certify.quality.bounds.planar_epsilons`
     (the per-grasp path's function, on the same generator floats) for every closure row; 0 and
     no evidence elsewhere. Returns ``(l1_lo, l1_hi, linf_lo, linf_hi, limited, evidence)``."""
     B, m = mu.shape

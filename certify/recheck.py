@@ -10,7 +10,7 @@ forces, strict Farkas, null-space form certificates). Each row's other claims ar
 ``dim``, ``n_contacts``, ``center`` and ``length`` against the grasp, status against certificate
 kind and closure flags, both margins equal to the certified ones (two-sided), and the epsilon
 columns (0 and no evidence without closure; with closure, the evidence re-checked by
-:func:`qualgrasp.certify.evidence.verify_bounds`, rigorous float bounds first). A table whose
+:func:`qualgrasp.certify.quality.evidence.verify_bounds`, rigorous float bounds first). A table whose
 schema is not the results schema is not proved in bulk at all. Every row not proved in bulk goes
 through :func:`qualgrasp.certify.report.verify_row`, which uses exact rational arithmetic and gives
 the message; a row fails only if that fails. No solver is involved anywhere.
@@ -29,7 +29,7 @@ from ._kernels.recheck import null_rows, verify_farkas_general, verify_interior_
 from .core.certificates import Tolerances, margin_of, margin_tolerance
 from .files.columns import GraspColumns
 from .core.cones import CONES, cone_code
-from .evidence import EPS_COLUMNS, Evidence, verify_bounds
+from .quality.evidence import EPS_COLUMNS, Evidence, verify_bounds
 from .core.problem import Block
 from .report import GEOMETRY_TOL
 from .files.results import RESULT_SCHEMA

@@ -3,7 +3,7 @@
 :func:`certify_grasp` returns a :class:`Report`; :meth:`Report.row` is the results-file row
 (:data:`qualgrasp.certify.files.results.COLUMNS`): the force and form closure verdicts, margins and
 certificates, whether both certificates re-checked, the ``center`` and ``length`` used, and the
-Ferrari-Canny epsilon bounds with their evidence (:mod:`qualgrasp.certify.evidence`; 0 and no
+Ferrari-Canny epsilon bounds with their evidence (:mod:`qualgrasp.certify.quality.evidence`; 0 and no
 evidence when not in force closure; null when quality was not asked for). ``status`` refers to
 force closure under the declared contact models.
 
@@ -19,9 +19,9 @@ from typing import Any
 from .core.certificates import Certificate, Check, Tolerances, verify
 from .errors import CertificateError
 from .core.closure import Verdict, form_closure, force_closure
-from .evidence import verify_epsilon
+from .quality.evidence import verify_epsilon
 from .core.grasp import Grasp
-from .quality import Epsilon, epsilons
+from .quality.bounds import Epsilon, epsilons
 from .files.results import NAMES, result_row
 
 __all__ = ["Report", "certify_grasp", "verify_row", "GEOMETRY_TOL"]
@@ -86,7 +86,7 @@ def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
         Compute the epsilons (with the grasp's ``center`` and ``length``).
     eps_gap, eps_budget
         Spatial epsilon: relative gap to reach and most work (see
-        :func:`qualgrasp.certify.quality.epsilon`).
+        :func:`qualgrasp.certify.quality.bounds.epsilon`).
     eps_time : float, optional
         Time limit of the quality computation for this grasp, in seconds (both norms
         together); when it is hit the epsilons are the bounds reached, flagged ``limited``
@@ -154,7 +154,7 @@ def verify_row(grasp: Grasp, row: dict[str, Any], tol: Tolerances = Tolerances()
       margin is 0 without closure and otherwise the margin the certificate's values certify, to
       within :func:`qualgrasp.certify.core.certificates.margin_tolerance` either way;
     * the epsilon columns are proved by their evidence
-      (:func:`qualgrasp.certify.evidence.verify_epsilon`).
+      (:func:`qualgrasp.certify.quality.evidence.verify_epsilon`).
 
     Returns
     -------

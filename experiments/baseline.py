@@ -59,7 +59,7 @@ from shapely.geometry import Polygon
 
 from qualgrasp.certify import Contact, Grasp, Report, certify_grasp
 from qualgrasp.certify.fastpath import planar_screen
-from qualgrasp.certify.steinitz import edge_samples
+from qualgrasp.certify.quality import edge_samples
 from qualgrasp.qualitative.candidates import object_frame
 from qualgrasp.qualitative.errors import QualitativeError
 from qualgrasp.qualitative.outline import DEFAULT_SCALE, Outline, outline_contour, resample

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import typer
 
-from ..certify.checks import FIGURE_SUFFIXES, number_in, optional_number_in, output_file
+from ..certify.cli.options import FIGURE_SUFFIXES, number_in, optional_number_in, output_file
 from ..certify.files import atomic_output
 from ..certify.errors import CertifyError
 from ..certify.files import write_grasps

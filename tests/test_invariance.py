@@ -6,7 +6,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from qualgrasp.certify import Contact, Grasp, force_closure, form_closure
-from qualgrasp.certify.bench import KINDS
+from qualgrasp.experiments.bench import KINDS
 from qualgrasp.certify.samples import random_grasp
 from helpers import rotation
 

@@ -16,7 +16,7 @@ from scipy.optimize import linprog
 
 from qualgrasp.certify import Contact, Grasp, GraspError, certify_grasp, force_closure, form_closure, verify
 from qualgrasp.certify import models
-from qualgrasp.certify.bench import compare_routes
+from qualgrasp.experiments.bench import compare_routes
 from qualgrasp.certify.chunk import Options, certify_values
 from qualgrasp.certify.fastpath import certify_table
 from qualgrasp.certify.core import grasp_from_dict, grasp_to_dict

@@ -21,7 +21,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from qualgrasp.certify.checks import OptionError, output_file, output_folder
+from qualgrasp.certify.cli.options import OptionError, output_file, output_folder
 from qualgrasp.certify.files import write_grasps
 from qualgrasp.certify.samples import random_grasps, textbook_grasps
 from qualgrasp.cli import app
@@ -354,7 +354,7 @@ def test_a_failed_write_keeps_the_old_output_whole(folder):
 
 
 def test_output_folder_refuses_an_input_folder_and_output_file_a_fifo(folder):
-    from qualgrasp.certify.checks import input_file
+    from qualgrasp.certify.cli.options import input_file
 
     with pytest.raises(OptionError, match="input"):
         output_folder(folder, "--out", reads=[folder / "g.jsonl"])

@@ -2,7 +2,7 @@
 
 import pytest
 
-from qualgrasp.certify.bench import KINDS, compare_routes
+from qualgrasp.experiments.bench import KINDS, compare_routes
 from qualgrasp.certify.samples import random_grasps
 
 N = 10_000

@@ -10,7 +10,7 @@ import pytest
 
 from qualgrasp.certify import certify_grasp, force_closure, grasp_to_dict
 from qualgrasp.certify.chunk import Options, certify_values
-from qualgrasp.certify.evidence import verify_epsilon
+from qualgrasp.certify.quality import verify_epsilon
 from qualgrasp.certify.fastpath import certify_table
 from qualgrasp.certify.quality import epsilons
 from qualgrasp.certify.samples import random_grasps
@@ -123,7 +123,7 @@ def test_rows_are_the_same_with_a_cold_and_a_warm_compile_cache(tmp_path):
 _NO_COMPILE_UNDER_THE_CLOCK = """
 import importlib, pkgutil
 import qualgrasp.certify._kernels as kernels
-from qualgrasp.certify import quality
+from qualgrasp.certify.quality import bounds as quality
 from qualgrasp.certify.core.closure import force_closure
 from qualgrasp.certify.samples import random_grasps
 

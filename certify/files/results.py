@@ -35,7 +35,7 @@ EVIDENCE = pa.struct([
     ("kind", pa.string()), ("direction", pa.list_(pa.float64())), ("ref", pa.list_(pa.int32())),
     ("points", pa.list_(pa.float64())), ("faces", pa.list_(pa.int32())),
 ])
-"""Evidence of one norm's epsilon bounds (:class:`qualgrasp.certify.evidence.Evidence`) as an
+"""Evidence of one norm's epsilon bounds (:class:`qualgrasp.certify.quality.evidence.Evidence`) as an
 Arrow struct."""
 
 

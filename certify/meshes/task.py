@@ -74,7 +74,7 @@ import trimesh
 from ..core import cones
 from ..core import exact as ex
 from ..core.certificates import Check
-from ..evidence import cycle_check, exact_face
+from ..quality.evidence import cycle_check, exact_face
 from ..core.grasp import Grasp
 from ..core.problem import Block, grasp_system
 from ..core.wrench import to_exact, wrench

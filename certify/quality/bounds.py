@@ -16,7 +16,7 @@ Torque scaling is explicit: wrenches are ``(f, (p - center) x f / length)``, so 
 the torque coordinates by ``s``. The min-weight margin of :mod:`qualgrasp.certify.core.closure` depends on neither.
 
 Every :class:`Epsilon` states rigorous bounds ``lo <= epsilon <= hi`` and carries
-:class:`~qualgrasp.certify.evidence.Evidence` that :mod:`qualgrasp.certify.evidence` re-checks
+:class:`~qualgrasp.certify.quality.evidence.Evidence` that :mod:`qualgrasp.certify.quality.evidence` re-checks
 without a solver: a direction ``u`` with ``h(u) = hi`` and an inscribed polytope (a closed
 triangulated surface on points of the GWS) whose faces are all at distance ``lo`` or more.
 
@@ -75,20 +75,20 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import ConvexHull, QhullError
 
-from ._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
-from ._kernels.jit import BOOL, F1, F2, FLOAT, I1, I2, INT, precompile
-from ._kernels.planar import planar_generators
-from ._kernels.surface import cycle_code, face_bounds
-from .core.closure import Verdict, force_closure
+from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
+from .._kernels.jit import BOOL, F1, F2, FLOAT, I1, I2, INT, precompile
+from .._kernels.planar import planar_generators
+from .._kernels.surface import cycle_code, face_bounds
+from ..core.closure import Verdict, force_closure
 from .evidence import (EPS_TOL, ConicSupport, Evidence, planar_generator_arrays,
                        planar_support_vertices, stated_lo, sum_errors, surface_faces,
                        surface_minimum)
-from .core.grasp import Grasp
-from .core.problem import System, grasp_system
-from .solvers.clarabel_direct import settings
+from ..core.grasp import Grasp
+from ..core.problem import System, grasp_system
+from ..solvers.clarabel_direct import settings
 
 __all__ = ["NORMS", "Epsilon", "epsilon", "epsilons", "planar_epsilon", "planar_epsilons",
-           "epsilon_of_points", "epsilon_linearised", "L1_ENUMERATION_MAX", "LINF_ENUMERATION_MAX",
+           "epsilon_of_points", "check_norm", "L1_ENUMERATION_MAX", "LINF_ENUMERATION_MAX",
            "SUMS_MAX", "MAX_VERTICES", "SOCP_COST"]
 
 NORMS = ("L1", "Linf")
@@ -148,7 +148,7 @@ class Epsilon:
     limited : bool
         The time limit stopped the computation (the bounds are those reached).
     evidence : Evidence or None
-        What proves ``lo`` and ``hi`` (:mod:`qualgrasp.certify.evidence`); None when not in
+        What proves ``lo`` and ``hi`` (:mod:`qualgrasp.certify.quality.evidence`); None when not in
         closure.
     """
 
@@ -169,7 +169,21 @@ class Epsilon:
         return (self.hi - self.lo) / self.hi if self.hi > 0 else 0.0
 
 
-def _check_norm(norm: str) -> None:
+def check_norm(norm: str) -> None:
+    """Refuse a norm other than those of :data:`NORMS` (``"L1"``, ``"Linf"``).
+
+    Raises
+    ------
+    ValueError
+        Naming the norm given.
+
+    Examples
+    --------
+    >>> check_norm("L2")
+    Traceback (most recent call last):
+    ...
+    ValueError: unknown norm 'L2'; use 'L1' or 'Linf'
+    """
     if norm not in NORMS:
         raise ValueError(f"unknown norm {norm!r}; use 'L1' or 'Linf'")
 
@@ -199,7 +213,7 @@ class _NoExact(Exception):
 
 def _prove(V: np.ndarray, EV: np.ndarray, faces, exact_vertex):
     """Bounds ``(lo, hi)`` of the smallest squared face distance of a surface proving a ball
-    (:func:`qualgrasp.certify.evidence.surface_minimum`, the checker's own rule), or None when
+    (:func:`qualgrasp.certify.quality.evidence.surface_minimum`, the checker's own rule), or None when
     it proves nothing."""
     if faces is None or len(faces) == 0:
         return None
@@ -441,7 +455,7 @@ def _sweep(W, owner, m, deadline):
 def planar_epsilon(grasp: Grasp, norm: str) -> tuple[float, np.ndarray]:
     """Exact planar epsilon and its direction, for a grasp in force closure (the value
     :func:`epsilon` reports as ``hi``)."""
-    _check_norm(norm)
+    check_norm(norm)
     W, E, owner = planar_generator_arrays(grasp)
     lo, hi, u, ev, limited = planar_epsilons(W, E, owner, len(grasp.contacts),
                                              exact=lambda: grasp_system(grasp, exact=True).columns)[norm]
@@ -486,13 +500,13 @@ def epsilon(grasp: Grasp, norm: str = "L1", *, rel_gap: float = 0.01, budget: in
     Two antipodal point contacts on the unit circle with ``mu = 0.5`` (exact in the plane):
 
     >>> from qualgrasp.certify import Contact, Grasp
-    >>> from qualgrasp.certify.quality import epsilon
+    >>> from qualgrasp.certify.quality.bounds import epsilon
     >>> g = Grasp((Contact((1, 0), (-1, 0), "point", 0.5), Contact((-1, 0), (1, 0), "point", 0.5)))
     >>> e = epsilon(g, "L1")
     >>> round(e.lo, 6), e.exact, e.center, e.length, e.evidence.kind
     (0.333333, True, (0.0, 0.0), 1.0, 'generators')
     """
-    _check_norm(norm)
+    check_norm(norm)
     norms = ("L1",) if norm == "L1" else ("L1", "Linf")
     return epsilons(grasp, norms, rel_gap=rel_gap, budget=budget, time_limit=time_limit,
                     verdict=verdict)[norm]
@@ -511,7 +525,7 @@ def epsilons(grasp: Grasp, norms=NORMS, *, rel_gap: float = 0.01, budget: int = 
         ``{norm: Epsilon}``.
     """
     for norm in norms:
-        _check_norm(norm)
+        check_norm(norm)
     verdict = verdict or force_closure(grasp)
     if verdict.status != "closure":
         return {norm: _zero(grasp, norm) for norm in norms}
@@ -732,41 +746,3 @@ def epsilon_of_points(points) -> float:
     except (QhullError, ValueError):
         return 0.0
     return max(0.0, float((-eq[:, -1]).min()))
-
-
-def epsilon_linearised(grasp: Grasp, norm: str = "L1", edges: int = 8) -> float:
-    """Epsilon with every spatial friction cone replaced by ``edges`` inscribed edges (the
-    linearisation other toolkits use, e.g. Dex-Net's 8 edges), exact for that polytope.
-
-    Point contacts only (no torsion); frictionless contacts keep their normal. The result is a
-    lower bound of the exact-cone epsilon. For ``Linf`` the Minkowski sum is enumerated, so keep
-    ``(edges + 1) ** contacts`` small.
-    """
-    _check_norm(norm)
-    system = grasp_system(grasp, socp=True)
-    theta = 2 * np.pi * np.arange(edges) / edges
-    per_contact = []
-    for b in system.blocks:
-        cols = system.columns[:, list(b.cols)]
-        if b.cone == "ray":
-            per_contact.append(cols.T)
-            continue
-        if len(b.cols) > len(b.n):
-            raise ValueError("epsilon_linearised handles point and frictionless contacts only")
-        n = np.asarray(b.n, dtype=float) / np.linalg.norm(b.n)
-        if len(n) == 2:
-            t = np.array([[-n[1], n[0]], [n[1], -n[0]]])
-        else:
-            axis = np.eye(3)[np.argmin(np.abs(n))]
-            t1 = np.cross(n, axis)
-            t1 /= np.linalg.norm(t1)
-            t2 = np.cross(n, t1)
-            t = np.cos(theta)[:, None] * t1 + np.sin(theta)[:, None] * t2
-        per_contact.append((n + float(b.mu) * t) @ cols.T)
-    if norm == "L1":
-        return epsilon_of_points(np.vstack([np.zeros(system.columns.shape[0])] + per_contact))
-    sums = np.zeros((1, system.columns.shape[0]))
-    for g in per_contact:
-        with_zero = np.vstack([np.zeros(g.shape[1]), g])
-        sums = (sums[:, None, :] + with_zero[None, :, :]).reshape(-1, g.shape[1])
-    return epsilon_of_points(sums)

@@ -1,4 +1,5 @@
-"""Checks every command makes before it works: output paths and numeric options.
+"""Checks every command makes before it works (output paths and numeric options), and how a
+command refuses: one line, exit code 2.
 
 Commands are thin layers over public functions; these checks run first, so that a bad path or
 number is refused at once with a one-line message in the command line's own terms (the flag and
@@ -18,6 +19,10 @@ Rules
 * An input file is a regular file (a FIFO or ``/dev/zero`` is refused, never read), within its
   size limit.
 * Numbers are finite and inside their documented range.
+
+Every half's command line (:mod:`qualgrasp.certify.cli`, :mod:`qualgrasp.certify.meshes.cli`,
+:mod:`qualgrasp.qualitative.cli`, :mod:`qualgrasp.experiments.cli`) uses these checks; a command
+that refuses prints :func:`fail`'s one line.
 """
 
 from __future__ import annotations
@@ -26,13 +31,17 @@ import math
 import os
 import stat
 from pathlib import Path
-from typing import Iterable
+from typing import Iterable, NoReturn
 
-from .errors import OptionError
-from .files.outputs import check_name_length, check_output, file_kind, inside, same_file, writable_folder
+import typer
+from rich.console import Console
+from rich.markup import escape
+
+from ..errors import OptionError
+from ..files.outputs import check_name_length, check_output, file_kind, inside, same_file, writable_folder
 
 __all__ = ["OptionError", "FIGURE_SUFFIXES", "output_file", "output_folder", "input_file", "number_in",
-           "count_in", "optional_number_in"]
+           "count_in", "optional_number_in", "printable", "fail"]
 
 #: Suffixes a figure may be saved with (matplotlib's writers).
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".tif", ".tiff", ".eps", ".ps", ".webp")
@@ -65,7 +74,7 @@ def output_file(path: str | Path, flag: str, *, suffixes: Iterable[str] | None =
 
     Examples
     --------
-    >>> from qualgrasp.certify.checks import output_file
+    >>> from qualgrasp.certify.cli.options import output_file
     >>> output_file("figure", "--plot", suffixes=(".png", ".pdf"))
     Traceback (most recent call last):
     ...
@@ -99,7 +108,7 @@ def output_folder(path: str | Path, flag: str, *, reads: Iterable[str | Path] = 
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> from qualgrasp.certify.checks import output_folder
+    >>> from qualgrasp.certify.cli.options import output_folder
     >>> out = output_folder(pathlib.Path(tempfile.mkdtemp()) / "figures", "--out")
     >>> out.is_dir()
     True
@@ -127,7 +136,7 @@ def input_file(path: str | Path, flag: str, *, max_bytes: int | None = None) -> 
 
     Examples
     --------
-    >>> from qualgrasp.certify.checks import input_file
+    >>> from qualgrasp.certify.cli.options import input_file
     >>> input_file("/dev/zero", "TRACE")
     Traceback (most recent call last):
     ...
@@ -160,7 +169,7 @@ def number_in(value: float, flag: str, low: float, high: float, *, unit: str = "
 
     Examples
     --------
-    >>> from qualgrasp.certify.checks import number_in
+    >>> from qualgrasp.certify.cli.options import number_in
     >>> number_in(0.5, "--mu", 0, 1e6, low_open=True)
     0.5
     """
@@ -195,7 +204,7 @@ def optional_number_in(value: float | None, flag: str, low: float, high: float, 
 
     Examples
     --------
-    >>> from qualgrasp.certify.checks import optional_number_in
+    >>> from qualgrasp.certify.cli.options import optional_number_in
     >>> optional_number_in(None, "--tol", 0, 1, low_open=True) is None
     True
     >>> optional_number_in(0.0, "--tol", 0, 1, low_open=True, unit="pixels")
@@ -206,3 +215,28 @@ def optional_number_in(value: float | None, flag: str, low: float, high: float, 
     if value is None:
         return None
     return number_in(value, flag, low, high, unit=unit, low_open=low_open, high_open=high_open)
+
+
+def printable(text: str) -> str:
+    """``text`` with lone surrogates (from invalid UTF-8 or JSON escapes) escaped, on one line.
+
+    Examples
+    --------
+    >>> printable("two\\nlines \\udcff")
+    'two\\\\nlines \\\\udcff'
+    """
+    return text.encode("utf-8", "backslashreplace").decode("utf-8").replace("\n", "\\n")
+
+
+def fail(message: str, console: Console | None = None) -> NoReturn:
+    """Print a one-line error (``error: message``, no markup interpreted in it, made
+    :func:`printable`) on ``console`` (default: standard error) and exit with code 2.
+
+    Raises
+    ------
+    typer.Exit
+        With code 2.
+    """
+    console = Console(stderr=True) if console is None else console
+    console.print("[red]error:[/red]", escape(printable(message)), soft_wrap=True)
+    raise typer.Exit(2)

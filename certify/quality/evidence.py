@@ -1,13 +1,13 @@
 """Evidence for the Ferrari-Canny epsilon bounds of a results row, and its re-check without a
 solver.
 
-Every epsilon bound a results row states (:mod:`qualgrasp.certify.quality`) carries evidence that
+Every epsilon bound a results row states (:mod:`qualgrasp.certify.quality.bounds`) carries evidence that
 :func:`verify_epsilon` re-checks in exact rational arithmetic on the float data (or with rigorous
 floating-point error bounds, :mod:`qualgrasp.certify._kernels.surface`):
 
 Upper bound ``hi``
     A direction ``u`` (``direction``): ``epsilon <= h(u) / |u|`` for the support function ``h``
-    of the grasp wrench space (GWS, :mod:`qualgrasp.certify.quality`). In the plane ``h(u)`` is
+    of the grasp wrench space (GWS, :mod:`qualgrasp.certify.quality.bounds`). In the plane ``h(u)`` is
     rational (a maximum or a sum of maxima of dot products with the generators), so ``h(u)^2``
     and ``hi^2 |u|^2`` are compared exactly; in space every contact's term
     ``(a . n + mu sqrt(q)) / |n|`` is bounded by integer square roots to 60 bits.
@@ -71,13 +71,13 @@ from typing import Any, Sequence
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
-from .core import cones
-from ._kernels.planar import planar_generators
-from ._kernels.surface import cycle_code, face_bounds, leibniz_tables, planar_h_bounds
-from .core.certificates import Check
-from .core.grasp import Grasp
-from .core.problem import grasp_system
-from .core.wrench import force_column_errors, generator_layout, grasp_arrays, to_exact, variants_of
+from ..core import cones
+from .._kernels.planar import planar_generators
+from .._kernels.surface import cycle_code, face_bounds, leibniz_tables, planar_h_bounds
+from ..core.certificates import Check
+from ..core.grasp import Grasp
+from ..core.problem import grasp_system
+from ..core.wrench import force_column_errors, generator_layout, grasp_arrays, to_exact, variants_of
 
 __all__ = ["EPS_TOL", "SHRINK", "KINDS", "Evidence", "ConicSupport", "surface_faces",
            "exact_face", "surface_minimum", "stated_lo", "planar_generator_arrays",

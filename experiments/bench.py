@@ -32,18 +32,19 @@ from rich.console import Console
 from rich.progress import Progress
 from rich.table import Table
 
-from .core.certificates import verify
-from .chunk import Options
-from .core.closure import force_closure, form_closure
-from .fastpath import certify_table
-from .core.grasp import grasp_to_dict
-from .quality import epsilon, epsilon_linearised, epsilons
-from .report import certify_grasp
-from .samples import random_grasps
-from .solvers import make_solver
-from .files.reader import grasps_table
+from ..certify.core import verify
+from ..certify.chunk import Options
+from ..certify.core import force_closure, form_closure
+from ..certify.fastpath import certify_table
+from ..certify.core import Grasp, grasp_to_dict
+from ..certify.core.problem import grasp_system
+from ..certify.quality.bounds import check_norm, epsilon, epsilon_of_points, epsilons
+from ..certify.report import certify_grasp
+from ..certify.samples import random_grasps
+from ..certify.solvers import make_solver
+from ..certify.files import grasps_table
 
-__all__ = ["KINDS", "BenchRow", "run_bench", "print_bench", "CONTACTS", "ContactsRow",
+__all__ = ["KINDS", "BenchRow", "run_bench", "print_bench", "CONTACTS", "ContactsRow", "epsilon_linearised",
            "run_contacts_bench", "print_contacts_bench"]
 
 #: name -> keyword arguments of :func:`qualgrasp.certify.samples.random_grasp`
@@ -307,3 +308,41 @@ def print_contacts_bench(rows: list[ContactsRow]) -> None:
                       f"{r.quality_s:.3f}", f"{100 * r.gap_l1:.2f} %", f"{100 * r.gap_linf:.2f} %",
                       "yes" if r.limited else "no")
     Console(width=max(120, Console().width)).print(table)
+
+
+def epsilon_linearised(grasp: Grasp, norm: str = "L1", edges: int = 8) -> float:
+    """Epsilon with every spatial friction cone replaced by ``edges`` inscribed edges (the
+    linearisation other toolkits use, e.g. Dex-Net's 8 edges), exact for that polytope.
+
+    Point contacts only (no torsion); frictionless contacts keep their normal. The result is a
+    lower bound of the exact-cone epsilon. For ``Linf`` the Minkowski sum is enumerated, so keep
+    ``(edges + 1) ** contacts`` small.
+    """
+    check_norm(norm)
+    system = grasp_system(grasp, socp=True)
+    theta = 2 * np.pi * np.arange(edges) / edges
+    per_contact = []
+    for b in system.blocks:
+        cols = system.columns[:, list(b.cols)]
+        if b.cone == "ray":
+            per_contact.append(cols.T)
+            continue
+        if len(b.cols) > len(b.n):
+            raise ValueError("epsilon_linearised handles point and frictionless contacts only")
+        n = np.asarray(b.n, dtype=float) / np.linalg.norm(b.n)
+        if len(n) == 2:
+            t = np.array([[-n[1], n[0]], [n[1], -n[0]]])
+        else:
+            axis = np.eye(3)[np.argmin(np.abs(n))]
+            t1 = np.cross(n, axis)
+            t1 /= np.linalg.norm(t1)
+            t2 = np.cross(n, t1)
+            t = np.cos(theta)[:, None] * t1 + np.sin(theta)[:, None] * t2
+        per_contact.append((n + float(b.mu) * t) @ cols.T)
+    if norm == "L1":
+        return epsilon_of_points(np.vstack([np.zeros(system.columns.shape[0])] + per_contact))
+    sums = np.zeros((1, system.columns.shape[0]))
+    for g in per_contact:
+        with_zero = np.vstack([np.zeros(g.shape[1]), g])
+        sums = (sums[:, None, :] + with_zero[None, :, :]).reshape(-1, g.shape[1])
+    return epsilon_of_points(sums)

@@ -1,9 +1,10 @@
-"""Command-line layer of :mod:`qualgrasp.certify`: ``qualgrasp certify``, ``verify``,
-``certify-regions``, ``bench`` and ``sample``.
+"""The certify commands: ``qualgrasp certify``, ``verify``, ``certify-regions`` and ``sample``.
 
 Each command is a thin wrapper over a public function (:func:`qualgrasp.certify.batch.certify_file`,
 :func:`qualgrasp.certify.batch.verify_file`, :func:`qualgrasp.certify.regions.certify_region_file`,
-:func:`qualgrasp.certify.regions.verify_region_file`, :func:`qualgrasp.certify.bench.run_bench`).
+:func:`qualgrasp.certify.regions.verify_region_file`,
+:func:`qualgrasp.certify.samples.write_random_grasp_file`); its checks and its one-line refusals are
+:mod:`qualgrasp.certify.cli.options`'.
 """
 
 from __future__ import annotations
@@ -13,19 +14,17 @@ from pathlib import Path
 
 import typer
 from rich.console import Console
-from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
-from . import models
-from .batch import certify_file, verify_file
-from .bench import (print_bench, print_contacts_bench, print_quality_bench, run_bench,
-                    run_contacts_bench, run_quality_bench)
-from .errors import CertifyError
-from .regions import DEFAULT_BUDGET, certify_region_file, verify_region_file
-from .samples import write_random_grasp_file
-from .files.reader import count_grasps
-from .core.validation import MAX_CONTACTS
+from .. import models
+from ..batch import certify_file, verify_file
+from ..errors import CertifyError
+from ..regions import DEFAULT_BUDGET, certify_region_file, verify_region_file
+from ..samples import write_random_grasp_file
+from ..files.reader import count_grasps
+from ..core.validation import MAX_CONTACTS
+from .options import fail, printable
 
 __all__ = ["register"]
 
@@ -33,12 +32,6 @@ console = Console(stderr=True)
 
 #: The solver routes a run may use (``qualgrasp bench`` times the others).
 METHODS = ("fast", "reference")
-
-
-def _fail(message: str) -> None:
-    """Print a one-line error (no markup interpreted in it) and exit with code 2."""
-    console.print("[red]error:[/red]", escape(_printable(message)), soft_wrap=True)
-    raise typer.Exit(2)
 
 
 def certify_command(
@@ -63,15 +56,15 @@ def certify_command(
     start (unreadable input, bad option, output naming the input or a folder, resume refused).
     """
     if method not in METHODS:
-        _fail(f"--method must be one of {', '.join(METHODS)}, got {method!r}")
+        fail(f"--method must be one of {', '.join(METHODS)}, got {method!r}")
     if not (math.isfinite(eps_gap) and 0 < eps_gap < 1):
-        _fail(f"--eps-gap must be a fraction between 0 and 1 (relative gap hi - lo <= gap * hi), got {eps_gap}")
+        fail(f"--eps-gap must be a fraction between 0 and 1 (relative gap hi - lo <= gap * hi), got {eps_gap}")
     if eps_budget < 1:
-        _fail(f"--eps-budget must be at least 1 direction cell, got {eps_budget}")
+        fail(f"--eps-budget must be at least 1 direction cell, got {eps_budget}")
     if workers < 0:
-        _fail(f"--workers must be 0 (all cores) or a number of processes, got {workers}")
+        fail(f"--workers must be 0 (all cores) or a number of processes, got {workers}")
     if chunk_size < 1:
-        _fail(f"--chunk-size must be at least 1 grasp, got {chunk_size}")
+        fail(f"--chunk-size must be at least 1 grasp, got {chunk_size}")
     total = count_grasps(grasps)
     with Progress(TextColumn("certify"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
                   console=console, disable=quiet) as bar:
@@ -83,7 +76,7 @@ def certify_command(
                                    eps_time=eps_time if eps_time > 0 else None, workers=workers or None,
                                    dask=dask, resume=resume, chunk_size=chunk_size)
         except CertifyError as err:
-            _fail(str(err))
+            fail(str(err))
     if not quiet:
         table = Table(title=f"{summary.rows} grasps -> {output}")
         table.add_column("status")
@@ -115,18 +108,18 @@ def verify_command(
     'qualgrasp certify-regions'). Exit code 1 when a row fails, 2 when the run cannot start.
     """
     if (grasps is None) == (regions is None):
-        _fail("give exactly one of --grasps and --regions")
+        fail("give exactly one of --grasps and --regions")
     if workers < 0:
-        _fail(f"--workers must be 0 (all cores) or a number of processes, got {workers}")
+        fail(f"--workers must be 0 (all cores) or a number of processes, got {workers}")
     try:
         if regions is not None:
             summary = verify_region_file(results, regions)
         else:
             summary = verify_file(results, grasps, workers=workers or None)
     except CertifyError as err:
-        _fail(str(err))
+        fail(str(err))
     for gid, reason in summary.failures:
-        typer.echo(_printable(f"{gid}\t{reason}"))
+        typer.echo(printable(f"{gid}\t{reason}"))
     checked = summary.rows - summary.errors
     missing = getattr(summary, "missing", 0)
     console.print(f"{checked} certified rows re-checked, {summary.errors} error rows skipped, "
@@ -151,7 +144,7 @@ def certify_regions_command(
     code 1 when some rows are errors or failed their own re-check, 2 when the run cannot start.
     """
     if budget < 1:
-        _fail(f"--budget must be at least 1 work unit per tuple, got {budget}")
+        fail(f"--budget must be at least 1 work unit per tuple, got {budget}")
     total = count_grasps(regions)  # for the progress bar only: the reader says what is wrong
     with Progress(TextColumn("regions"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
                   console=console, disable=quiet) as bar:
@@ -159,7 +152,7 @@ def certify_regions_command(
         try:
             summary = certify_region_file(regions, output, budget=budget, progress=lambda n: bar.advance(task, n))
         except CertifyError as err:
-            _fail(str(err))
+            fail(str(err))
     if not quiet:
         table = Table(title=f"{summary.rows} region tuples -> {output}")
         table.add_column("status")
@@ -171,42 +164,6 @@ def certify_regions_command(
         console.print(f"{summary.seconds:.1f} s")
     if summary.errors or summary.unverified:
         raise typer.Exit(1)
-def _printable(text: str) -> str:
-    """``text`` with lone surrogates (from invalid UTF-8 or JSON escapes) escaped, on one line."""
-    return text.encode("utf-8", "backslashreplace").decode("utf-8").replace("\n", "\\n")
-
-
-def bench_command(
-    n: int = typer.Option(20000, "--n", help="Grasps per kind."),
-    seed: int = typer.Option(0, help="Random seed of the grasps."),
-    reference_n: int = typer.Option(300, "--reference-n", help="Grasps per kind for slow routes."),
-    quality: bool = typer.Option(False, "--quality", help="Benchmark epsilon instead: gaps, times, 8-edge error."),
-    contacts: bool = typer.Option(False, "--contacts", help="Time closure and quality of one grasp per contact count "
-                                                            "(3 to 1000 point contacts, planar and spatial)."),
-) -> None:
-    """Time every certification route on the same random grasps, with ratios to the batch path.
-
-    Routes: the batch path, the per-grasp fast route, clarabel, linprog, cvxpy with Parameters
-    and cvxpy rebuilt per grasp; prints grasps per second and each route's ratio.
-
-    With --quality: epsilon bound gaps and time per grasp, and the error of the 8-edge cone
-    linearisation other toolkits use, on --n random grasps in closure per kind.
-
-    With --contacts: seconds per grasp of closure and of quality (both epsilons with their
-    evidence, no time limit) for one grasp in closure with 3, 10, 50, 200 and 1000 point
-    contacts, planar and spatial (about a minute).
-    """
-    if n < 1 or reference_n < 0:
-        _fail(f"--n must be at least 1 and --reference-n at least 0, got {n} and {reference_n}")
-
-    if contacts:
-        print_contacts_bench(run_contacts_bench(seed=seed))
-    elif quality:
-        print_quality_bench(run_quality_bench(n=n, seed=seed))
-    else:
-        print_bench(run_bench(n=n, seed=seed, reference_n=reference_n))
-
-
 def sample_command(
     output: Path = typer.Argument(..., help="Grasp set to write: .parquet or .jsonl."),
     n: int = typer.Option(100_000, "--n", help="Number of grasps."),
@@ -219,20 +176,20 @@ def sample_command(
 
     Contacts are placed around a random blob; about a third of the grasps are in closure."""
     if n < 0:
-        _fail(f"--n must be a number of grasps (>= 0), got {n}")
+        fail(f"--n must be a number of grasps (>= 0), got {n}")
     if dim not in (2, 3):
-        _fail(f"--dim must be 2 (planar) or 3 (spatial), got {dim}")
+        fail(f"--dim must be 2 (planar) or 3 (spatial), got {dim}")
     if not 1 <= contacts <= MAX_CONTACTS:
-        _fail(f"--contacts must be between 1 and {MAX_CONTACTS}, got {contacts}")
+        fail(f"--contacts must be between 1 and {MAX_CONTACTS}, got {contacts}")
     if model not in models.names():
-        _fail(f"--model must be one of {', '.join(models.names())}, got {model!r}")
+        fail(f"--model must be one of {', '.join(models.names())}, got {model!r}")
     if dim not in models.get(model).dims:
-        _fail(f"--model {model} exists in {' and '.join(map(str, models.get(model).dims))} dimensions only, "
+        fail(f"--model {model} exists in {' and '.join(map(str, models.get(model).dims))} dimensions only, "
               f"not with --dim {dim}")
     try:
         count = write_random_grasp_file(output, n, seed=seed, dim=dim, n_contacts=contacts, model=model)
     except CertifyError as err:
-        _fail(str(err))
+        fail(str(err))
     console.print(f"wrote {count} grasps to {output}")
 
 
@@ -241,5 +198,4 @@ def register(app: typer.Typer) -> None:
     app.command("certify")(certify_command)
     app.command("verify")(verify_command)
     app.command("certify-regions")(certify_regions_command)
-    app.command("bench")(bench_command)
     app.command("sample")(sample_command)

@@ -27,10 +27,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import GraspError
-from .core.grasp import Contact, Grasp
-from .quality import epsilon, epsilon_of_points
-from .core.problem import grasp_system
+from ..errors import GraspError
+from ..core.grasp import Contact, Grasp
+from .bounds import epsilon, epsilon_of_points
+from ..core.problem import grasp_system
 
 __all__ = ["Efficiency", "polygon_frame", "edge_samples", "boundary_contacts", "boundary_epsilon",
            "steinitz_bound", "efficiency"]
