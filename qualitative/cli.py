@@ -13,7 +13,7 @@ from ..certify.files import atomic_output
 from ..certify.errors import CertifyError
 from ..certify.files import write_grasps
 from ..certify.models import MAX_MU
-from ..certify.region_boundary import SEARCH_BUDGET
+from ..certify.regions.boundary import SEARCH_BUDGET
 from . import procedures
 from .errors import FormulaError, QualitativeError, TraceError
 from .grasp_plot import synthesis_figure

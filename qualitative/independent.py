@@ -48,8 +48,8 @@ import numpy as np
 from ..certify.errors import CertifyError, GraspError
 from ..certify.core import Grasp, grasp_from_dict
 from ..certify.files import atomic_output, check_output
-from ..certify.region_boundary import SEARCH_BUDGET, IndependentRegions, bisection_tol, independent_regions
-from ..certify.region_data import tuple_to_dict
+from ..certify.regions.boundary import SEARCH_BUDGET, IndependentRegions, bisection_tol, independent_regions
+from ..certify.regions import tuple_to_dict
 from ..certify.files import json_lines
 from ..certify.core.validation import id_problem, number, show
 from .errors import QualitativeError

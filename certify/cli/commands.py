@@ -20,7 +20,7 @@ from rich.table import Table
 from .. import models
 from ..batch import certify_file, verify_file
 from ..errors import CertifyError
-from ..regions import DEFAULT_BUDGET, certify_region_file, verify_region_file
+from ..regions.files import DEFAULT_BUDGET, certify_region_file, verify_region_file
 from ..samples import write_random_grasp_file
 from ..files.reader import count_grasps
 from ..core.validation import MAX_CONTACTS

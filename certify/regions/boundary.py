@@ -5,16 +5,16 @@ The object's boundary is a closed polygon of points ``P_0 .. P_n-1`` with inward
 **straight** when its two normals are equal (within ``1e-9``) and perpendicular to it (within
 ``1e-9`` relative); consecutive straight edges with the same normal form a **straight run** (a
 side of a polygon, however finely sampled). Other edges are curved stretches read as
-:mod:`qualgrasp.certify.region_data` reads curved regions; a zero-length edge across which the
+:mod:`qualgrasp.certify.regions.data` reads curved regions; a zero-length edge across which the
 normal turns is a corner.
 
 :func:`independent_regions` finds, for a grasp whose contacts lie on the boundary, the largest
 ``delta`` such that the regions made of the boundary within arc length ``delta`` on each side of
 every contact -- clipped at the contact's **limits**, an arc-length interval it must not leave
 (default: the straight run the contact lies on, or its own edge on a curved stretch, so that a
-finger never slides over a corner) -- are robust (:func:`qualgrasp.certify.region_certify.certify_regions`).
-A stretch within one straight run is a :class:`~qualgrasp.certify.region_data.StraightRegion`;
-any other is a :class:`~qualgrasp.certify.region_data.CurvedRegion` through the boundary points,
+finger never slides over a corner) -- are robust (:func:`qualgrasp.certify.regions.decide.certify_regions`).
+A stretch within one straight run is a :class:`~qualgrasp.certify.regions.data.StraightRegion`;
+any other is a :class:`~qualgrasp.certify.regions.data.CurvedRegion` through the boundary points,
 widened outward to the boundary points around its ends (never beyond a limit: limits on curved
 stretches are rounded inward to boundary points), so that every point of the stretch is covered.
 
@@ -37,11 +37,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .core.closure import Verdict, force_closure
-from .errors import GraspError
-from .core.grasp import Contact, Grasp
-from .region_certify import RegionVerdict, certify_regions
-from .region_data import CurvedRegion, RegionTuple, StraightRegion
+from ..core.closure import Verdict, force_closure
+from ..errors import GraspError
+from ..core.grasp import Contact, Grasp
+from .decide import RegionVerdict, certify_regions
+from .data import CurvedRegion, RegionTuple, StraightRegion
 
 __all__ = ["Boundary", "IndependentRegions", "independent_regions", "enclosing_diameter", "SEARCH_BUDGET",
            "TOL_FLOOR", "bisection_tol"]

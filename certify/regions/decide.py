@@ -1,6 +1,6 @@
 """Region certificates: is every choice of one contact per region in force closure?
 
-A region tuple (:class:`qualgrasp.certify.region_data.RegionTuple`) is **robust** when every
+A region tuple (:class:`qualgrasp.certify.regions.data.RegionTuple`) is **robust** when every
 choice of one contact per region is in force closure under the declared contact models, **not
 robust** when some choice is not -- witnessed by that choice, a grasp in certify's format, and its
 Farkas certificate (certify's, re-checked exactly) -- and **undecided** when the question could not
@@ -15,10 +15,10 @@ be settled (a budget ran out, or the worst choice lies on the closure boundary).
 ``exact``
     Straight regions, ``normal_tol = 0``: decided exactly, with no budget, by 10 small linear
     programmes whose dual multipliers are re-checked in exact rationals
-    (:mod:`qualgrasp.certify.region_exact`).
+    (:mod:`qualgrasp.certify.regions._exact`).
 ``branch``
     Curved regions or ``normal_tol > 0``: branch and bound over wrench directions and pieces of
-    the regions, conservative, within a budget (:mod:`qualgrasp.certify.region_branch`).
+    the regions, conservative, within a budget (:mod:`qualgrasp.certify.regions._branch`).
 
 :func:`verify_regions` re-checks a verdict without any solver: the certificate of a robust tuple
 (exactly for ``point`` and ``exact``; for ``branch``, every bound recomputed in floating point
@@ -36,14 +36,14 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .core.certificates import Certificate, Check, verify
-from .core.closure import Verdict, force_closure
-from .errors import CertificateError, GraspError
-from .core.grasp import Contact, Grasp, grasp_from_dict, grasp_to_dict
-from .region_branch import DEFAULT_BUDGET, cells_certificate, check_cells, decide_branch
-from .region_data import RegionTuple, StraightRegion
-from .region_exact import (check_faces, check_faces_float, faces_certificate, generator_rows, on_segment,
-                           solve_faces, straight_witness)
+from ..core.certificates import Certificate, Check, verify
+from ..core.closure import Verdict, force_closure
+from ..errors import CertificateError, GraspError
+from ..core.grasp import Contact, Grasp, grasp_from_dict, grasp_to_dict
+from ._branch import DEFAULT_BUDGET, cells_certificate, check_cells, decide_branch
+from .data import RegionTuple, StraightRegion
+from ._exact import (check_faces, check_faces_float, faces_certificate, generator_rows, on_segment,
+                     solve_faces, straight_witness)
 
 __all__ = ["STATUSES", "RegionVerdict", "certify_regions", "verify_regions", "in_region", "DEFAULT_BUDGET",
            "DEFAULT_TOL"]

@@ -8,7 +8,7 @@ single point, is one arc). A stretch is over-approximated by what a finger there
 * its point lies in a rectangle on the chord ``[P_j0, P_j1]``: ``P_j0 + s (P_j1 - P_j0) + h' E``
   with ``0 <= s <= 1`` and ``|h'| <= h`` (``E`` the chord's unit normal). On every arc the
   curve's normal stays within the angles of its end normals and its chord's normal
-  (:mod:`qualgrasp.certify.region_data`'s reading), so over the stretch the tangent stays within
+  (:mod:`qualgrasp.certify.regions.data`'s reading), so over the stretch the tangent stays within
   ``[a_lo, a_hi]`` of the chord (``a_lo <= 0 <= a_hi``, the extreme angles of those normals and
   of the stretch's chord normal, widened by ``normal_tol``): the curve moves forward along the
   chord and stays within ``h = c tan(a_hi) tan(-a_lo) / (tan(a_hi) + tan(-a_lo))`` of it (the
@@ -64,13 +64,13 @@ from typing import Any
 
 import numpy as np
 
-from . import models as registry
-from ._kernels.regions import piece_bounds
-from .core.certificates import Check, verify
-from .core.closure import force_closure
-from .core.grasp import Contact, Grasp
-from .region_data import RegionTuple, StraightRegion
-from .region_exact import region_variant
+from .. import models as registry
+from .._kernels.regions import piece_bounds
+from ..core.certificates import Check, verify
+from ..core.closure import force_closure
+from ..core.grasp import Contact, Grasp
+from .data import RegionTuple, StraightRegion
+from ._exact import region_variant
 
 __all__ = ["FACES", "Geometry", "MAX_MERGED", "candidate_weights", "cells_certificate", "bounds", "decide_branch", "check_cells",
            "exact_candidates", "turned", "BranchResult", "DEFAULT_BUDGET", "MIN_CELL", "MIN_PIECE"]

@@ -53,12 +53,12 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import linprog
 
-from . import models as registry
-from .core.certificates import Check, verify
-from .core.closure import force_closure
-from .errors import SolverError
-from .core.grasp import Grasp
-from .region_data import RegionTuple
+from .. import models as registry
+from ..core.certificates import Check, verify
+from ..core.closure import force_closure
+from ..errors import SolverError
+from ..core.grasp import Grasp
+from .data import RegionTuple
 
 __all__ = ["FACES", "FaceSolution", "Dyadic", "generator_rows", "scaled_rows", "face_box", "solve_faces", "check_faces",
            "check_faces_float", "faces_certificate", "point_on_segment", "on_segment", "straight_witness",

@@ -23,7 +23,7 @@ must be narrower than 90 degrees (sample the curve densely enough). Then the tan
 within the same angles of the chord, so the curve lies in the parallelogram spanned from
 ``P_j`` and ``P_j+1`` by its extreme tangent directions; its height above and below the chord
 is ``c tan(a_hi) tan(-a_lo) / (tan(a_hi) + tan(-a_lo))`` (``c`` the chord length, ``a_lo <= 0
-<= a_hi`` the extreme tangent angles to the chord). :mod:`qualgrasp.certify.region_branch` works
+<= a_hi`` the extreme tangent angles to the chord). :mod:`qualgrasp.certify.regions._branch` works
 with that set. A curved region of one point is a point contact (with ``normal_tol``, its normal
 varies).
 
@@ -49,11 +49,11 @@ from typing import Any, Mapping, Sequence, Union
 
 import numpy as np
 
-from . import models as registry
-from .errors import GraspError
-from .core.grasp import Contact
-from .models import MAX_LENGTH, MIN_LENGTH
-from .core.validation import check_contacts, contact_data, number, numbers, show
+from .. import models as registry
+from ..errors import GraspError
+from ..core.grasp import Contact
+from ..models import MAX_LENGTH, MIN_LENGTH
+from ..core.validation import check_contacts, contact_data, number, numbers, show
 
 __all__ = ["MAX_NORMAL_TOL", "MAX_TURN", "MAX_REGIONS", "MAX_POINTS", "StraightRegion", "CurvedRegion",
            "Region", "RegionTuple", "region_from_dict", "region_to_dict", "tuple_from_dict",
