@@ -18,7 +18,7 @@ from .core.closure import Verdict, force_closure, form_closure, positive_span
 from .errors import CertificateError, CertifyError, GraspError, GraspFileError, SolverError
 from .core.grasp import Contact, Grasp, grasp_from_dict, grasp_to_dict
 from .report import Report, certify_grasp
-from .chunk import Options, certify_arrow
+from .batch.chunk import Options, certify_arrow
 
 __all__ = [
     "Contact", "Grasp", "grasp_from_dict", "grasp_to_dict",

@@ -3,7 +3,7 @@
 For each kind of grasp every route answers force closure, with its certificate, on the same
 grasps (a prefix of them for the slow routes):
 
-* **qualgrasp batch**: :func:`qualgrasp.certify.fastpath.certify_table` on an Arrow table of the grasps,
+* **qualgrasp batch**: :func:`qualgrasp.certify.batch.fastpath.certify_table` on an Arrow table of the grasps,
   the path ``qualgrasp certify`` takes on Parquet input, per worker process. It does more than the
   others: force *and* form closure, both certificates and their rigorous re-check (epsilon off).
 * **per-grasp fast route**: :func:`qualgrasp.certify.core.closure.force_closure` with the fast solver.
@@ -33,21 +33,21 @@ from rich.progress import Progress
 from rich.table import Table
 
 from ..certify.core import verify
-from ..certify.chunk import Options
+from ..certify.batch import Options
 from ..certify.core import force_closure, form_closure
-from ..certify.fastpath import certify_table
+from ..certify.batch import certify_table
 from ..certify.core import Grasp, grasp_to_dict
 from ..certify.core.problem import grasp_system
 from ..certify.quality.bounds import check_norm, epsilon, epsilon_of_points, epsilons
 from ..certify.report import certify_grasp
-from ..certify.samples import random_grasps
+from ..certify.batch import random_grasps
 from ..certify.solvers import make_solver
 from ..certify.files import grasps_table
 
 __all__ = ["KINDS", "BenchRow", "run_bench", "print_bench", "CONTACTS", "ContactsRow", "epsilon_linearised",
            "run_contacts_bench", "print_contacts_bench"]
 
-#: name -> keyword arguments of :func:`qualgrasp.certify.samples.random_grasp`
+#: name -> keyword arguments of :func:`qualgrasp.certify.batch.samples.random_grasp`
 #: (sizes chosen so that both verdicts are frequent: 17 % to 40 % of the grasps are in closure)
 KINDS = {
     "planar frictionless, 5 contacts": dict(dim=2, n_contacts=5, model="frictionless"),
@@ -274,7 +274,7 @@ class ContactsRow:
 
 def run_contacts_bench(contacts=CONTACTS, seed: int = 0, time_limit: float | None = None) -> list[ContactsRow]:
     """Time one grasp in closure per size and dimension (random point contacts, ``mu`` in
-    [0.2, 1], the first of :func:`~qualgrasp.certify.samples.random_grasps` in closure), after a
+    [0.2, 1], the first of :func:`~qualgrasp.certify.batch.samples.random_grasps` in closure), after a
     warm-up that compiles the kernels."""
     rows = []
     for dim in (2, 3):

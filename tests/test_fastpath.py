@@ -5,11 +5,11 @@ import pytest
 
 from qualgrasp.certify import Contact, Grasp
 from qualgrasp.certify.batch import verify_file
-from qualgrasp.certify.chunk import Options, certify_values
+from qualgrasp.certify.batch.chunk import Options, certify_values
 from qualgrasp.certify.files import table_values
-from qualgrasp.certify.fastpath import certify_table
+from qualgrasp.certify.batch import certify_table
 from qualgrasp.certify.core import grasp_to_dict
-from qualgrasp.certify.samples import random_grasp_table, random_grasps, textbook_grasps
+from qualgrasp.certify.batch import random_grasp_table, random_grasps, textbook_grasps
 from qualgrasp.certify.files import grasps_table, rows_to_table, table_to_rows
 
 

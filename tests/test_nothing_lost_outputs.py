@@ -23,7 +23,7 @@ from typer.testing import CliRunner
 
 from qualgrasp.certify.cli.options import OptionError, output_file, output_folder
 from qualgrasp.certify.files import write_grasps
-from qualgrasp.certify.samples import random_grasps, textbook_grasps
+from qualgrasp.certify.batch import random_grasps, textbook_grasps
 from qualgrasp.cli import app
 
 runner = CliRunner()
@@ -307,7 +307,7 @@ def test_write_grasps_refuses_a_fifo_and_an_input(folder):
     code = textwrap.dedent(f"""
         from qualgrasp.certify.errors import OptionError
         from qualgrasp.certify.files.writers import write_grasps
-        from qualgrasp.certify.samples import textbook_grasps
+        from qualgrasp.certify.batch.samples import textbook_grasps
         try:
             write_grasps({str(fifo)!r}, textbook_grasps())
         except OptionError as err:

@@ -18,7 +18,7 @@ import pytest
 from typer.testing import CliRunner
 
 from qualgrasp.certify.files import write_grasps
-from qualgrasp.certify.samples import random_grasps
+from qualgrasp.certify.batch import random_grasps
 from qualgrasp.cli import app
 
 runner = CliRunner()

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from qualgrasp.certify import Contact, Grasp, certify_grasp
-from qualgrasp.certify.fastpath import planar_screen
+from qualgrasp.certify.batch import planar_screen
 
 
 def _random_batch(rng, m, count):

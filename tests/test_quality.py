@@ -13,7 +13,7 @@ from scipy.spatial import ConvexHull
 from qualgrasp.certify import Contact, Grasp, force_closure
 from qualgrasp.certify.quality import epsilon
 from qualgrasp.experiments.bench import epsilon_linearised
-from qualgrasp.certify.samples import random_grasp, random_grasps
+from qualgrasp.certify.batch import random_grasp, random_grasps
 from qualgrasp.certify.quality import efficiency, steinitz_bound
 from helpers import rotation
 
@@ -348,7 +348,7 @@ def test_default_time_limit_is_never_hit_on_small_grasps():
     """The default limit (10 s per grasp, Options.eps_time) leaves the benchmark's and the
     study's grasps (2 to 10 contacts) untouched."""
     from qualgrasp.experiments.bench import QUALITY_KINDS
-    from qualgrasp.certify.chunk import Options
+    from qualgrasp.certify.batch import Options
 
     for kwargs in QUALITY_KINDS.values():
         for g in _closure(random_grasps(16, 20, **kwargs))[:2]:

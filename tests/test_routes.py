@@ -3,7 +3,7 @@
 import pytest
 
 from qualgrasp.experiments.bench import KINDS, compare_routes
-from qualgrasp.certify.samples import random_grasps
+from qualgrasp.certify.batch import random_grasps
 
 N = 10_000
 

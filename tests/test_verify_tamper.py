@@ -26,7 +26,7 @@ from qualgrasp.certify import Contact, Grasp
 from qualgrasp.certify.batch import certify_file, verify_file
 from qualgrasp.certify.files import write_grasps
 from qualgrasp.certify.files import NAMES, RESULT_SCHEMA
-from qualgrasp.certify.samples import random_grasps
+from qualgrasp.certify.batch import random_grasps
 from qualgrasp.certify.files import rows_to_table, table_to_rows
 from qualgrasp.cli import app
 

@@ -1,6 +1,6 @@
 """Planar grasps in one compiled pass per grasp (numba): generator wrenches with error bounds,
 the closure LP in closed form, certificates re-checked in floating point, and the exact planar
-epsilon (:func:`planar_batch`, the columnar path of :mod:`qualgrasp.certify.fastpath`)."""
+epsilon (:func:`planar_batch`, the columnar path of :mod:`qualgrasp.certify.batch.fastpath`)."""
 
 from __future__ import annotations
 

@@ -3,7 +3,7 @@
 Each command is a thin wrapper over a public function (:func:`qualgrasp.certify.batch.certify_file`,
 :func:`qualgrasp.certify.batch.verify_file`, :func:`qualgrasp.certify.regions.certify_region_file`,
 :func:`qualgrasp.certify.regions.verify_region_file`,
-:func:`qualgrasp.certify.samples.write_random_grasp_file`); its checks and its one-line refusals are
+:func:`qualgrasp.certify.batch.samples.write_random_grasp_file`); its checks and its one-line refusals are
 :mod:`qualgrasp.certify.cli.options`'.
 """
 
@@ -18,10 +18,10 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from .. import models
-from ..batch import certify_file, verify_file
+from ..batch.jobs import certify_file, verify_file
 from ..errors import CertifyError
 from ..regions.files import DEFAULT_BUDGET, certify_region_file, verify_region_file
-from ..samples import write_random_grasp_file
+from ..batch.samples import write_random_grasp_file
 from ..files.reader import count_grasps
 from ..core.validation import MAX_CONTACTS
 from .options import fail, printable

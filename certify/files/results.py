@@ -4,7 +4,7 @@ A results file has one row per input grasp, in input order. :data:`COLUMNS` stat
 once (name, Arrow type, meaning, value in an error row); the Arrow schema of Parquet results
 (:data:`RESULT_SCHEMA`), the per-grasp row (:func:`result_row`, used by
 :meth:`qualgrasp.certify.Report.row`), the error row (:func:`error_row`) and the columnar builder
-(:func:`result_table`, used by :mod:`qualgrasp.certify.fastpath`) are all derived from it, so they
+(:func:`result_table`, used by :mod:`qualgrasp.certify.batch.fastpath`) are all derived from it, so they
 cannot drift apart.
 
 An input's extra top-level fields (columns of a Parquet or Arrow grasp table other than ``id``,

@@ -23,17 +23,17 @@ import json
 import numpy as np
 import pyarrow as pa
 
-from . import models as registry
-from ._kernels.planar import planar_generators
-from ._kernels.recheck import null_rows, verify_farkas_general, verify_interior_general
-from .core.certificates import Tolerances, margin_of, margin_tolerance
-from .files.columns import GraspColumns
-from .core.cones import CONES, cone_code
-from .quality.evidence import EPS_COLUMNS, Evidence, verify_bounds
-from .core.problem import Block
-from .report import GEOMETRY_TOL
-from .files.results import RESULT_SCHEMA
-from .core.wrench import force_column_errors, force_columns, generator_columns, generator_layout
+from .. import models as registry
+from .._kernels.planar import planar_generators
+from .._kernels.recheck import null_rows, verify_farkas_general, verify_interior_general
+from ..core.certificates import Tolerances, margin_of, margin_tolerance
+from ..files.columns import GraspColumns
+from ..core.cones import CONES, cone_code
+from ..quality.evidence import EPS_COLUMNS, Evidence, verify_bounds
+from ..core.problem import Block
+from ..report import GEOMETRY_TOL
+from ..files.results import RESULT_SCHEMA
+from ..core.wrench import force_column_errors, force_columns, generator_columns, generator_layout
 
 __all__ = ["recheck_table", "generator_errors", "schema_matches"]
 

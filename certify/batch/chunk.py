@@ -3,14 +3,14 @@
 A chunk (:class:`qualgrasp.certify.files.reader.Chunk`) holds JSON Lines text or an Arrow table. Either
 is read into checked columns (:mod:`qualgrasp.certify.files.columns`: one validation, the same rules and
 messages for both). An Arrow chunk goes through the columnar path
-(:func:`qualgrasp.certify.fastpath.certify_table`); every row it does not settle, like every row
+(:func:`qualgrasp.certify.batch.fastpath.certify_table`); every row it does not settle, like every row
 of a JSON chunk, goes through the per-grasp path (:func:`certify_rows`). A bad row becomes an
 ``error`` row naming its line, the field and the problem: a chunk always gives exactly one
 results row per input row, in order. A grasp's extra top-level fields are carried through
 (:func:`qualgrasp.certify.files.results.carried_name`).
 
 Re-checking (:func:`verify_chunk`) mirrors it: Arrow chunks with the results schema are proved
-in bulk by the rigorous floating-point kernels (:func:`qualgrasp.certify.recheck.recheck_table`),
+in bulk by the rigorous floating-point kernels (:func:`qualgrasp.certify.batch._recheck.recheck_table`),
 every other row (and every row the bulk proof leaves open) by
 :func:`qualgrasp.certify.report.verify_row` with exact rational arithmetic, which checks every
 column the row states. A malformed row is a failure with a message naming the column, never an
@@ -27,15 +27,15 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
-from .core.certificates import Tolerances
-from .files.columns import GraspColumns, extra_columns, grasp_columns, value_columns
-from .errors import CertifyError, GraspFileError
+from ..core.certificates import Tolerances
+from ..files.columns import GraspColumns, extra_columns, grasp_columns, value_columns
+from ..errors import CertifyError, GraspFileError
 from .fastpath import certify_table
-from .recheck import recheck_table, schema_matches
-from .report import certify_grasp, verify_row
-from .files.results import NAMES, carried_clash, carried_name, error_row
-from .solvers import make_solver
-from .files.reader import Chunk, chunk_values, column_problem, table_to_rows
+from ._recheck import recheck_table, schema_matches
+from ..report import certify_grasp, verify_row
+from ..files.results import NAMES, carried_clash, carried_name, error_row
+from ..solvers import make_solver
+from ..files.reader import Chunk, chunk_values, column_problem, table_to_rows
 
 __all__ = ["Options", "Quality", "certify_rows", "certify_values", "certify_chunk_results", "certify_arrow",
            "verify_rows", "verify_chunk", "status_counts", "STATUSES"]
@@ -155,7 +155,7 @@ def certify_arrow(data: Any, options: Options = Options(), tol: Tolerances = Tol
     Examples
     --------
     >>> import pyarrow as pa
-    >>> from qualgrasp.certify.chunk import Options, certify_arrow
+    >>> from qualgrasp.certify.batch.chunk import Options, certify_arrow
     >>> t = pa.table({"id": ["g1"], "contacts": [[
     ...     {"p": [1.0, 0.0], "n": [-1.0, 0.0], "mu": 0.5}, {"p": [-1.0, 0.0], "n": [1.0, 0.0], "mu": 0.5}]],
     ...     "note": ["mine"]})

@@ -42,11 +42,11 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from .chunk import Options, certify_chunk_results, status_counts
-from .errors import CertifyError, GraspFileError
-from .files.outputs import check_output, lock_output, write_error
-from .files.results import RESULT_SCHEMA, RESULT_WRITE_OPTIONS, carried_clash
-from .files.reader import Chunk, input_format, is_parquet, iter_chunks, rows_to_table, table_to_rows
-from .core.validation import TOP_LEVEL
+from ..errors import CertifyError, GraspFileError
+from ..files.outputs import check_output, lock_output, write_error
+from ..files.results import RESULT_SCHEMA, RESULT_WRITE_OPTIONS, carried_clash
+from ..files.reader import Chunk, input_format, is_parquet, iter_chunks, rows_to_table, table_to_rows
+from ..core.validation import TOP_LEVEL
 
 __all__ = ["RunSummary", "run", "check_paths", "certify_chunk", "parts_folder", "MADE_BY"]
 

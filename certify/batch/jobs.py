@@ -1,7 +1,7 @@
 """Certify and re-verify whole grasp-set files (JSON Lines or Parquet, chosen by extension).
 
-:func:`certify_file` streams the input in chunks through :mod:`qualgrasp.certify.engine` (parallel,
-resumable; :mod:`qualgrasp.certify.chunk` is what happens to one chunk); :func:`verify_file`
+:func:`certify_file` streams the input in chunks through :mod:`qualgrasp.certify.batch.engine` (parallel,
+resumable; :mod:`qualgrasp.certify.batch.chunk` is what happens to one chunk); :func:`verify_file`
 re-checks a results file (all of its rows or any subset, in any order: rows are paired with their
 grasps by line) against its grasps, in parallel, without any solver.
 """
@@ -19,12 +19,12 @@ from typing import Any, Callable, Iterator, Sequence
 import numpy as np
 import pyarrow as pa
 
-from .core.certificates import Tolerances
+from ..core.certificates import Tolerances
 from .chunk import STATUSES, Options, Quality, verify_chunk
 from .engine import RunSummary, run
-from .errors import CertifyError
-from .files.reader import Chunk, chunk_values, count_grasps, input_format, is_parquet, iter_chunks
-from .core.validation import show
+from ..errors import CertifyError
+from ..files.reader import Chunk, chunk_values, count_grasps, input_format, is_parquet, iter_chunks
+from ..core.validation import show
 
 __all__ = ["Summary", "certify_file", "verify_file"]
 
@@ -35,9 +35,9 @@ def certify_file(grasps_path: str | Path, results_path: str | Path, *, method: s
                  quality: bool = True, eps_gap: float = 0.01, eps_budget: int = 200_000,
                  eps_time: float | None = 10.0) -> RunSummary:
     """Certify every grasp of ``grasps_path`` into ``results_path``: one results row per grasp,
-    in input order. See :func:`qualgrasp.certify.engine.run` for ``workers``, ``dask``, ``resume`` and
+    in input order. See :func:`qualgrasp.certify.batch.engine.run` for ``workers``, ``dask``, ``resume`` and
     ``chunk_size`` (``workers=None`` uses every core); ``quality``, ``eps_gap``, ``eps_budget``
-    and ``eps_time`` are :class:`qualgrasp.certify.chunk.Options`' (``eps_time`` in seconds per
+    and ``eps_time`` are :class:`qualgrasp.certify.batch.chunk.Options`' (``eps_time`` in seconds per
     grasp, None for no limit)."""
     options = Options(method=method, quality=quality, eps_gap=eps_gap, eps_budget=eps_budget,
                       eps_time=eps_time)

@@ -28,25 +28,25 @@ from dataclasses import dataclass
 import numpy as np
 import pyarrow as pa
 
-from ._kernels.barrier import barrier_batch
-from ._kernels.linalg import projection_bound, world_values
-from ._kernels.planar import planar_batch, planar_generators
-from ._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
-from .core.certificates import Tolerances, verify
-from .core.closure import decide, farkas_from_arrays
-from .files.columns import GraspColumns, extra_columns, grasp_columns
-from .core.cones import LORENTZ, cone_code
-from .core.grasp import Contact, Grasp
-from .core.problem import Block, ClosureProblem, System, conic_columns, grasp_problem, grasp_system
-from .quality.bounds import planar_epsilons
-from .files.results import CERTIFICATE, RESULT_SCHEMA, carried_name, result_table
-from .solvers import BARRIER_NEAR_ZERO, FastSolver, make_solver
-from .solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
-from .solvers.enumeration import FEAS, bases
-from .solvers.squeeze import squeeze_farkas
-from .files.reader import rows_to_table
-from . import models as registry
-from .core.wrench import force_column_errors, force_columns, generator_columns, generator_layout
+from .._kernels.barrier import barrier_batch
+from .._kernels.linalg import projection_bound, world_values
+from .._kernels.planar import planar_batch, planar_generators
+from .._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
+from ..core.certificates import Tolerances, verify
+from ..core.closure import decide, farkas_from_arrays
+from ..files.columns import GraspColumns, extra_columns, grasp_columns
+from ..core.cones import LORENTZ, cone_code
+from ..core.grasp import Contact, Grasp
+from ..core.problem import Block, ClosureProblem, System, conic_columns, grasp_problem, grasp_system
+from ..quality.bounds import planar_epsilons
+from ..files.results import CERTIFICATE, RESULT_SCHEMA, carried_name, result_table
+from ..solvers import BARRIER_NEAR_ZERO, FastSolver, make_solver
+from ..solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
+from ..solvers.enumeration import FEAS, bases
+from ..solvers.squeeze import squeeze_farkas
+from ..files.reader import rows_to_table
+from .. import models as registry
+from ..core.wrench import force_column_errors, force_columns, generator_columns, generator_layout
 
 __all__ = ["certify_table", "PlanarScreen", "planar_screen"]
 
@@ -557,7 +557,7 @@ def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(
     columns carried through.
 
     ``slow(row_indices) -> list of results rows`` certifies rows grasp by grasp (the per-grasp
-    path, :func:`qualgrasp.certify.chunk.certify_rows`); it receives every row that the columnar
+    path, :func:`qualgrasp.certify.batch.chunk.certify_rows`); it receives every row that the columnar
     rules do not settle, invalid rows included. ``columns``: the table's checked columns, when
     the caller has them already.
     """

@@ -8,10 +8,10 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from . import models as registry
-from .core.grasp import Contact, Grasp
-from .files.outputs import atomic_output
-from .files.reader import CONTACT, GRASP_SCHEMA, is_parquet
+from .. import models as registry
+from ..core.grasp import Contact, Grasp
+from ..files.outputs import atomic_output
+from ..files.reader import CONTACT, GRASP_SCHEMA, is_parquet
 
 __all__ = ["RANGES", "random_grasp", "random_grasps", "textbook_grasps", "random_grasp_table", "write_random_grasp_file"]
 
