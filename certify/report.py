@@ -21,6 +21,7 @@ from .errors import CertificateError
 from .core.closure import Verdict, form_closure, force_closure
 from .quality.evidence import verify_epsilon
 from .core.grasp import Grasp
+from .solvers import Method
 from .quality.bounds import Epsilon, epsilons
 from .files.results import NAMES, result_row
 
@@ -71,7 +72,7 @@ class Report:
             n_contacts=len(g.contacts), **eps)
 
 
-def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
+def certify_grasp(grasp: Grasp, *, method: Method = "fast", solver=None,
                   tol: Tolerances = Tolerances(), quality: bool = True, eps_gap: float = 0.01,
                   eps_budget: int = 200_000, eps_time: float | None = None) -> Report:
     """Certify one grasp end to end: force and form closure, the re-check of both certificates

@@ -108,6 +108,21 @@ def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     return out
 
 
+def private_imports(graph: dict[str, set[str]]) -> list[tuple[str, str]]:
+    """``(importer, module)`` of every import of a private module (a part of its name starts with
+    ``_``) from outside the package that holds it."""
+    bad = []
+    for m, targets in sorted(graph.items()):
+        for t in sorted(targets):
+            parts = t.split(".")
+            private = [k for k, p in enumerate(parts) if p.startswith("_") and not p.startswith("__")]
+            if private:
+                home = ".".join(parts[:private[0]])
+                if not (m == home or m.startswith(home + ".")):
+                    bad.append((m, t))
+    return bad
+
+
 def longest_chain(graph: dict[str, set[str]], within: str = "qualgrasp") -> list[str]:
     """The longest chain of imports ``a imports b imports c ...`` among modules under ``within``
     (the graph must have no cycle). A package's ``__init__`` counts as a module."""

@@ -20,6 +20,7 @@ exception. No solver is used.
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
@@ -34,7 +35,8 @@ from .fastpath import certify_table
 from ._recheck import recheck_table, schema_matches
 from ..report import certify_grasp, verify_row
 from ..files.results import NAMES, carried_clash, carried_name, error_row
-from ..solvers import make_solver
+from ..solvers import METHODS, Method, make_solver
+from ..core.arguments import choice, count_in, number_in, require
 from ..files.reader import Chunk, chunk_values, column_problem, table_to_rows
 
 __all__ = ["Options", "Quality", "certify_rows", "certify_values", "certify_chunk_results", "certify_arrow",
@@ -48,11 +50,18 @@ class Options:
     epsilon's relative gap and budget, and the per-grasp time limit of quality in seconds
     (``eps_time``, None for none; see :func:`qualgrasp.certify.certify_grasp`)."""
 
-    method: str = "fast"
+    method: Method = "fast"
     quality: bool = True
     eps_gap: float = 0.01
     eps_budget: int = 200_000
     eps_time: float | None = 10.0
+
+    def __post_init__(self) -> None:
+        choice(self.method, "method", METHODS)
+        number_in(self.eps_gap, "eps_gap", 0, 1, high_open=True)
+        count_in(self.eps_budget, "eps_budget", 1, what="direction")
+        if self.eps_time is not None:
+            number_in(self.eps_time, "eps_time", 0, math.inf, unit="seconds")
 
 
 def certify_rows(cols: GraspColumns, rows: Sequence[int], lines: Sequence[int],
@@ -151,6 +160,9 @@ def certify_arrow(data: Any, options: Options = Options(), tol: Tolerances = Tol
     ------
     GraspFileError
         ``data`` is not Arrow tabular data.
+    TypeError
+        ``options`` is not an :class:`Options` or ``tol`` not a
+        :class:`~qualgrasp.certify.Tolerances`.
 
     Examples
     --------
@@ -163,6 +175,8 @@ def certify_arrow(data: Any, options: Options = Options(), tol: Tolerances = Tol
     >>> r.column("status").to_pylist(), r.column("note").to_pylist()
     (['closure'], ['mine'])
     """
+    require(options, Options, "options")
+    require(tol, Tolerances, "tol")
     if isinstance(data, pa.RecordBatch):
         data = pa.Table.from_batches([data])
     if not isinstance(data, pa.Table):

@@ -25,11 +25,12 @@ from .engine import RunSummary, run
 from ..errors import CertifyError
 from ..files.reader import Chunk, chunk_values, count_grasps, input_format, is_parquet, iter_chunks
 from ..core.validation import show
+from ..solvers import Method
 
 __all__ = ["Summary", "certify_file", "verify_file"]
 
 
-def certify_file(grasps_path: str | Path, results_path: str | Path, *, method: str = "fast",
+def certify_file(grasps_path: str | Path, results_path: str | Path, *, method: Method = "fast",
                  progress: Callable[[int], None] | None = None, workers: int | None = 1,
                  dask: str | None = None, resume: bool = False, chunk_size: int = 4096,
                  quality: bool = True, eps_gap: float = 0.01, eps_budget: int = 200_000,

@@ -27,7 +27,6 @@ that refuses prints :func:`fail`'s one line.
 
 from __future__ import annotations
 
-import math
 import os
 import stat
 from pathlib import Path
@@ -37,6 +36,7 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
+from ..core import arguments
 from ..errors import OptionError
 from ..files.outputs import check_name_length, check_output, file_kind, inside, same_file, writable_folder
 
@@ -173,14 +173,8 @@ def number_in(value: float, flag: str, low: float, high: float, *, unit: str = "
     >>> number_in(0.5, "--mu", 0, 1e6, low_open=True)
     0.5
     """
-    ok = math.isfinite(value) and (value > low if low_open else value >= low) and (
-        value < high if high_open else value <= high)
-    if not ok:
-        lo = f"{'>' if low_open else '>='} {low:g}"
-        hi = f"{'<' if high_open else '<='} {high:g}"
-        unit = f" {unit}" if unit else ""
-        raise OptionError(f"{flag} must be a finite number {lo} and {hi}{unit}, got {value:g}")
-    return value
+    return arguments.number_in(value, flag, low, high, unit=unit, low_open=low_open, high_open=high_open,
+                               error=OptionError)
 
 
 def count_in(value: int, flag: str, low: int, high: int | None = None, *, what: str = "") -> int:
@@ -191,10 +185,7 @@ def count_in(value: int, flag: str, low: int, high: int | None = None, *, what: 
     OptionError
         Saying the flag and the range.
     """
-    if value < low or (high is not None and value > high):
-        span = f"at least {low}" if high is None else f"between {low} and {high}"
-        raise OptionError(f"{flag} must be {span}{' ' + what if what else ''}, got {value}")
-    return value
+    return arguments.count_in(value, flag, low, high, what=what, error=OptionError)
 
 
 def optional_number_in(value: float | None, flag: str, low: float, high: float, *, unit: str = "",

@@ -38,8 +38,9 @@ from . import cones
 from . import exact as ex
 from .._kernels.cones import polar_values as kernel_polar_values
 from ..errors import CertificateError
+from .arguments import number_in, require
 from .grasp import Grasp
-from .problem import Block, block_arrays, grasp_system, span_system
+from .problem import Block, block_arrays, grasp_system, span_system, span_vectors
 from .wrench import to_exact
 
 __all__ = [
@@ -75,6 +76,10 @@ class Tolerances:
     margin: float = 1e-7
     residual: float = 1e-7
     near: float = 1e-5
+
+    def __post_init__(self) -> None:
+        for name in ("rank", "margin", "residual", "near"):
+            number_in(getattr(self, name), name, 0, math.inf)
 
 
 @dataclass(frozen=True)
@@ -197,6 +202,12 @@ def verify(grasp: Grasp, certificate: Certificate, *, status: str | None = None,
         Truthy when the certificate proves the claim; otherwise ``reason`` says what failed.
         A malformed certificate is a failed check, never an exception.
 
+    Raises
+    ------
+    TypeError
+        ``grasp`` is not a :class:`Grasp`, ``certificate`` not a :class:`Certificate` (read one
+        with :meth:`Certificate.from_json`) or ``tol`` not a :class:`Tolerances`.
+
     Examples
     --------
     >>> from qualgrasp.certify import Contact, Grasp, force_closure, verify
@@ -207,6 +218,9 @@ def verify(grasp: Grasp, certificate: Certificate, *, status: str | None = None,
     >>> verify(g, v.certificate, status=v.status, margin=0.3).reason
     'claimed margin 0.3 exceeds the certified 0.25'
     """
+    require(grasp, Grasp, "grasp")
+    require(certificate, Certificate, "certificate")
+    require(tol, Tolerances, "tol")
     socp = certificate.layout == "forces"  # a planar grasp may be certified by its 2-D cones
     try:
         Cx, blocks, layout = grasp_system(grasp, frictionless=frictionless, socp=socp, exact=True)
@@ -219,6 +233,8 @@ def verify(grasp: Grasp, certificate: Certificate, *, status: str | None = None,
 def verify_span(vectors, certificate: Certificate, *, status: str | None = None,
                 margin: float | None = None, tol: Tolerances = Tolerances()) -> Check:
     """Re-check a positive-spanning certificate for the rows of ``vectors``."""
+    span_vectors(vectors)
+    require(certificate, Certificate, "certificate")
     Cx, blocks, layout = span_system(vectors, exact=True)
     return verify_system(Cx, blocks, layout, certificate, status=status, margin=margin, tol=tol)
 

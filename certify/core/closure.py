@@ -24,12 +24,15 @@ import numpy as np
 
 from . import exact as ex
 from .certificates import Certificate, Tolerances
-from ..errors import GraspError, SolverError
+from .. import models as registry
+from ..errors import ArgumentError, SolverError
+from .arguments import require
 from .grasp import Grasp
 from .._kernels.cones import farkas_direction
 from .._kernels.linalg import null_direction, pivot_basis
-from .problem import ClosureProblem, block_arrays, grasp_problem, grasp_system, span_problem, span_system
-from ..solvers import make_solver
+from .problem import (ClosureProblem, block_arrays, grasp_problem, grasp_system, span_problem, span_system,
+                      span_vectors)
+from ..solvers import Method, make_solver
 
 __all__ = ["Verdict", "force_closure", "form_closure", "positive_span", "decide", "farkas_certificate",
            "farkas_from_arrays"]
@@ -130,7 +133,7 @@ def farkas_from_arrays(C: np.ndarray, arrays, layout: str, y: np.ndarray,
                        null_space=bool(tight) and len(tight) == len(arrays[0]))
 
 
-def force_closure(grasp: Grasp, *, method: str = "fast", solver=None, socp: bool = False,
+def force_closure(grasp: Grasp, *, method: Method = "fast", solver=None, socp: bool = False,
                   tol: Tolerances = Tolerances()) -> Verdict:
     """Force closure of ``grasp`` under its declared contact models, with a certificate.
 
@@ -163,6 +166,10 @@ def force_closure(grasp: Grasp, *, method: str = "fast", solver=None, socp: bool
 
     Raises
     ------
+    ArgumentError
+        Unknown ``method``, or ``socp`` with a polyhedral contact model (pads).
+    TypeError
+        ``grasp`` is not a :class:`Grasp` or ``tol`` not a :class:`Tolerances`.
     SolverError
         The solver failed on a full-rank problem (not seen in practice).
 
@@ -177,7 +184,7 @@ def force_closure(grasp: Grasp, *, method: str = "fast", solver=None, socp: bool
     return _grasp_verdict(grasp, False, method, solver, tol, socp)
 
 
-def form_closure(grasp: Grasp, *, method: str = "fast", solver=None,
+def form_closure(grasp: Grasp, *, method: Method = "fast", solver=None,
                  tol: Tolerances = Tolerances()) -> Verdict:
     """Form closure of ``grasp``: force closure with friction ignored at every contact (each
     contact replaced by its model's frictionless counterpart; a pad stays a pad with ``mu = 0``).
@@ -203,6 +210,12 @@ def form_closure(grasp: Grasp, *, method: str = "fast", solver=None,
 
 
 def _grasp_verdict(grasp, frictionless, method, solver, tol, socp=False) -> Verdict:
+    require(grasp, Grasp, "grasp")
+    require(tol, Tolerances, "tol")
+    polyhedral = [c.model for c in grasp.contacts if registry.get(c.model).forces is None]
+    if socp and polyhedral:
+        raise ArgumentError(f"socp=True: {polyhedral[0]} contacts have no conic form (they are polyhedral); "
+                            "use socp=False")
     solver = solver or make_solver(method)
     kw = dict(frictionless=frictionless, socp=socp)
     return decide(
@@ -213,7 +226,7 @@ def _grasp_verdict(grasp, frictionless, method, solver, tol, socp=False) -> Verd
     )
 
 
-def positive_span(vectors, *, method: str = "fast", solver=None,
+def positive_span(vectors, *, method: Method = "fast", solver=None,
                   tol: Tolerances = Tolerances()) -> Verdict:
     """Do the rows of ``vectors`` positively span ``R^d``?
 
@@ -246,8 +259,7 @@ def positive_span(vectors, *, method: str = "fast", solver=None,
     >>> positive_span([[1, 0], [0, 1], [-1, 0.1]]).status  # all in the upper half plane
     'no_closure'
     """
-    V = np.asarray(vectors, dtype=float)
-    if V.ndim != 2 or not np.isfinite(V).all():
-        raise GraspError("vectors must be a finite (k, d) array")
+    V = span_vectors(vectors)
+    require(tol, Tolerances, "tol")
     solver = solver or make_solver(method)
     return decide(span_problem(V), lambda: span_system(V, exact=True).columns, solver, tol)

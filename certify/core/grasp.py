@@ -31,7 +31,9 @@ from typing import Any, Mapping
 import numpy as np
 
 from .. import models as registry
+from ..models import ModelName
 from ..errors import GraspError
+from .arguments import require
 from .validation import (Checked, CheckedGrasps, GraspData, check_contacts, contact_data, grasp_data,
                          check_grasps, grasp_rules, number, numbers, param_names)
 
@@ -86,7 +88,7 @@ class Contact:
     model: str
     params: tuple[tuple[str, float], ...]
 
-    def __init__(self, p, n, model: str | None = "frictionless", mu: float | None = None,
+    def __init__(self, p, n, model: ModelName | str | None = "frictionless", mu: float | None = None,
                  torsion: float | None = None, **params: float) -> None:
         unknown = sorted(set(params) - set(param_names()))
         if unknown:
@@ -320,6 +322,7 @@ def grasp_to_dict(grasp: Grasp) -> dict[str, Any]:
     >>> grasp_to_dict(Grasp((Contact((0, 0), (1, 0)),), id="g"))["contacts"]
     [{'p': [0.0, 0.0], 'n': [1.0, 0.0], 'model': 'frictionless'}]
     """
+    require(grasp, Grasp, "grasp")
     contacts = []
     for c in grasp.contacts:
         item: dict[str, Any] = {"p": list(c.p), "n": list(c.n), "model": c.model}

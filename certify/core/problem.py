@@ -27,13 +27,14 @@ import scipy.sparse as sp
 
 from .grasp import Grasp
 from .. import models as registry
+from ..errors import ArgumentError, GraspError
 from .._kernels.linalg import world_values
 from .cones import cone_code
 from .wrench import (contact_frame, force_columns, generator_columns, grasp_arrays, tangent,
                      to_exact, variants_of, wrench)
 
 __all__ = ["Block", "block_arrays", "System", "ClosureProblem", "grasp_problem", "span_problem", "grasp_system",
-           "span_system", "is_polyhedral"]
+           "span_system", "span_vectors", "is_polyhedral"]
 
 
 @dataclass(frozen=True)
@@ -213,7 +214,7 @@ def conic_columns(P, N, params, models, center, length):
             blocks.append(N[..., i, :, None])
             continue
         if model.cone != "lorentz":
-            raise ValueError(f"{name} contacts have no conic form (they are polyhedral: use the generators)")
+            raise ArgumentError(f"{name} contacts have no conic form (they are polyhedral: use the generators)")
         cols.extend(wrenches[..., i, j, :] for j in range(dim))
         frame = np.swapaxes(frames[..., i, :, :], -1, -2)
         if model.extra:
@@ -271,6 +272,25 @@ def grasp_system(grasp: Grasp, *, frictionless: bool = False, socp: bool = False
         g = num(contact.param(model.extra[0])) if model.extra else 0
         blocks.append(Block(model.cone, cols, tuple(conv(np.array(contact.n))), num(contact.mu), g, i))
     return System(C, tuple(blocks), "forces")
+
+
+def span_vectors(vectors) -> np.ndarray:
+    """``vectors`` as a finite float array ``(k, d)`` with ``k >= 1``, else :class:`GraspError`.
+
+    Examples
+    --------
+    >>> span_vectors([[1, 2], [3]])
+    Traceback (most recent call last):
+    ...
+    qualgrasp.certify.errors.GraspError: vectors must be a finite (k, d) array
+    """
+    try:
+        V = np.asarray(vectors, dtype=float)
+    except (TypeError, ValueError):
+        V = None
+    if V is None or V.ndim != 2 or V.size == 0 or not np.isfinite(V).all():
+        raise GraspError("vectors must be a finite (k, d) array")
+    return V
 
 
 def span_system(vectors, *, exact: bool = False):

@@ -16,6 +16,7 @@ from typing import Sequence
 import numpy as np
 
 from .. import models as registry
+from ..errors import ArgumentError
 from .._kernels.linalg import ETA
 from .grasp import Grasp
 from .validation import param_names
@@ -124,7 +125,7 @@ def generator_layout(models: Sequence[str], variants: Sequence[int], dim: int, *
             model = registry.get(target)
         gens = model.generators(dim, variant)
         if gens is None:
-            raise ValueError(f"{model.name} contacts have no finite generators in {dim} dimensions; "
+            raise ArgumentError(f"{model.name} contacts have no finite generators in {dim} dimensions; "
                              "use force_columns (the conic form)")
         for g in gens:
             owner.append(i), offset.append(g.offset), friction.append(g.friction)
@@ -211,7 +212,7 @@ def force_columns(P, N, models, center, length):
     for i, name in enumerate(models):
         model = registry.get(name)
         if model.forces is None:
-            raise ValueError(f"{name} contacts have no conic form (they are polyhedral: use the generators)")
+            raise ArgumentError(f"{name} contacts have no conic form (they are polyhedral: use the generators)")
         forces = N[..., i:i + 1, :] if model.forces == "normal" else np.broadcast_to(eye, batch + (dim, dim))
         w = wrench(P[..., i:i + 1, :], forces, c, L)
         cols += [w[..., j, :] for j in range(w.shape[-2])]

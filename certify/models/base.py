@@ -46,6 +46,8 @@ from typing import ClassVar, Mapping
 
 import numpy as np
 
+from ..errors import ArgumentError
+
 __all__ = ["Param", "Generator", "ContactModel", "register", "get", "names", "models",
            "MAX_MU", "MAX_LENGTH", "MIN_LENGTH"]
 
@@ -161,7 +163,7 @@ class ContactModel:
     def columns(self, dim: int) -> int:
         """Number of certificate columns of a contact in the conic form."""
         if self.forces is None:
-            raise ValueError(f"{self.name} contacts have no conic form")
+            raise ArgumentError(f"{self.name} contacts have no conic form")
         return (1 if self.forces == "normal" else dim) + len(self.extra)
 
     def __repr__(self) -> str:
@@ -174,7 +176,7 @@ _REGISTRY: dict[str, ContactModel] = {}
 def register(model: ContactModel) -> ContactModel:
     """Register ``model`` under its name; its code is the order of registration."""
     if model.name in _REGISTRY:
-        raise ValueError(f"contact model {model.name!r} is registered already")
+        raise ArgumentError(f"contact model {model.name!r} is registered already")
     model.code = len(_REGISTRY)
     _REGISTRY[model.name] = model
     return model

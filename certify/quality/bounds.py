@@ -69,6 +69,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from typing import Literal, get_args
 
 import clarabel
 import numpy as np
@@ -79,6 +80,8 @@ from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, sup
 from .._kernels.jit import BOOL, F1, F2, FLOAT, I1, I2, INT, precompile
 from .._kernels.planar import planar_generators
 from .._kernels.surface import cycle_code, face_bounds
+from ..core.arguments import count_in, number_in, require
+from ..errors import ArgumentError
 from ..core.closure import Verdict, force_closure
 from .evidence import (EPS_TOL, ConicSupport, Evidence, planar_generator_arrays,
                        planar_support_vertices, stated_lo, sum_errors, surface_faces,
@@ -87,11 +90,13 @@ from ..core.grasp import Grasp
 from ..core.problem import System, grasp_system
 from ..solvers.clarabel_direct import settings
 
-__all__ = ["NORMS", "Epsilon", "epsilon", "epsilons", "planar_epsilon", "planar_epsilons",
+__all__ = ["Norm", "NORMS", "Epsilon", "epsilon", "epsilons", "planar_epsilon", "planar_epsilons",
            "epsilon_of_points", "check_norm", "L1_ENUMERATION_MAX", "LINF_ENUMERATION_MAX",
            "SUMS_MAX", "MAX_VERTICES", "SOCP_COST"]
 
-NORMS = ("L1", "Linf")
+#: A norm of the grasp wrench space.
+Norm = Literal["L1", "Linf"]
+NORMS: tuple[str, ...] = get_args(Norm)
 
 #: Planar L1 with at most this many generators: compiled enumeration of triples (else the hull).
 L1_ENUMERATION_MAX = 16
@@ -169,23 +174,23 @@ class Epsilon:
         return (self.hi - self.lo) / self.hi if self.hi > 0 else 0.0
 
 
-def check_norm(norm: str) -> None:
+def check_norm(norm: Norm) -> None:
     """Refuse a norm other than those of :data:`NORMS` (``"L1"``, ``"Linf"``).
 
     Raises
     ------
-    ValueError
-        Naming the norm given.
+    ArgumentError
+        Naming the norm given (a ``ValueError``).
 
     Examples
     --------
     >>> check_norm("L2")
     Traceback (most recent call last):
     ...
-    ValueError: unknown norm 'L2'; use 'L1' or 'Linf'
+    qualgrasp.certify.errors.ArgumentError: unknown norm 'L2'; use 'L1' or 'Linf'
     """
-    if norm not in NORMS:
-        raise ValueError(f"unknown norm {norm!r}; use 'L1' or 'Linf'")
+    if not isinstance(norm, str) or norm not in NORMS:
+        raise ArgumentError(f"unknown norm {norm!r}; use 'L1' or 'Linf'")
 
 
 def _zero(grasp: Grasp, norm: str) -> Epsilon:
@@ -464,7 +469,7 @@ def planar_epsilon(grasp: Grasp, norm: str) -> tuple[float, np.ndarray]:
 
 # --- entry points --------------------------------------------------------------------------------
 
-def epsilon(grasp: Grasp, norm: str = "L1", *, rel_gap: float = 0.01, budget: int = 200_000,
+def epsilon(grasp: Grasp, norm: Norm = "L1", *, rel_gap: float = 0.01, budget: int = 200_000,
             time_limit: float | None = None, verdict: Verdict | None = None) -> Epsilon:
     """Ferrari-Canny epsilon of ``grasp`` for the ``norm`` GWS (module docstring).
 
@@ -492,8 +497,11 @@ def epsilon(grasp: Grasp, norm: str = "L1", *, rel_gap: float = 0.01, budget: in
 
     Raises
     ------
-    ValueError
-        Unknown ``norm``.
+    ArgumentError
+        Unknown ``norm``; ``rel_gap`` not in ``[0, 1)``, ``budget`` below 1, ``time_limit``
+        negative or not finite.
+    TypeError
+        ``grasp`` is not a :class:`~qualgrasp.certify.Grasp`.
 
     Examples
     --------
@@ -524,8 +532,13 @@ def epsilons(grasp: Grasp, norms=NORMS, *, rel_gap: float = 0.01, budget: int = 
     dict
         ``{norm: Epsilon}``.
     """
+    require(grasp, Grasp, "grasp")
     for norm in norms:
         check_norm(norm)
+    number_in(rel_gap, "rel_gap", 0, 1, high_open=True)
+    count_in(budget, "budget", 1, what="direction")
+    if time_limit is not None:
+        number_in(time_limit, "time_limit", 0, math.inf, unit="seconds")
     verdict = verdict or force_closure(grasp)
     if verdict.status != "closure":
         return {norm: _zero(grasp, norm) for norm in norms}
