@@ -5,7 +5,8 @@
 * :mod:`.chunk`: what happens to one chunk (certify every grasp, or re-check every row), and
   :func:`certify_arrow` for Arrow data in memory;
 * :mod:`.fastpath`: the columnar route (compiled kernels for whole groups of grasps at once),
-  row for row equal to :func:`qualgrasp.certify.certify_grasp`;
+  row for row equal to :func:`qualgrasp.certify.certify_grasp` (its results tables are built by
+  the private ``_arrow``; the private ``_recheck`` re-checks results tables columnar);
 * :mod:`.samples`: random and textbook grasp sets, for trying the toolkit and for benchmarks.
 """
 

@@ -17,7 +17,8 @@ grouped by contact pattern (dimension, contact count, each contact's model and v
 
 Every row these rules do not settle (invalid input, numerically thin or near-degenerate problems,
 certificates the float re-check cannot prove, spatial rows that need the epsilon) goes through
-the per-grasp path, so the two agree by construction.
+the per-grasp path, so the two agree by construction. This module solves; the results tables
+are built in Arrow by ``qualgrasp.certify.batch._arrow``.
 """
 
 from __future__ import annotations
@@ -34,74 +35,21 @@ from .._kernels.planar import planar_batch, planar_generators
 from .._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
 from ..core.certificates import Tolerances, verify
 from ..core.closure import decide, farkas_from_arrays
-from ..files.columns import GraspColumns, extra_columns, grasp_columns
+from ..files.columns import GraspColumns, grasp_columns
 from ..core.cones import LORENTZ, cone_code
 from ..core.grasp import Contact, Grasp
 from ..core.problem import Block, ClosureProblem, System, conic_columns, grasp_problem, grasp_system
 from ..quality.bounds import planar_epsilons
-from ..files.results import CERTIFICATE, RESULT_SCHEMA, carried_name, result_table
 from ..solvers import BARRIER_NEAR_ZERO, FastSolver, make_solver
 from ..solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
 from ..solvers.enumeration import FEAS, bases
 from ..solvers.squeeze import squeeze_farkas
 from ..files.reader import rows_to_table
+from ._arrow import assemble, group_table
 from .. import models as registry
 from ..core.wrench import force_column_errors, force_columns, generator_columns, generator_layout
 
 __all__ = ["certify_table", "PlanarScreen", "planar_screen"]
-
-
-_STATUS = pa.array(["no_closure", "closure"])
-_KIND = pa.array(["farkas", "interior"])
-
-
-def _list_array(values: np.ndarray, valid: np.ndarray | None, type_: pa.DataType) -> pa.Array:
-    """Arrow list array with ``values.shape[1]`` items per valid row and nulls elsewhere
-    (``valid=None``: every row valid)."""
-    n, w = values.shape
-    if valid is None:
-        offsets = np.arange(0, n * w + 1, w, dtype=np.int32)
-        return pa.ListArray.from_arrays(pa.array(offsets), pa.array(values.ravel(), type=type_.value_type))
-    offsets = np.zeros(n + 1, dtype=np.int32)
-    offsets[1:] = np.cumsum(np.where(valid, w, 0))
-    flat = values[valid].ravel()
-    return pa.ListArray.from_arrays(pa.array(offsets), pa.array(flat, type=type_.value_type),
-                                    mask=pa.array(~valid))
-
-
-def _certificates(code: np.ndarray, lam: np.ndarray, basis: np.ndarray, y: np.ndarray,
-                  layout: str = "generators", blocks: int | None = None,
-                  tight: dict | None = None) -> pa.Array:
-    """Certificate structs from verdict codes: 1 interior (values, basis), 2 strict Farkas,
-    3 Farkas orthogonal to every one of the ``blocks`` cone blocks (null space), 4 Farkas with
-    the tight blocks ``tight[row]``."""
-    n, k = lam.shape
-    nb = k if blocks is None else blocks
-    interior = code == 1
-    lengths = np.where(code == 3, nb, 0).astype(np.int32)
-    extra = {r: np.asarray(v, dtype=np.int32) for r, v in (tight or {}).items() if code[r] == 4}
-    for r, v in extra.items():
-        lengths[r] = len(v)
-    offsets = np.zeros(n + 1, dtype=np.int32)
-    np.cumsum(lengths, out=offsets[1:])
-    flat = np.zeros(int(offsets[-1]), dtype=np.int32)
-    null_rows = np.flatnonzero(code == 3)
-    if len(null_rows):  # every block tight: 0 .. nb-1 at each such row
-        flat[(offsets[null_rows][:, None] + np.arange(nb)).ravel()] = np.tile(np.arange(nb), len(null_rows))
-    for r, v in extra.items():
-        flat[offsets[r]:offsets[r + 1]] = v
-    tight_arr = pa.ListArray.from_arrays(pa.array(offsets), pa.array(flat, type=pa.int32()),
-                                         mask=pa.array(interior))
-    return pa.StructArray.from_arrays([
-        _KIND.take(pa.array(interior.astype(np.int8))),
-        pa.array([layout]).take(pa.array(np.zeros(n, np.int8))),
-        _list_array(lam, interior, CERTIFICATE.field("values").type),
-        _list_array(basis.astype(np.int32), interior, CERTIFICATE.field("basis").type),
-        _list_array(y, ~interior, CERTIFICATE.field("y").type),
-        tight_arr,
-        pa.array(lengths == nb, mask=interior),
-        pa.nulls(n, pa.string()),
-    ], fields=list(CERTIFICATE))
 
 
 def _planar_kernel(P, N, mu, width, c, L, models, variants, tol: Tolerances, quality: bool):
@@ -510,47 +458,6 @@ def _tight_shift(C, E, owner, mask, models, P, y) -> float:
     return np.inf
 
 
-def _group_table(cols: GraspColumns, rows: np.ndarray, lines: np.ndarray, out, options) -> pa.Table:
-    code, t, lam, basis, yn = out["force"]
-    fcode, ft, flam, fbasis, fyn = out["form"]
-    closure, fclosure = code == 1, fcode == 1
-    n = len(rows)
-    dim = int(cols.dim[rows[0]])
-    force_layout, blocks = out.get("force_layout", ("generators", None))
-    cert = pa.StructArray.from_arrays(
-        [_certificates(code, lam, basis, yn, force_layout, blocks, out.get("tight")),
-         _certificates(fcode, flam, fbasis, fyn, tight=out.get("form_tight"))],
-        fields=list(RESULT_SCHEMA.field("certificate").type))
-    eps = {}
-    if options.quality:  # spatial groups settle rows not in closure only: 0 there
-        l1_lo, l1_hi, linf_lo, linf_hi, limited, evidence = out.get("eps") or (
-            np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n, dtype=bool),
-            np.full(n, None, dtype=object))
-        for key, values in (("eps_l1_lo", l1_lo), ("eps_l1_hi", l1_hi), ("eps_linf_lo", linf_lo),
-                            ("eps_linf_hi", linf_hi)):
-            eps[key] = pa.array(values, type=pa.float64())
-        eps["eps_limited"] = pa.array(limited, type=pa.bool_())
-        eps["eps_evidence"] = pa.array(list(evidence), type=RESULT_SCHEMA.field("eps_evidence").type)
-    return result_table({
-        "id": cols.id_column(rows),
-        "line": pa.array(lines, type=pa.int64()),
-        "dim": pa.array(np.full(n, dim, dtype=np.int8)),
-        "status": _STATUS.take(pa.array(closure.astype(np.int8))),
-        "form_closure": pa.array(fclosure),
-        "force_closure": pa.array(closure),
-        "margin": pa.array(np.where(closure, t, 0.0)),
-        "form_status": _STATUS.take(pa.array(fclosure.astype(np.int8))),
-        "form_margin": pa.array(np.where(fclosure, ft, 0.0)),
-        "certificate": cert,
-        "verified": pa.array(np.ones(n, dtype=bool)),
-        "error": pa.nulls(n, pa.string()),
-        "center": _list_array(np.ascontiguousarray(cols.center[rows, :dim]), None, pa.list_(pa.float64())),
-        "length": pa.array(cols.length[rows]),
-        "n_contacts": pa.array(cols.count[rows].astype(np.int32)),
-        **eps,
-    }, n)
-
-
 def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(), slow=None, *,
                   columns: GraspColumns | None = None) -> pa.Table:
     """Results table of an Arrow grasp table (rows in input order), with the table's extra
@@ -583,31 +490,14 @@ def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(
                     if name in out:
                         sub[name] = {int(new[r]): v for r, v in out[name].items() if settled[r]}
             if settled.any():
-                pieces.append(_group_table(cols, rows[settled], lines[rows[settled]], sub, options))
+                pieces.append(group_table(cols, rows[settled], lines[rows[settled]], sub, options))
                 order.append(rows[settled])
                 done[rows[settled]] = True
     rest = np.flatnonzero(~done)
     if len(rest):
         pieces.append(rows_to_table(slow(rest)))
         order.append(rest)
-    if not pieces:
-        return _carry(RESULT_SCHEMA.empty_table(), table)
-    result = pa.concat_tables(pieces)
-    order = np.concatenate(order)
-    perm = np.argsort(order, kind="stable")
-    starts = np.concatenate([[0], np.flatnonzero(np.diff(perm) != 1) + 1])
-    if len(starts) > 64:
-        return _carry(result.take(pa.array(perm)), table)
-    # few runs (one group and a few rows left to the per-grasp path): zero-copy slices
-    ends = np.append(starts[1:], len(perm))
-    return _carry(pa.concat_tables([result.slice(perm[a], b - a) for a, b in zip(starts, ends)]), table)
-
-
-def _carry(result: pa.Table, table: pa.Table) -> pa.Table:
-    """``result`` with the input table's extra columns appended (:func:`carried_name`)."""
-    for name in extra_columns(table):
-        result = result.append_column(carried_name(name), table.column(name))
-    return result
+    return assemble(pieces, order, table)
 
 
 def _take(value, mask):
