@@ -6,6 +6,8 @@ rigorous bounds and the evidence that proves them.
   evidence;
 * :mod:`.evidence`: the evidence (a direction for ``hi``, an inscribed surface for ``lo``) and
   its re-check without a solver, in exact arithmetic;
+* :mod:`.gws`: the grasp wrench space both build on (generators, support points, hulls), so that
+  a vertex the evidence names is the vertex that was computed;
 * :mod:`.steinitz`: Steinitz-style bounds and the efficiency of contacts on a polygon's boundary.
 
 >>> from qualgrasp.certify import Contact, Grasp

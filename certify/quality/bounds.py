@@ -83,9 +83,8 @@ from .._kernels.surface import cycle_code, face_bounds
 from ..core.arguments import count_in, number_in, require
 from ..errors import ArgumentError
 from ..core.closure import Verdict, force_closure
-from .evidence import (EPS_TOL, ConicSupport, Evidence, planar_generator_arrays,
-                       planar_support_vertices, stated_lo, sum_errors, surface_faces,
-                       surface_minimum)
+from .evidence import EPS_TOL, Evidence, stated_lo, surface_minimum
+from .gws import ConicSupport, planar_generator_arrays, planar_support_vertices, sum_errors, surface_faces
 from ..core.grasp import Grasp
 from ..core.problem import System, grasp_system
 from ..solvers.clarabel_direct import settings
