@@ -32,17 +32,13 @@ from rich.console import Console
 from rich.progress import Progress
 from rich.table import Table
 
-from ..certify.core import verify
-from ..certify.batch import Options
-from ..certify.core import force_closure, form_closure
-from ..certify.batch import certify_table
-from ..certify.core import Grasp, grasp_to_dict
+from ..certify.batch import Options, certify_table, random_grasps
+from ..certify.core import Grasp, force_closure, form_closure, grasp_to_dict, verify
 from ..certify.core.problem import grasp_system
+from ..certify.files import grasps_table
 from ..certify.quality.bounds import check_norm, epsilon, epsilon_of_points, epsilons
 from ..certify.report import certify_grasp
-from ..certify.batch import random_grasps
 from ..certify.solvers import make_solver
-from ..certify.files import grasps_table
 
 __all__ = ["KINDS", "BenchRow", "run_bench", "print_bench", "CONTACTS", "ContactsRow", "epsilon_linearised",
            "run_contacts_bench", "print_contacts_bench"]
