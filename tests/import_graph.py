@@ -136,6 +136,40 @@ def longest_chain(graph: dict[str, set[str]], within: str = "qualgrasp") -> list
     return list(max((chain(v) for v in starts), key=len, default=()))
 
 
+def without_packages(graph: dict[str, set[str]], found: dict[str, pathlib.Path]) -> dict[str, set[str]]:
+    """``graph`` with every package ``__init__`` contracted away: a module importing a package
+    imports what the package's ``__init__`` imports (the floors of real modules)."""
+    packages = {m for m, p in found.items() if p.name == "__init__.py"}
+
+    @functools.cache
+    def through(v: str) -> frozenset[str]:
+        out = set()
+        for w in graph.get(v, ()):
+            out |= through(w) if w in packages else {w}
+        return frozenset(out)
+
+    return {v: set(through(v)) for v in graph if v not in packages}
+
+
+def defined_public_names(found: dict[str, pathlib.Path] | None = None) -> dict[str, list[str]]:
+    """``{module: names}`` of the public names each public module defines itself (functions,
+    classes, assignments; not names it imports or re-exports)."""
+    found = modules() if found is None else found
+    out = {}
+    for module, path in found.items():
+        if any(p.startswith("_") for p in module.split(".")):
+            continue
+        names = []
+        for node in ast.parse(path.read_text()).body:
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                names.append(node.name)
+            elif isinstance(node, (ast.Assign, ast.AnnAssign)):
+                targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+                names += [n.id for t in targets for n in ast.walk(t) if isinstance(n, ast.Name)]
+        out[module] = sorted({n for n in names if not n.startswith("_")})
+    return out
+
+
 def public_names(found: dict[str, pathlib.Path] | None = None) -> dict[str, list[str]]:
     """``{module: its public names}`` of every public module (no ``_`` part in its dotted name):
     the names in ``__all__`` when the module has one, else every top-level name it binds (defines,
@@ -175,15 +209,18 @@ def report(show_chain: bool = False) -> None:
     print(f"  {'total':24} {len(found)}")
     graph = edges(found)
     print(f"import cycles: {len(cycles(graph))}")
+    flat = without_packages(graph, found)
     for within in ("qualgrasp", "qualgrasp.certify"):
-        chain = longest_chain(graph, within)
-        print(f"longest import chain under {within}: {len(chain)} modules")
-        if show_chain:
-            print("  " + "\n  -> ".join(chain))
-    names = public_names(found)
-    print(f"public names: {sum(map(len, names.values()))} in {len(names)} public modules")
-    certify = {m: n for m, n in names.items() if m.startswith("qualgrasp.certify")}
-    print(f"  of which qualgrasp.certify: {sum(map(len, certify.values()))} in {len(certify)} modules")
+        for label, g in (("modules and package __init__s", graph), ("modules, packages contracted", flat)):
+            chain = longest_chain(g, within)
+            print(f"longest import chain under {within} ({label}): {len(chain)}")
+            if show_chain:
+                print("  " + "\n  -> ".join(chain))
+    for label, names in (("public names (__all__, else every public top-level name)", public_names(found)),
+                         ("public names defined (not re-exported)", defined_public_names(found))):
+        certify = {m: n for m, n in names.items() if m.startswith("qualgrasp.certify")}
+        print(f"{label}: {sum(map(len, names.values()))} in {len(names)} public modules; "
+              f"qualgrasp.certify: {sum(map(len, certify.values()))} in {len(certify)} modules")
 
 
 if __name__ == "__main__":
