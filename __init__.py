@@ -7,8 +7,10 @@ The package has three halves, each importable on its own:
   synthesis procedures;
 * :mod:`qualgrasp.experiments`: the paper's figures, the comparison study, the demo.
 
-The names below are the main API, re-exported from the halves; ``__version__`` is the installed
-distribution's version (its one source is ``pyproject.toml``).
+The names below are the main API, re-exported from the halves, and every exception the package
+raises on purpose (all derive from :class:`QualgraspError`; :mod:`qualgrasp.certify.errors` states
+the rule); ``__version__`` is the installed distribution's version (its one source is
+``pyproject.toml``).
 
 Examples
 --------
@@ -28,8 +30,13 @@ from importlib.metadata import version
 from qualgrasp.certify import (Certificate, Check, Contact, Grasp, Report, Verdict, certify_grasp,
                                force_closure, form_closure, grasp_from_dict, grasp_to_dict, positive_span,
                                verify)
-from qualgrasp.certify.errors import CertificateError, CertifyError, GraspError, GraspFileError, SolverError
+from qualgrasp.certify.errors import (ArgumentError, CertificateError, CertifyError, GraspError, GraspFileError,
+                                      OptionError, QualgraspError, SolverError, WriteError)
+from qualgrasp.certify.meshes.errors import GripperError, MeshError, PoseError, PoseFileError
 from qualgrasp.certify.quality import Epsilon, epsilon
+from qualgrasp.qualitative.errors import (ContourError, FormulaError, ImageError, NetworkError, OutlineError,
+                                          QualitativeError, RegionError, SegmentationError, SynthesisError,
+                                          TraceError, ZoneError)
 from qualgrasp.qualitative.synthesis import Synthesis, synthesize
 
 __version__ = version("qualgrasp")
@@ -41,5 +48,9 @@ __all__ = [
     "Report", "certify_grasp",
     "Epsilon", "epsilon",
     "Synthesis", "synthesize",
-    "CertifyError", "GraspError", "GraspFileError", "CertificateError", "SolverError",
+    "QualgraspError",
+    "CertifyError", "ArgumentError", "GraspError", "GraspFileError", "CertificateError", "SolverError",
+    "OptionError", "WriteError", "MeshError", "GripperError", "PoseError", "PoseFileError",
+    "QualitativeError", "ImageError", "SegmentationError", "ContourError", "OutlineError", "FormulaError",
+    "TraceError", "NetworkError", "RegionError", "ZoneError", "SynthesisError",
 ]

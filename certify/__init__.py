@@ -4,8 +4,22 @@ Form closure and positive spanning are linear programmes; force closure is a lin
 the plane (friction cones have exactly two edges) and a second-order-cone programme in space
 (exact Lorentz cones, no linearisation). Every verdict carries a certificate that
 :func:`verify` re-checks with exact rational arithmetic, without any solver, and every
-Ferrari-Canny epsilon bound its evidence (:mod:`qualgrasp.certify.evidence`); a results row is
+Ferrari-Canny epsilon bound its evidence (:mod:`qualgrasp.certify.quality.evidence`); a results row is
 re-checked column by column (:func:`qualgrasp.certify.report.verify_row`).
+
+The subpackages, one concept each (each ``__init__`` lists its public names):
+
+* :mod:`~qualgrasp.certify.core`: grasps, wrenches, cones, the closure programmes and their
+  certificates; :mod:`~qualgrasp.certify.models` the contact models, :mod:`~qualgrasp.certify.solvers`
+  the solver routes;
+* :mod:`~qualgrasp.certify.quality`: the epsilon bounds and the evidence that proves them;
+* :mod:`~qualgrasp.certify.report`: one grasp end to end (closure, quality, the results row);
+* :mod:`~qualgrasp.certify.regions`: region certificates and independent regions;
+* :mod:`~qualgrasp.certify.files`: reading and writing grasp sets and results, safely;
+* :mod:`~qualgrasp.certify.batch`: whole files, in parallel chunks, by the columnar fast path;
+* :mod:`~qualgrasp.certify.meshes`: grasps of a gripper on a mesh;
+* :mod:`~qualgrasp.certify.cli`: the commands, and the option checks every half's commands use;
+* :mod:`~qualgrasp.certify.errors`: the exceptions (one root, :class:`QualgraspError`).
 
 >>> from qualgrasp.certify import Contact, Grasp, force_closure
 >>> g = Grasp((Contact((1, 0), (-1, 0), "point", 0.5), Contact((-1, 0), (1, 0), "point", 0.5)))
@@ -13,17 +27,18 @@ re-checked column by column (:func:`qualgrasp.certify.report.verify_row`).
 'closure'
 """
 
-from .certificates import Certificate, Check, Tolerances, verify, verify_span
-from .closure import Verdict, force_closure, form_closure, positive_span
-from .errors import CertificateError, CertifyError, GraspError, GraspFileError, SolverError
-from .grasp import Contact, Grasp, grasp_from_dict, grasp_to_dict
+from .batch import Options, certify_arrow
+from .core import (Certificate, Check, Contact, Grasp, Tolerances, Verdict, force_closure, form_closure,
+                   grasp_from_dict, grasp_to_dict, positive_span, verify, verify_span)
+from .errors import (ArgumentError, CertificateError, CertifyError, GraspError, GraspFileError, OptionError,
+                     QualgraspError, SolverError, WriteError)
 from .report import Report, certify_grasp
-from .chunk import Options, certify_arrow
 
 __all__ = [
     "Contact", "Grasp", "grasp_from_dict", "grasp_to_dict",
     "Verdict", "force_closure", "form_closure", "positive_span",
     "Certificate", "Check", "Tolerances", "verify", "verify_span",
     "Report", "certify_grasp", "Options", "certify_arrow",
-    "CertifyError", "GraspError", "GraspFileError", "CertificateError", "SolverError",
+    "QualgraspError", "CertifyError", "ArgumentError", "GraspError", "GraspFileError", "CertificateError",
+    "SolverError", "OptionError", "WriteError",
 ]

@@ -1,13 +1,24 @@
-"""Exceptions raised by :mod:`qualgrasp.certify`.
+"""Exceptions raised by :mod:`qualgrasp`.
 
-Every error a user can cause derives from :class:`CertifyError`, so a caller can catch one class;
-the subclasses say which kind of input was wrong.
+Every error a user can cause derives from :class:`QualgraspError`, so a caller can catch one
+class: :class:`CertifyError` for :mod:`qualgrasp.certify` (this module; certify is the base layer)
+and :class:`qualgrasp.qualitative.errors.QualitativeError` for the qualitative half. The
+subclasses say which kind of input was wrong; each is also the built-in exception it refines
+(``ValueError``, ``RuntimeError``, ``OSError``), so code catching those keeps working.
+
+The rule of the public functions: a value of the right Python type that is out of the function's
+domain (NaN, an empty or wrongly shaped array, an unknown method, norm or model name, a contact
+model an option does not apply to) raises a :class:`QualgraspError`; an argument of a plainly
+wrong Python type (a number where a :class:`~qualgrasp.certify.Grasp` is expected, say) raises
+``TypeError``, as Python's own functions do.
 """
 
 from __future__ import annotations
 
 __all__ = [
+    "QualgraspError",
     "CertifyError",
+    "ArgumentError",
     "GraspError",
     "GraspFileError",
     "CertificateError",
@@ -17,8 +28,18 @@ __all__ = [
 ]
 
 
-class CertifyError(Exception):
+class QualgraspError(Exception):
+    """Base class of every error :mod:`qualgrasp` raises on purpose."""
+
+
+class CertifyError(QualgraspError):
     """Base class of every error raised by :mod:`qualgrasp.certify`."""
+
+
+class ArgumentError(CertifyError, ValueError):
+    """An argument is outside what the function accepts: an unknown method or norm, an option
+    that does not apply to the grasp's contact models, a number out of its range (the message
+    names the argument)."""
 
 
 class GraspError(CertifyError, ValueError):
@@ -37,7 +58,7 @@ class SolverError(CertifyError, RuntimeError):
     """A convex solver failed to return a usable answer."""
 
 
-class OptionError(CertifyError, ValueError):
+class OptionError(ArgumentError):
     """A command-line option or path is unusable (the message names the flag)."""
 
 

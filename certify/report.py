@@ -1,9 +1,9 @@
 """Certify one grasp end to end: force and form closure, certificates, independent re-check.
 
 :func:`certify_grasp` returns a :class:`Report`; :meth:`Report.row` is the results-file row
-(:data:`qualgrasp.certify.results.COLUMNS`): the force and form closure verdicts, margins and
+(:data:`qualgrasp.certify.files.results.COLUMNS`): the force and form closure verdicts, margins and
 certificates, whether both certificates re-checked, the ``center`` and ``length`` used, and the
-Ferrari-Canny epsilon bounds with their evidence (:mod:`qualgrasp.certify.evidence`; 0 and no
+Ferrari-Canny epsilon bounds with their evidence (:mod:`qualgrasp.certify.quality.evidence`; 0 and no
 evidence when not in force closure; null when quality was not asked for). ``status`` refers to
 force closure under the declared contact models.
 
@@ -16,13 +16,14 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from .certificates import Certificate, Check, Tolerances, verify
+from .core.certificates import Certificate, Check, Tolerances, verify
 from .errors import CertificateError
-from .closure import Verdict, form_closure, force_closure
-from .evidence import verify_epsilon
-from .grasp import Grasp
-from .quality import Epsilon, epsilons
-from .results import NAMES, result_row
+from .core.closure import Verdict, form_closure, force_closure
+from .quality.evidence import verify_epsilon
+from .core.grasp import Grasp
+from .solvers import Method
+from .quality.bounds import Epsilon, epsilons
+from .files.results import NAMES, result_row
 
 __all__ = ["Report", "certify_grasp", "verify_row", "GEOMETRY_TOL"]
 
@@ -48,7 +49,7 @@ class Report:
         return float(self.epsilons["L1"].hi) if self.certified and self.epsilons else 0.0
 
     def row(self, line: int | None = None) -> dict[str, Any]:
-        """The results-file row of this grasp (:data:`qualgrasp.certify.results.COLUMNS`)."""
+        """The results-file row of this grasp (:data:`qualgrasp.certify.files.results.COLUMNS`)."""
         g = self.grasp
         eps = {}
         for norm, key in (("L1", "l1"), ("Linf", "linf")):
@@ -71,7 +72,7 @@ class Report:
             n_contacts=len(g.contacts), **eps)
 
 
-def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
+def certify_grasp(grasp: Grasp, *, method: Method = "fast", solver=None,
                   tol: Tolerances = Tolerances(), quality: bool = True, eps_gap: float = 0.01,
                   eps_budget: int = 200_000, eps_time: float | None = None) -> Report:
     """Certify one grasp end to end: force and form closure, the re-check of both certificates
@@ -86,7 +87,7 @@ def certify_grasp(grasp: Grasp, *, method: str = "fast", solver=None,
         Compute the epsilons (with the grasp's ``center`` and ``length``).
     eps_gap, eps_budget
         Spatial epsilon: relative gap to reach and most work (see
-        :func:`qualgrasp.certify.quality.epsilon`).
+        :func:`qualgrasp.certify.quality.bounds.epsilon`).
     eps_time : float, optional
         Time limit of the quality computation for this grasp, in seconds (both norms
         together); when it is hit the epsilons are the bounds reached, flagged ``limited``
@@ -152,9 +153,9 @@ def verify_row(grasp: Grasp, row: dict[str, Any], tol: Tolerances = Tolerances()
     * ``status`` and ``form_status`` agree with ``force_closure`` and ``form_closure`` and are
       proved by their certificates (:func:`qualgrasp.certify.verify`, exact rationals); each
       margin is 0 without closure and otherwise the margin the certificate's values certify, to
-      within :func:`qualgrasp.certify.certificates.margin_tolerance` either way;
+      within :func:`qualgrasp.certify.core.certificates.margin_tolerance` either way;
     * the epsilon columns are proved by their evidence
-      (:func:`qualgrasp.certify.evidence.verify_epsilon`).
+      (:func:`qualgrasp.certify.quality.evidence.verify_epsilon`).
 
     Returns
     -------

@@ -18,7 +18,7 @@ Search (:func:`search`), on ``Budget.samples`` contacts evenly spaced by arc len
   coordinate ascent: for each finger in turn try every other sample in its place and keep the best
   if it improves epsilon; at most ``Budget.rounds`` rounds.
 
-Every candidate is screened by :func:`qualgrasp.certify.fastpath.planar_screen` (the compiled columnar
+Every candidate is screened by :func:`qualgrasp.certify.batch.fastpath.planar_screen` (the compiled columnar
 kernels of certify: force closure proved by the float re-check, exact planar L1 epsilon; 0 when not
 proved). The ``Budget.keep`` best **distinct** candidates (each differing from every better one by
 at least ``Budget.separation`` samples at some finger) are then certified one by one with
@@ -58,8 +58,8 @@ from scipy import ndimage
 from shapely.geometry import Polygon
 
 from qualgrasp.certify import Contact, Grasp, Report, certify_grasp
-from qualgrasp.certify.fastpath import planar_screen
-from qualgrasp.certify.steinitz import edge_samples
+from qualgrasp.certify.batch import planar_screen
+from qualgrasp.certify.quality import edge_samples
 from qualgrasp.qualitative.candidates import object_frame
 from qualgrasp.qualitative.errors import QualitativeError
 from qualgrasp.qualitative.outline import DEFAULT_SCALE, Outline, outline_contour, resample
@@ -436,10 +436,10 @@ def screen_grasps(grasps: Sequence[Grasp]) -> tuple[np.ndarray, np.ndarray]:
     """Certified force closure and L1 epsilon of many planar grasps.
 
     Grasps of point and frictionless contacts are grouped by contact pattern and screened
-    columnar (:func:`qualgrasp.certify.fastpath.planar_screen`); other contact models, and the
+    columnar (:func:`qualgrasp.certify.batch.fastpath.planar_screen`); other contact models, and the
     rows the screen does not settle, are certified one by one
     with :func:`qualgrasp.certify.certify_grasp`. A grasp counts as certified when force closure is proved
-    (columnar) or certified and verified (per grasp), as in :func:`qualgrasp.certify.fastpath.certify_table`.
+    (columnar) or certified and verified (per grasp), as in :func:`qualgrasp.certify.batch.fastpath.certify_table`.
 
     Returns
     -------

@@ -1,5 +1,5 @@
-"""Command-line layer of :mod:`qualgrasp.experiments`: ``demo``, ``figures``, ``compare`` and
-``silhouettes``; each command is a thin wrapper over a public function."""
+"""Command-line layer of :mod:`qualgrasp.experiments`: ``demo``, ``figures``, ``compare``,
+``silhouettes`` and ``bench``; each command is a thin wrapper over a public function."""
 
 from __future__ import annotations
 
@@ -13,9 +13,11 @@ from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from ..certify.checks import OptionError, count_in, output_folder
+from ..certify.cli.options import OptionError, count_in, fail, output_folder
 from ..certify.errors import CertifyError
 from . import figures
+from .bench import (print_bench, print_contacts_bench, print_quality_bench, run_bench, run_contacts_bench,
+                    run_quality_bench)
 from .demo import demo_steps, run_demo
 from .silhouettes import available_silhouettes, available_wings, write_silhouettes
 from .silhouettes import silhouettes as bundled
@@ -27,17 +29,11 @@ __all__ = ["register"]
 console = Console()
 
 
-def _fail(message: str) -> None:
-    """Print a one-line error (no markup interpreted in it) and exit with code 2."""
-    console.print("[red]error:[/red]", escape(message), soft_wrap=True)
-    raise typer.Exit(2)
-
-
 def _folder(out: Path, reads: list[Path] = ()) -> Path:
     try:
         return output_folder(out, "--out", reads=reads)
     except OptionError as err:
-        _fail(str(err))
+        fail(str(err), console)
 
 
 def register(app: typer.Typer) -> None:
@@ -46,6 +42,7 @@ def register(app: typer.Typer) -> None:
     app.command("figures")(figures_command)
     app.command("compare")(compare_command)
     app.command("silhouettes")(silhouettes_command)
+    app.command("bench")(bench_command)
 
 
 def demo_command(out: Path = typer.Option(Path("qualgrasp-demo"), "--out", help="Output folder.")) -> None:
@@ -62,7 +59,7 @@ def demo_command(out: Path = typer.Option(Path("qualgrasp-demo"), "--out", help=
         try:
             result = run_demo(out, progress=lambda message: bar.update(task, advance=1, description=message))
         except CertifyError as err:  # an output the run may not write (a file in the way, a full disk)
-            _fail(str(err))
+            fail(str(err), console)
     table = Table(title="synthesis on the built-in objects, certified and re-checked")
     for col in ("object", "outline", "route", "grasps", "certified", "median eps"):
         table.add_column(col, no_wrap=True)
@@ -100,7 +97,7 @@ def figures_command(out: Path = typer.Option(Path("qualgrasp-figures"), "--out",
     try:
         paths = figures.make_figures(out, formats=kinds, progress=lambda message: console.print(message))
     except CertifyError as err:
-        _fail(str(err))
+        fail(str(err), console)
     for path in paths:
         console.print(f"wrote {path}", soft_wrap=True)  # paths stay whole, for copy and paste
     console.print(f"{len(paths)} files in {out}", soft_wrap=True)
@@ -140,7 +137,7 @@ def compare_command(
         if trials is not None:
             count_in(trials, "--trials", 1, 1000)
     except OptionError as err:
-        _fail(str(err))
+        fail(str(err), console)
     _folder(out, [folder] if folder else [])
     images: list = sorted(p for p in folder.iterdir() if p.suffix.lower() in _IMAGE_SUFFIXES) if folder else []
     images += list(BUILTINS) if builtins else []
@@ -155,7 +152,7 @@ def compare_command(
         try:
             result = compare(images, out, settings=settings, progress=_study_ticks(bar, task, settings))
         except CertifyError as err:
-            _fail(str(err))
+            fail(str(err), console)
     table = Table(title=f"{len(result.objects)} objects, {result.seconds:.0f} s; eps: certified L1 of the "
                         "grasps counted, robust: fraction still certified under vision errors; slide: "
                         "median of how far every finger of the best grasp may slide either way "
@@ -207,10 +204,41 @@ def silhouettes_command(out: Path = typer.Option(Path("qualgrasp-silhouettes"), 
         count_in(n, "--n", 0, available_silhouettes() - 1, what="(the bundled cell outlines)")
         count_in(wings, "--wings", 0, available_wings(), what="(the bundled wing outlines)")
     except OptionError as err:
-        _fail(str(err))
+        fail(str(err), console)
     _folder(out)
     try:
         paths = write_silhouettes(out, n, with_horse=horse, wings=wings)
     except (OSError, ValueError, CertifyError) as exc:
-        _fail(str(exc))
+        fail(str(exc), console)
     console.print(f"wrote {len(paths)} images into {out}", soft_wrap=True)
+
+
+def bench_command(
+    n: int = typer.Option(20000, "--n", help="Grasps per kind."),
+    seed: int = typer.Option(0, help="Random seed of the grasps."),
+    reference_n: int = typer.Option(300, "--reference-n", help="Grasps per kind for slow routes."),
+    quality: bool = typer.Option(False, "--quality", help="Benchmark epsilon instead: gaps, times, 8-edge error."),
+    contacts: bool = typer.Option(False, "--contacts", help="Time closure and quality of one grasp per contact count "
+                                                            "(3 to 1000 point contacts, planar and spatial)."),
+) -> None:
+    """Time every certification route on the same random grasps, with ratios to the batch path.
+
+    Routes: the batch path, the per-grasp fast route, clarabel, linprog, cvxpy with Parameters
+    and cvxpy rebuilt per grasp; prints grasps per second and each route's ratio.
+
+    With --quality: epsilon bound gaps and time per grasp, and the error of the 8-edge cone
+    linearisation other toolkits use, on --n random grasps in closure per kind.
+
+    With --contacts: seconds per grasp of closure and of quality (both epsilons with their
+    evidence, no time limit) for one grasp in closure with 3, 10, 50, 200 and 1000 point
+    contacts, planar and spatial (about a minute).
+    """
+    if n < 1 or reference_n < 0:
+        fail(f"--n must be at least 1 and --reference-n at least 0, got {n} and {reference_n}")
+
+    if contacts:
+        print_contacts_bench(run_contacts_bench(seed=seed))
+    elif quality:
+        print_quality_bench(run_quality_bench(n=n, seed=seed))
+    else:
+        print_bench(run_bench(n=n, seed=seed, reference_n=reference_n))

@@ -21,11 +21,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from qualgrasp.certify.batch import Summary, certify_file, verify_file
-from qualgrasp.certify.engine import RunSummary
-from qualgrasp.certify.io import write_grasps
-from qualgrasp.certify.outputs import atomic_output
-from qualgrasp.certify.samples import textbook_grasps
+from qualgrasp.certify.batch import RunSummary, Summary, certify_file, textbook_grasps, verify_file
+from qualgrasp.certify.files import atomic_output, write_grasps
 from qualgrasp.qualitative.objects import render
 from qualgrasp.qualitative.synthesis import MU, synthesize
 

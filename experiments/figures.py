@@ -50,8 +50,7 @@ from matplotlib.patches import Circle, Patch, Polygon as MplPolygon, Wedge
 from shapely.geometry import Polygon as ShapelyPolygon
 
 from qualgrasp.certify import Contact, Grasp, Report, Verdict, certify_grasp, positive_span
-from qualgrasp.certify.region_certify import RegionVerdict, certify_regions
-from qualgrasp.certify.region_data import CurvedRegion, RegionTuple, StraightRegion
+from qualgrasp.certify.regions import CurvedRegion, RegionTuple, RegionVerdict, StraightRegion, certify_regions
 from qualgrasp.qualitative.candidates import separated
 from qualgrasp.qualitative.forcegrasp import GAP, ForceGrasp, friction_zone, positively_spans, span_margin
 from qualgrasp.qualitative.formgrasp import zone_steps

@@ -46,7 +46,7 @@ from ..certify.meshes.poses import grasp_of
 from ..certify.meshes.rays import RayCaster
 from ..certify.meshes.sampling import sample_poses
 from ..certify.meshes.task import G, check_bound, hold_verdict, least_grip
-from ..certify.wrench import contact_frame, wrench
+from ..certify.core.wrench import contact_frame, wrench
 
 __all__ = ["made_up_meshes", "real_meshes", "independent_travel", "edge8_forces", "edge8_holds", "in_exact_cones",
            "real_study", "main"]

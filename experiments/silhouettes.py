@@ -61,7 +61,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import shapely
-from qualgrasp.certify.outputs import atomic_output
+from qualgrasp.certify.files import atomic_output
 from qualgrasp.qualitative.objects import normalise, place, render_polygon
 from scipy import ndimage
 from scipy.interpolate import splev, splprep

@@ -12,7 +12,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from qualgrasp.certify.outputs import atomic_output
+from qualgrasp.certify.files import atomic_output
 
 from .design import (GRASP_COLUMNS, KINDS, OBJECT_COLUMNS, OVERALL_COLUMNS, REASONS, ROBUSTNESS_COLUMNS,
                      UNITS, RouteSummary, Settings, routes)

@@ -22,7 +22,7 @@ from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from qualgrasp.certify.outputs import atomic_output
+from qualgrasp.certify.files import atomic_output
 from qualgrasp.qualitative.grasp_plot import CONE, TCOLOR, ZMINUS, ZPLUS
 from qualgrasp.qualitative.objects import BACKGROUND, FOREGROUND
 from qualgrasp.qualitative.plot import STYLE as CURVATURE

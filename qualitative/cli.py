@@ -8,12 +8,12 @@ from pathlib import Path
 
 import typer
 
-from ..certify.checks import FIGURE_SUFFIXES, number_in, optional_number_in, output_file
-from ..certify.outputs import atomic_output
+from ..certify.cli.options import FIGURE_SUFFIXES, number_in, optional_number_in, output_file
+from ..certify.files import atomic_output
 from ..certify.errors import CertifyError
-from ..certify.io import write_grasps
+from ..certify.files import write_grasps
 from ..certify.models import MAX_MU
-from ..certify.region_boundary import SEARCH_BUDGET
+from ..certify.regions.boundary import SEARCH_BUDGET
 from . import procedures
 from .errors import FormulaError, QualitativeError, TraceError
 from .grasp_plot import synthesis_figure
@@ -86,7 +86,7 @@ def _scale_words(used: float, given: float | None, finger_width: float) -> str:
 
 
 def _save(figure, path: Path, dpi: int, reads: list[Path]) -> None:
-    """Save a figure through :func:`qualgrasp.certify.outputs.atomic_output` (never an input,
+    """Save a figure through :func:`qualgrasp.certify.files.outputs.atomic_output` (never an input,
     one writer at a time), or exit 2 saying why it could not be written (a full disk, ...)."""
     try:
         with atomic_output(path, "--plot", reads=reads) as tmp:

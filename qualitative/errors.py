@@ -6,6 +6,8 @@ of input was wrong. Messages name the problem and, where there is one, the fix.
 
 from __future__ import annotations
 
+from ..certify.errors import QualgraspError
+
 __all__ = [
     "QualitativeError",
     "ImageError",
@@ -21,7 +23,7 @@ __all__ = [
 ]
 
 
-class QualitativeError(Exception):
+class QualitativeError(QualgraspError):
     """Base class of every error raised by :mod:`qualgrasp.qualitative`."""
 
 

@@ -46,7 +46,7 @@ from functools import cache
 
 import numpy as np
 
-from ..certify.wrench import cross
+from ..certify.core import cross
 
 from .candidates import ERROR, GAP, Candidates, separated
 from .errors import SynthesisError

@@ -46,12 +46,12 @@ from typing import Any, Callable
 import numpy as np
 
 from ..certify.errors import CertifyError, GraspError
-from ..certify.grasp import Grasp, grasp_from_dict
-from ..certify.outputs import atomic_output, check_output
-from ..certify.region_boundary import SEARCH_BUDGET, IndependentRegions, bisection_tol, independent_regions
-from ..certify.region_data import tuple_to_dict
-from ..certify.table import json_lines
-from ..certify.validation import id_problem, number, show
+from ..certify.core import Grasp, grasp_from_dict
+from ..certify.files import atomic_output, check_output
+from ..certify.regions.boundary import SEARCH_BUDGET, IndependentRegions, bisection_tol, independent_regions
+from ..certify.regions import tuple_to_dict
+from ..certify.files import json_lines
+from ..certify.core.validation import id_problem, number, show
 from .errors import QualitativeError
 from .outline import DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_contour, planning_scale
 from .regions import ALPHA, ALPHA_MAX, FINGER_WIDTH, MARGIN, Region, feasible_regions, planning_regions
@@ -322,14 +322,14 @@ def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str 
     QualitativeError
         The image cannot be read or holds no single object.
     GraspFileError
-        The grasp set cannot be read as a whole (:func:`qualgrasp.certify.table.json_lines`: not
+        The grasp set cannot be read as a whole (:func:`qualgrasp.certify.files.reader.json_lines`: not
         a regular file, not JSON Lines); a bad line is an error row.
     OptionError
         The output is an input (the grasp set, the image, the mask; through any link), a
         folder, a FIFO or a device, or another run is writing it
-        (:func:`qualgrasp.certify.outputs.atomic_output`).
+        (:func:`qualgrasp.certify.files.outputs.atomic_output`).
     GraspError
-        ``tol`` is below :data:`qualgrasp.certify.region_boundary.TOL_FLOOR` of the object's size.
+        ``tol`` is below :data:`qualgrasp.certify.regions.boundary.TOL_FLOOR` of the object's size.
     """
     grasps_path, out_path = Path(grasps_path), Path(out_path)
     reads = [grasps_path, *(p for p in (image, mask) if isinstance(p, (str, Path)))]
@@ -356,7 +356,7 @@ def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str 
 
 def _line_row(image, number: int, value: Any, outline: Outline, contour: np.ndarray, cache: dict, *, alpha,
               finger_width, margin, scale, symmetric, tol, budget, normal_tol) -> dict:
-    """The results row of grasp line ``number`` (``value`` as :func:`qualgrasp.certify.table.json_lines`
+    """The results row of grasp line ``number`` (``value`` as :func:`qualgrasp.certify.files.reader.json_lines`
     reads it: a JSON value, or the error that made the line unreadable)."""
     gid = value.get("id") if isinstance(value, dict) and id_problem(value.get("id")) is None else None
     try:

@@ -114,7 +114,7 @@ import numpy as np
 from ..certify import Contact, Grasp, Report, certify_grasp
 from ..certify.errors import GraspError
 from ..certify.quality import epsilon
-from ..certify.region_boundary import IndependentRegions
+from ..certify.regions import IndependentRegions
 from . import procedures as registry
 from .candidates import ERROR, INSET, PER_REGION, STEP, Candidates, candidates, object_frame
 from .errors import SynthesisError

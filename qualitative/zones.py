@@ -76,7 +76,7 @@ import shapely
 from shapely.geometry import MultiPoint
 from shapely.geometry.base import BaseGeometry
 
-from ..certify.wrench import cross, wrench
+from ..certify.core.wrench import cross, wrench
 
 from .errors import ZoneError
 
@@ -302,7 +302,7 @@ def twist_constraints(points, normals, center=None, length=None) -> tuple[np.nda
 
 
 def unit_wrenches(points, normals, center, length) -> np.ndarray:
-    """The frictionless contacts' wrenches (certify's :func:`qualgrasp.certify.wrench.wrench` of the unit
+    """The frictionless contacts' wrenches (certify's :func:`qualgrasp.certify.core.wrench.wrench` of the unit
     inward normals, torques about ``center`` divided by ``length``), each scaled to unit norm:
     the constraint vectors ``a_i`` of the free twists, ``(..., 3)``."""
     a = wrench(np.asarray(points, dtype=np.float64), np.asarray(normals, dtype=np.float64),

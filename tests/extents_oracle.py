@@ -7,7 +7,7 @@ import itertools
 import numpy as np
 from scipy.optimize import linprog
 
-from qualgrasp.certify.region_data import StraightRegion
+from qualgrasp.certify.regions import StraightRegion
 
 
 def edge_wrenches(points, normals, mus, center, length) -> np.ndarray:

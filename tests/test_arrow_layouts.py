@@ -17,7 +17,7 @@ import pytest
 
 from qualgrasp.certify import Options, certify_arrow
 from qualgrasp.certify.batch import certify_file
-from qualgrasp.certify.table import table_to_rows
+from qualgrasp.certify.files import table_to_rows
 
 N = 10_000
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from qualgrasp.certify import Certificate, certify_grasp, force_closure, form_closure, verify
-from qualgrasp.certify.bench import KINDS
-from qualgrasp.certify.samples import random_grasps, textbook_grasps
+from qualgrasp.experiments.bench import KINDS
+from qualgrasp.certify.batch import random_grasps, textbook_grasps
 
 KIND_GRASPS = {kind: random_grasps(7, 150, **kw) for kind, kw in KINDS.items()}
 

@@ -6,8 +6,8 @@ import pytest
 from typer.testing import CliRunner
 
 from qualgrasp.certify.batch import certify_file, verify_file
-from qualgrasp.certify.io import write_grasps
-from qualgrasp.certify.samples import random_grasps, textbook_grasps
+from qualgrasp.certify.files import write_grasps
+from qualgrasp.certify.batch import random_grasps, textbook_grasps
 from qualgrasp.cli import app
 
 runner = CliRunner()

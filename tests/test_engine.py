@@ -10,8 +10,8 @@ import pytest
 
 from qualgrasp.certify import Grasp
 from qualgrasp.certify.batch import certify_file, verify_file
-from qualgrasp.certify.io import read_results, write_grasps
-from qualgrasp.certify.samples import random_grasps, textbook_grasps
+from qualgrasp.certify.files import read_results, write_grasps
+from qualgrasp.certify.batch import random_grasps, textbook_grasps
 
 from helpers import signal_after
 

@@ -5,12 +5,12 @@ import pytest
 
 from qualgrasp.certify import Contact, Grasp
 from qualgrasp.certify.batch import verify_file
-from qualgrasp.certify.chunk import Options, certify_values
-from qualgrasp.certify.table import table_values
-from qualgrasp.certify.fastpath import certify_table
-from qualgrasp.certify.grasp import grasp_to_dict
-from qualgrasp.certify.samples import random_grasp_table, random_grasps, textbook_grasps
-from qualgrasp.certify.table import grasps_table, rows_to_table, table_to_rows
+from qualgrasp.certify.batch.chunk import Options, certify_values
+from qualgrasp.certify.files import table_values
+from qualgrasp.certify.batch import certify_table
+from qualgrasp.certify.core import grasp_to_dict
+from qualgrasp.certify.batch import random_grasp_table, random_grasps, textbook_grasps
+from qualgrasp.certify.files import grasps_table, rows_to_table, table_to_rows
 
 
 def _both(table, options):
@@ -92,7 +92,7 @@ def test_bulk_recheck_rejects_tampered_rows(tmp_path):
         Grasp(g.contacts, id=f"s{i}") for i, g in enumerate(
             random_grasps(5, 60, dim=3, n_contacts=3, model="point", spread=0.3))]
     gpath, rpath = tmp_path / "g.parquet", tmp_path / "r.parquet"
-    from qualgrasp.certify.io import write_grasps
+    from qualgrasp.certify.files import write_grasps
 
     write_grasps(gpath, grasps)
     certify_file(gpath, rpath, quality=False, chunk_size=64)

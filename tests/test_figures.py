@@ -21,7 +21,7 @@ from qualgrasp.experiments.figures import (STEMS, fig3_outline, fig4_regions, fi
                                  fig7_three_fingers, fig8_spanning, fig9_regions, form_example, make_figures,
                                  nguyen_example, spanning_examples)
 from qualgrasp.certify import force_closure
-from qualgrasp.certify.region_certify import certify_regions
+from qualgrasp.certify.regions import certify_regions
 from qualgrasp.certify.regions import verify_regions
 from qualgrasp.qualitative.forcegrasp import friction_zone, nguyen_angles, positively_spans
 from qualgrasp.qualitative.objects import render

@@ -20,10 +20,10 @@ from typer.testing import CliRunner
 
 from qualgrasp.certify import CertifyError, GraspError, Options, certify_arrow, certify_grasp, grasp_from_dict
 from qualgrasp.certify.batch import certify_file, verify_file
-from qualgrasp.certify.chunk import certify_values
-from qualgrasp.certify.columns import grasp_columns
-from qualgrasp.certify.table import table_to_rows
-from qualgrasp.certify.validation import MAX_CONTACTS
+from qualgrasp.certify.batch.chunk import certify_values
+from qualgrasp.certify.files import grasp_columns
+from qualgrasp.certify.files import table_to_rows
+from qualgrasp.certify.core import MAX_CONTACTS
 from qualgrasp.cli import app
 from qualgrasp.qualitative.errors import FormulaError, TraceError
 from qualgrasp.qualitative.st0 import parse, read_trace

@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 trimesh = pytest.importorskip("trimesh")
 
 from qualgrasp.certify.batch import certify_file
-from qualgrasp.certify.io import read_results
+from qualgrasp.certify.files import read_results
 from qualgrasp.certify.meshes.cli import register
 
 app = typer.Typer()

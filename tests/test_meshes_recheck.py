@@ -205,7 +205,7 @@ def old_least_grip_duals(grasp, w):
     equilibrium and of the normal forces, or None when ``theta*`` is not positive."""
     import cvxpy as cp
 
-    from qualgrasp.certify.problem import grasp_system
+    from qualgrasp.certify.core.problem import grasp_system
 
     C, blocks, _ = grasp_system(grasp, socp=True)
     C = np.asarray(C, dtype=float)

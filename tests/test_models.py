@@ -16,12 +16,12 @@ from scipy.optimize import linprog
 
 from qualgrasp.certify import Contact, Grasp, GraspError, certify_grasp, force_closure, form_closure, verify
 from qualgrasp.certify import models
-from qualgrasp.certify.bench import compare_routes
-from qualgrasp.certify.chunk import Options, certify_values
-from qualgrasp.certify.fastpath import certify_table
-from qualgrasp.certify.grasp import grasp_from_dict, grasp_to_dict
-from qualgrasp.certify.samples import random_grasp_table, random_grasps
-from qualgrasp.certify.table import grasps_table, rows_to_table, table_to_rows, table_values
+from qualgrasp.experiments.bench import compare_routes
+from qualgrasp.certify.batch.chunk import Options, certify_values
+from qualgrasp.certify.batch import certify_table
+from qualgrasp.certify.core import grasp_from_dict, grasp_to_dict
+from qualgrasp.certify.batch import random_grasp_table, random_grasps
+from qualgrasp.certify.files import grasps_table, rows_to_table, table_to_rows, table_values
 from qualgrasp.experiments.baseline import screen_grasps
 
 

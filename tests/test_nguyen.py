@@ -3,7 +3,7 @@
 import pytest
 
 from qualgrasp.certify import Contact, Grasp, force_closure, verify
-from qualgrasp.certify.samples import random_grasps
+from qualgrasp.certify.batch import random_grasps
 from qualgrasp.certify.solvers import make_solver
 
 from helpers import nguyen

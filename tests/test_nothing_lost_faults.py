@@ -21,8 +21,8 @@ import pyarrow.parquet as pq
 import pytest
 
 from qualgrasp.certify.batch import certify_file
-from qualgrasp.certify.io import read_results, write_grasps
-from qualgrasp.certify.samples import random_grasps
+from qualgrasp.certify.files import read_results, write_grasps
+from qualgrasp.certify.batch import random_grasps
 
 from helpers import signal_after
 

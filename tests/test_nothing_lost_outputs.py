@@ -21,9 +21,9 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from qualgrasp.certify.checks import OptionError, output_file, output_folder
-from qualgrasp.certify.io import write_grasps
-from qualgrasp.certify.samples import random_grasps, textbook_grasps
+from qualgrasp.certify.cli.options import OptionError, output_file, output_folder
+from qualgrasp.certify.files import write_grasps
+from qualgrasp.certify.batch import random_grasps, textbook_grasps
 from qualgrasp.cli import app
 
 runner = CliRunner()
@@ -183,7 +183,7 @@ def test_certify_output_linked_to_the_input_is_refused(folder, link):
 
 def lock_output(path, flag):
     """A run in progress on ``path`` (the lock it holds)."""
-    from qualgrasp.certify.outputs import lock_output
+    from qualgrasp.certify.files import lock_output
 
     return lock_output(path, flag)
 
@@ -306,8 +306,8 @@ def test_write_grasps_refuses_a_fifo_and_an_input(folder):
     os.mkfifo(fifo)
     code = textwrap.dedent(f"""
         from qualgrasp.certify.errors import OptionError
-        from qualgrasp.certify.io import write_grasps
-        from qualgrasp.certify.samples import textbook_grasps
+        from qualgrasp.certify.files.writers import write_grasps
+        from qualgrasp.certify.batch.samples import textbook_grasps
         try:
             write_grasps({str(fifo)!r}, textbook_grasps())
         except OptionError as err:
@@ -322,7 +322,7 @@ def test_write_grasps_refuses_a_fifo_and_an_input(folder):
 # -- the mechanism other commands call (independent-regions, synthesize --plot, figures --out) ----
 
 def test_atomic_output_refuses_an_input_image_through_any_link(folder):
-    from qualgrasp.certify.outputs import atomic_output
+    from qualgrasp.certify.files import atomic_output
 
     image = folder / "obj.png"
     image.write_bytes(b"\x89PNG not really")
@@ -337,7 +337,7 @@ def test_atomic_output_refuses_an_input_image_through_any_link(folder):
 
 
 def test_a_failed_write_keeps_the_old_output_whole(folder):
-    from qualgrasp.certify.outputs import write_lines
+    from qualgrasp.certify.files import write_lines
 
     out = folder / "o.jsonl"
     write_lines(out, [{"id": 1}, {"id": 2}])
@@ -354,7 +354,7 @@ def test_a_failed_write_keeps_the_old_output_whole(folder):
 
 
 def test_output_folder_refuses_an_input_folder_and_output_file_a_fifo(folder):
-    from qualgrasp.certify.checks import input_file
+    from qualgrasp.certify.cli.options import input_file
 
     with pytest.raises(OptionError, match="input"):
         output_folder(folder, "--out", reads=[folder / "g.jsonl"])
@@ -380,7 +380,7 @@ def test_a_write_error_is_one_line_and_an_oserror_keeping_the_old_output(folder)
     import errno
 
     from qualgrasp.certify.errors import CertifyError
-    from qualgrasp.certify.outputs import write_lines
+    from qualgrasp.certify.files import write_lines
 
     out = folder / "o.jsonl"
     write_lines(out, [{"id": 1}])

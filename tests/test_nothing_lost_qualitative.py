@@ -9,7 +9,7 @@ import cv2
 import pytest
 from typer.testing import CliRunner
 
-from qualgrasp.certify.region_boundary import TOL_FLOOR
+from qualgrasp.certify.regions.boundary import TOL_FLOOR
 from qualgrasp.cli import app
 from qualgrasp.qualitative.objects import render
 from qualgrasp.qualitative.synthesis import synthesize

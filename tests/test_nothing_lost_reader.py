@@ -17,8 +17,8 @@ import pyarrow.parquet as pq
 import pytest
 from typer.testing import CliRunner
 
-from qualgrasp.certify.io import write_grasps
-from qualgrasp.certify.samples import random_grasps
+from qualgrasp.certify.files import write_grasps
+from qualgrasp.certify.batch import random_grasps
 from qualgrasp.cli import app
 
 runner = CliRunner()

@@ -127,7 +127,7 @@ def test_placements_inside_stay_on_the_certified_regions():
     import numpy as np
     from shapely.geometry import LineString, Point
 
-    from qualgrasp.certify.region_boundary import Boundary
+    from qualgrasp.certify.regions.boundary import Boundary
     from qualgrasp.experiments.physics.study import grasps_of, placement
     from qualgrasp.experiments.study import subjects
     from qualgrasp.qualitative.independent import outline_boundary

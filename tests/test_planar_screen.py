@@ -1,10 +1,10 @@
-"""certify.fastpath.planar_screen: the columnar kernels on arrays agree with certify_grasp."""
+"""certify.batch.fastpath.planar_screen: the columnar kernels on arrays agree with certify_grasp."""
 
 import numpy as np
 import pytest
 
 from qualgrasp.certify import Contact, Grasp, certify_grasp
-from qualgrasp.certify.fastpath import planar_screen
+from qualgrasp.certify.batch import planar_screen
 
 
 def _random_batch(rng, m, count):

@@ -11,9 +11,10 @@ from hypothesis import strategies as st
 from scipy.spatial import ConvexHull
 
 from qualgrasp.certify import Contact, Grasp, force_closure
-from qualgrasp.certify.quality import epsilon, epsilon_linearised
-from qualgrasp.certify.samples import random_grasp, random_grasps
-from qualgrasp.certify.steinitz import efficiency, steinitz_bound
+from qualgrasp.certify.quality import epsilon
+from qualgrasp.experiments.bench import epsilon_linearised
+from qualgrasp.certify.batch import random_grasp, random_grasps
+from qualgrasp.certify.quality import efficiency, steinitz_bound
 from helpers import rotation
 
 
@@ -76,7 +77,7 @@ def test_planar_epsilon_equals_qhull():
         for g in random_grasps(21, 150, dim=2, **kw):
             if force_closure(g).status != "closure":
                 continue
-            from qualgrasp.certify.wrench import generator_columns, grasp_arrays
+            from qualgrasp.certify.core.wrench import generator_columns, grasp_arrays
 
             P, N, mu, _, c, L = grasp_arrays(g)
             W, owner = generator_columns(P, N, mu, tuple(x.model for x in g.contacts), c, L)
@@ -227,7 +228,7 @@ def test_efficiency_never_exceeds_one(seed):
     rng = np.random.default_rng(seed)
     angles = np.sort(rng.uniform(0, 2 * np.pi, 7))
     poly = np.column_stack([np.cos(angles), np.sin(angles)]) * rng.uniform(0.5, 2.0)
-    from qualgrasp.certify.steinitz import boundary_contacts
+    from qualgrasp.certify.quality import boundary_contacts
 
     cs = boundary_contacts(poly, 0.05, model="point", mu=0.4)
     pick = rng.choice(len(cs), 3, replace=False)
@@ -238,10 +239,11 @@ def test_efficiency_never_exceeds_one(seed):
 # --- routes at many contacts, evidence, time limit ---------------------------------------------
 
 from qualgrasp.certify import certify_grasp  # noqa: E402
-from qualgrasp.certify import quality as quality_module  # noqa: E402
+from qualgrasp.certify.quality import bounds as quality_module  # noqa: E402
 from qualgrasp.certify._kernels.epsilon import planar_epsilon_one  # noqa: E402
-from qualgrasp.certify.evidence import planar_generator_arrays, verify_epsilon  # noqa: E402
-from qualgrasp.certify.quality import epsilons, planar_epsilons  # noqa: E402
+from qualgrasp.certify.quality.evidence import verify_epsilon  # noqa: E402
+from qualgrasp.certify.quality.gws import planar_generator_arrays  # noqa: E402
+from qualgrasp.certify.quality.bounds import epsilons, planar_epsilons  # noqa: E402
 
 PLANAR_KINDS = [dict(n_contacts=3, model="point"), dict(n_contacts=5, model="frictionless"),
                 dict(n_contacts=3, model="pad"), dict(n_contacts=8, model="point"),
@@ -346,8 +348,8 @@ def test_time_limit_keeps_the_verdict_and_states_the_bounds_reached():
 def test_default_time_limit_is_never_hit_on_small_grasps():
     """The default limit (10 s per grasp, Options.eps_time) leaves the benchmark's and the
     study's grasps (2 to 10 contacts) untouched."""
-    from qualgrasp.certify.bench import QUALITY_KINDS
-    from qualgrasp.certify.chunk import Options
+    from qualgrasp.experiments.bench import QUALITY_KINDS
+    from qualgrasp.certify.batch import Options
 
     for kwargs in QUALITY_KINDS.values():
         for g in _closure(random_grasps(16, 20, **kwargs))[:2]:

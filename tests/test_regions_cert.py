@@ -454,7 +454,7 @@ def test_a_region_of_length_zero_gives_the_point_grasps_verdict():
     """Regions of length 0 are the grasp: its verdict is certify_grasp's (closure: robust,
     no_closure: not robust with the grasp itself as witness); regions of length 1e-9 go through
     the exact LP route and agree wherever certify's margin is clear."""
-    from qualgrasp.certify.samples import random_grasps
+    from qualgrasp.certify.batch import random_grasps
     mapping = {"closure": "robust", "no_closure": "not_robust", "degenerate": "undecided"}
     agree = tiny = 0
     grasps = random_grasps(5, 150, dim=2, n_contacts=3) + random_grasps(6, 100, dim=2, n_contacts=2, model="pad")

@@ -2,8 +2,8 @@
 
 import pytest
 
-from qualgrasp.certify.bench import KINDS, compare_routes
-from qualgrasp.certify.samples import random_grasps
+from qualgrasp.experiments.bench import KINDS, compare_routes
+from qualgrasp.certify.batch import random_grasps
 
 N = 10_000
 

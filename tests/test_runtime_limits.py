@@ -9,12 +9,12 @@ import sys
 import pytest
 
 from qualgrasp.certify import certify_grasp, force_closure, grasp_to_dict
-from qualgrasp.certify.chunk import Options, certify_values
-from qualgrasp.certify.evidence import verify_epsilon
-from qualgrasp.certify.fastpath import certify_table
+from qualgrasp.certify.batch.chunk import Options, certify_values
+from qualgrasp.certify.quality import verify_epsilon
+from qualgrasp.certify.batch import certify_table
 from qualgrasp.certify.quality import epsilons
-from qualgrasp.certify.samples import random_grasps
-from qualgrasp.certify.table import grasps_table, table_to_rows, table_values
+from qualgrasp.certify.batch import random_grasps
+from qualgrasp.certify.files import grasps_table, table_to_rows, table_values
 
 # Planar grasps of every epsilon route: 21 point contacts (42 generators: the L-infinity sweep
 # and `support` evidence refined under the clock), pads, frictionless, few points; and spatial.
@@ -75,10 +75,10 @@ def test_every_bound_a_limit_changes_is_flagged(kwargs):
 _ROWS = """
 import json
 from qualgrasp.certify import grasp_to_dict
-from qualgrasp.certify.chunk import Options, certify_values
-from qualgrasp.certify.fastpath import certify_table
-from qualgrasp.certify.samples import random_grasps
-from qualgrasp.certify.table import grasps_table, rows_to_table, table_to_rows, table_values
+from qualgrasp.certify.batch.chunk import Options, certify_values
+from qualgrasp.certify.batch.fastpath import certify_table
+from qualgrasp.certify.batch.samples import random_grasps
+from qualgrasp.certify.files.reader import grasps_table, rows_to_table, table_to_rows, table_values
 
 dicts = [grasp_to_dict(g) for g in random_grasps(8, 6, dim=2, n_contacts=21, model="point")]
 dicts += [grasp_to_dict(g) for g in random_grasps(7, 4, dim=2, n_contacts=3, model="pad", mu=(0.1, 0.8))]
@@ -123,9 +123,9 @@ def test_rows_are_the_same_with_a_cold_and_a_warm_compile_cache(tmp_path):
 _NO_COMPILE_UNDER_THE_CLOCK = """
 import importlib, pkgutil
 import qualgrasp.certify._kernels as kernels
-from qualgrasp.certify import quality
-from qualgrasp.certify.closure import force_closure
-from qualgrasp.certify.samples import random_grasps
+from qualgrasp.certify.quality import bounds as quality
+from qualgrasp.certify.core.closure import force_closure
+from qualgrasp.certify.batch.samples import random_grasps
 
 grasps = (random_grasps(8, 4, dim=2, n_contacts=21, model="point") + random_grasps(7, 4, dim=2, n_contacts=3, model="pad")
           + random_grasps(5, 4, dim=2, n_contacts=4, model="frictionless") + random_grasps(4, 4, dim=2, n_contacts=9, model="point")

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from qualgrasp.certify import Contact, Grasp, force_closure, verify
-from qualgrasp.certify.problem import grasp_problem
+from qualgrasp.certify.core.problem import grasp_problem
 from qualgrasp.certify.solvers.squeeze import squeeze_solution
 
 

@@ -1,14 +1,17 @@
-"""The package's structure: one top-level name, no import cycles, no private name imported
-across modules, imports inside functions only for optional dependencies, and the registries."""
+"""The package's structure: one top-level name, its layers (certify imports nothing of the other
+halves, qualitative nothing of experiments), no import cycles, no private name imported across
+modules and no private module imported from outside its package, imports inside functions only
+for optional dependencies, and the registries. The import graph is read with ``ast``
+(``import_graph.py``)."""
 
 import ast
-import collections
 import pathlib
 import sys
 import sysconfig
 
 import pytest
 
+import import_graph
 import qualgrasp
 
 ROOT = pathlib.Path(qualgrasp.__file__).parent
@@ -19,50 +22,16 @@ ROOT = pathlib.Path(qualgrasp.__file__).parent
 LAZY = {"distributed", "resource", "qualgrasp.certify.solvers.reference", "h5py", "embreex",
         "trimesh.ray.ray_pyembree", "pymunk"}
 
-
-def _modules():
-    out = {}
-    for path in ROOT.rglob("*.py"):
-        rel = path.relative_to(ROOT)
-        if rel.parts[0] not in ("certify", "qualitative", "experiments") and len(rel.parts) > 1:
-            continue
-        if rel.parts[0] in ("tests", "docs") or "data" in rel.parts:
-            continue
-        parts = list(rel.with_suffix("").parts)
-        if parts[-1] == "__init__":
-            parts = parts[:-1]
-        out[".".join(["qualgrasp"] + parts)] = path
-    return out
-
-
-MODULES = _modules()
-
-
-def _target(module: str, node: ast.ImportFrom, is_package: bool) -> str:
-    if node.level == 0:
-        return node.module or ""
-    base = module.split(".") if is_package else module.split(".")[:-1]
-    base = base[: len(base) - (node.level - 1)]
-    return ".".join(base + ([node.module] if node.module else []))
+MODULES = import_graph.modules(ROOT)
 
 
 def _imports():
     """``(module, target, names, inside a function)`` of every import of the package."""
-    for module, path in MODULES.items():
-        tree = ast.parse(path.read_text())
-        inner = {id(n) for f in ast.walk(tree) if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef))
-                 for n in ast.walk(f) if isinstance(n, (ast.Import, ast.ImportFrom))}
-        for node in ast.walk(tree):
-            if isinstance(node, ast.ImportFrom):
-                target = _target(module, node, path.name == "__init__.py")
-                yield module, target, [a.name for a in node.names], id(node) in inner
-            elif isinstance(node, ast.Import):
-                for a in node.names:
-                    yield module, a.name, [], id(node) in inner
+    return import_graph.imports(MODULES)
 
 
 def test_modules_are_found():
-    assert {"qualgrasp.certify.grasp", "qualgrasp.qualitative.synthesis", "qualgrasp.experiments.study",
+    assert {"qualgrasp.certify.core.grasp", "qualgrasp.qualitative.synthesis", "qualgrasp.experiments.study",
             "qualgrasp.cli", "qualgrasp.certify.models.pad"} <= set(MODULES)
 
 
@@ -78,35 +47,35 @@ def test_imports_inside_functions_only_for_optional_dependencies():
 
 
 def test_no_import_cycles():
-    edges = collections.defaultdict(set)
-    for m, t, names, inner in _imports():
-        if inner or not t.startswith("qualgrasp"):
-            continue
-        for n in names or [None]:
-            full = f"{t}.{n}" if n else t
-            edges[m].add(full if full in MODULES else t)
-    seen, stack, cycles = {}, [], []
-
-    def visit(v):
-        seen[v] = 1
-        stack.append(v)
-        for w in edges.get(v, ()):
-            if w not in MODULES or w == v:
-                continue
-            if seen.get(w) == 1:
-                cycles.append(stack[stack.index(w):] + [w])
-            elif w not in seen:
-                visit(w)
-        stack.pop()
-        seen[v] = 2
-
-    sys.setrecursionlimit(10_000)
-    for v in MODULES:
-        if v not in seen:
-            visit(v)
     # a package's __init__ importing its own submodules is not a cycle unless a submodule imports
     # the package back
-    assert not cycles
+    assert not import_graph.cycles(import_graph.edges(MODULES))
+
+
+def test_the_graph_checks_find_faults():
+    assert import_graph.cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == [["a", "b", "c", "a"]]
+    assert import_graph.longest_chain({"a": {"b"}, "b": {"c"}, "c": set()}, "") == ["a", "b", "c"]
+    graph = {"q.c.regions": {"q.c.regions._branch"}, "q.c.regions.decide": {"q.c.regions._branch"},
+             "q.c.batch.chunk": {"q.c.regions._branch", "q.c._kernels.lp"}, "q.x": {"q.c._kernels.lp"}}
+    assert import_graph.private_imports(graph) == [("q.c.batch.chunk", "q.c.regions._branch"),
+                                                   ("q.x", "q.c._kernels.lp")]
+
+
+@pytest.mark.parametrize("half, never", [("qualgrasp.certify", ("qualgrasp.qualitative", "qualgrasp.experiments")),
+                                         ("qualgrasp.qualitative", ("qualgrasp.experiments",))])
+def test_layers(half, never):
+    """certify is the base layer: it imports nothing of qualitative or experiments; qualitative
+    imports nothing of experiments (inside functions neither)."""
+    graph = import_graph.edges(MODULES, inner=True)
+    bad = sorted((m, t) for m, targets in graph.items() if m.startswith(half)
+                 for t in targets if t.startswith(never))
+    assert not bad
+
+
+def test_private_modules_stay_in_their_package():
+    """A module or package whose name starts with ``_`` (``certify/regions/_branch.py``,
+    ``certify/_kernels/``) is imported only from inside the package that holds it."""
+    assert not import_graph.private_imports(import_graph.edges(MODULES, inner=True))
 
 
 def test_only_qualgrasp_is_installed_as_a_top_level_name():

@@ -12,7 +12,7 @@ from skimage import data
 from typer.testing import CliRunner
 
 from qualgrasp.certify import grasp_from_dict
-from qualgrasp.certify.io import read_results
+from qualgrasp.certify.files import read_results
 from qualgrasp.cli import app
 from qualgrasp.qualitative.candidates import object_frame
 from qualgrasp.qualitative.errors import QualitativeError, SynthesisError

@@ -8,7 +8,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from qualgrasp.certify import Contact, Grasp, certify_grasp, force_closure, form_closure, positive_span, verify
-from qualgrasp.certify.samples import CUBE_7, random_grasps, textbook_grasps
+from qualgrasp.certify.batch.samples import CUBE_7, random_grasps, textbook_grasps
 
 BOOK = {g.id: g for g in textbook_grasps()}
 

@@ -10,7 +10,7 @@ import pytest
 from typer.testing import CliRunner
 
 from qualgrasp.certify import Contact, Grasp, force_closure
-from qualgrasp.certify.region_data import StraightRegion
+from qualgrasp.certify.regions import StraightRegion
 from qualgrasp.certify.regions import verify_regions
 from qualgrasp.cli import app
 from qualgrasp.experiments.study import evaluate_object, subjects

@@ -24,10 +24,10 @@ from typer.testing import CliRunner
 
 from qualgrasp.certify import Contact, Grasp
 from qualgrasp.certify.batch import certify_file, verify_file
-from qualgrasp.certify.io import write_grasps
-from qualgrasp.certify.results import NAMES, RESULT_SCHEMA
-from qualgrasp.certify.samples import random_grasps
-from qualgrasp.certify.table import rows_to_table, table_to_rows
+from qualgrasp.certify.files import write_grasps
+from qualgrasp.certify.files import NAMES, RESULT_SCHEMA
+from qualgrasp.certify.batch import random_grasps
+from qualgrasp.certify.files import rows_to_table, table_to_rows
 from qualgrasp.cli import app
 
 KINDS = ("changed", "halved", "doubled", "negative", "nan", "null", "deleted", "wrong_type",

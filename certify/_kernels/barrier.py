@@ -46,7 +46,7 @@ def _barrier_terms(y, Pm, T, rk, kappa, K, q, u, psi, Ty):
 
 @kernel
 def socp_dual_barrier(Pm, T, rk, kappa, exit_below, gap_tol, max_newton):
-    """The spatial closure SOCP (see :mod:`qualgrasp.certify.problem`) through its dual, by a barrier method.
+    """The spatial closure SOCP (see :mod:`qualgrasp.certify.core.problem`) through its dual, by a barrier method.
 
     Per contact block ``b`` the support of its unit-normal-force wrenches along ``y`` is
     ``c_b(y) = p_b . y + kappa_b norm(T_b y)`` (``p_b`` the normal-force column, ``T_b`` the

@@ -1,8 +1,8 @@
-"""Cone tests in floating point, compiled (numba): the formulas of :mod:`qualgrasp.certify.cones`.
+"""Cone tests in floating point, compiled (numba): the formulas of :mod:`qualgrasp.certify.core.cones`.
 
 Cone blocks are given as arrays ``(cone, first, width, n, mu, g)``
-(:func:`qualgrasp.certify.problem.block_arrays`): the cone shape code (:data:`~qualgrasp.certify.cones.RAY`
-or :data:`~qualgrasp.certify.cones.LORENTZ`), the block's first certificate column and its
+(:func:`qualgrasp.certify.core.problem.block_arrays`): the cone shape code (:data:`~qualgrasp.certify.core.cones.RAY`
+or :data:`~qualgrasp.certify.core.cones.LORENTZ`), the block's first certificate column and its
 number of columns, its stored normal (zeros for rays), friction coefficient and moment length
 (a Lorentz block's columns beyond the dimension of ``n`` are moment columns weighted by ``g``).
 """
@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..cones import RAY
+from ..core.cones import RAY
 from .jit import kernel
 
 __all__ = ["functional", "polar_value", "polar_values", "farkas_direction", "squeeze_direction"]
@@ -54,7 +54,7 @@ def polar_value(a, cone, width, n, mu, g):
 @kernel
 def polar_values(C, cone, first, width, n, mu, g, y):
     """:func:`polar_value` of every block for the functional ``a = C_b' y`` (the same formula
-    for every route: see :mod:`qualgrasp.certify.cones`)."""
+    for every route: see :mod:`qualgrasp.certify.core.cones`)."""
     out = np.empty(cone.shape[0])
     a = np.empty(C.shape[1])
     for b in range(cone.shape[0]):
@@ -65,7 +65,7 @@ def polar_values(C, cone, first, width, n, mu, g, y):
 
 @kernel
 def farkas_direction(C, cone, first, width, n, mu, g, y, rel):
-    """The rule of :func:`qualgrasp.certify.closure.farkas_certificate`, compiled: ``(ok, y,
+    """The rule of :func:`qualgrasp.certify.core.closure.farkas_certificate`, compiled: ``(ok, y,
     tight)``.
 
     ``y`` is normalised; if every block's polar value is below ``-1e-9 scale`` (``scale`` the

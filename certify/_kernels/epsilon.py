@@ -6,7 +6,7 @@ Two routes: :func:`planar_epsilon` enumerates the candidate normals (triples of 
 L1, pairs of edges for L-infinity), ``O(k^4)`` and ``O(k^3)`` for ``k`` generators, the fastest
 for a handful of contacts; :func:`linf_sweep` finds the L-infinity candidates by a sweep around
 the great circle orthogonal to each edge, ``O(k^2 log k)`` in all (the L1 route for many
-generators is the convex hull, in :mod:`qualgrasp.certify.quality`).
+generators is the convex hull, in :mod:`qualgrasp.certify.quality.bounds`).
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Planar grasps in one compiled pass per grasp (numba): generator wrenches with error bounds,
 the closure LP in closed form, certificates re-checked in floating point, and the exact planar
-epsilon (:func:`planar_batch`, the columnar path of :mod:`qualgrasp.certify.fastpath`)."""
+epsilon (:func:`planar_batch`, the columnar path of :mod:`qualgrasp.certify.batch.fastpath`)."""
 
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ DUAL_BELOW = 1e-3
 @kernel
 def planar_generators(P, N, mu, width, c, L, owner, offset, friction, W, E):
     """Generator wrenches ``W`` (3, k) of one planar grasp, with the arithmetic of
-    :func:`qualgrasp.certify.wrench.generator_columns` (same operations, same order, so the same
+    :func:`qualgrasp.certify.core.wrench.generator_columns` (same operations, same order, so the same
     floats), and bounds ``E`` on their distance to the exact values on the same data.
 
     Generator ``j`` of contact ``i = owner[j]`` is the force ``f = n + (friction_j mu_i) t``
@@ -73,7 +73,7 @@ def planar_generators(P, N, mu, width, c, L, owner, offset, friction, W, E):
 def _classify(Wb, Eb, combos, feas, margin, residual_tol, C, D, buf, R, used, lam, y, basis,
               rays, first, ones, zeros2, zeros1, no_tight):
     """Verdict of one planar generator matrix, settled only where the per-grasp rules of
-    :func:`qualgrasp.certify.closure.decide` give it without exact arithmetic and the certificate is proved
+    :func:`qualgrasp.certify.core.closure.decide` give it without exact arithmetic and the certificate is proved
     by the float re-check: 1 closure (``lam``, ``basis``), 2 strict Farkas (``y``), 3 null-space
     Farkas (``y``, fewer than 3 generators), 0 not settled. Returns ``(code, t)``. The block
     layout of the re-check (every generator a ray: ``rays`` 0, ``first`` 0..k-1, ``ones`` (k,)

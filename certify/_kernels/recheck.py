@@ -2,16 +2,16 @@
 
 Columns ``C`` come with bounds ``E`` on their distance to the exact columns of the same float
 data; every rounding of the check itself is bounded with :func:`~.linalg.gamma`. A check that
-passes proves what the exact rational checker (:mod:`qualgrasp.certify.certificates`) would
+passes proves what the exact rational checker (:mod:`qualgrasp.certify.core.certificates`) would
 prove; one that fails proves nothing (the caller then uses the exact checker). Cone blocks are
-given as arrays ``(cone, first, width, n, mu, g)`` (:func:`qualgrasp.certify.problem.block_arrays`).
+given as arrays ``(cone, first, width, n, mu, g)`` (:func:`qualgrasp.certify.core.problem.block_arrays`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..cones import RAY
+from ..core.cones import RAY
 from .cones import polar_values
 from .jit import kernel
 from .linalg import U, gamma, inverse_norm_bound, pivot_basis_into, projection_bound
@@ -166,7 +166,7 @@ def certify_rows(C, E, cone, first, width, N, mu, g, values, y, closure, farkas,
                  residual_tol):
     """Per row of a batch (B, d, k): for ``closure`` rows choose the basis and prove the
     interior certificate ``values``; for ``farkas`` rows check the strict separation rule of
-    :func:`qualgrasp.certify.closure.farkas_certificate` (every polar value below ``-1e-9 scale``) and prove
+    :func:`qualgrasp.certify.core.closure.farkas_certificate` (every polar value below ``-1e-9 scale``) and prove
     it. Returns codes (1 closure, 2 strict Farkas, 0 not settled) and the bases."""
     B, d, k = C.shape
     code = np.zeros(B, dtype=np.int64)

@@ -1,4 +1,4 @@
-"""The bound of :mod:`qualgrasp.certify.region_branch`, compiled (numba).
+"""The bound of :mod:`qualgrasp.certify.regions._branch`, compiled (numba).
 
 For each item ``b`` (a cell of wrench directions, a contact and a piece of its region): the
 minimum over the vertex combinations ``(y, q, n)`` (4 each) of ``sum_g W[c, g] F_g`` with

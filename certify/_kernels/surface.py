@@ -1,6 +1,6 @@
 """Rigorous floating-point checks of epsilon evidence (numba): the faces of an inscribed surface
 and the support function of a planar GWS, with error bounds instead of rationals (the float half
-of :mod:`qualgrasp.certify.evidence`; the exact half decides whatever these cannot).
+of :mod:`qualgrasp.certify.quality.evidence`; the exact half decides whatever these cannot).
 
 Vertex coordinates ``V`` come with bounds ``EV`` on their distance to the exact values. A
 determinant computed from floats by Leibniz's formula (a signed sum of products of ``d - 1``

@@ -20,9 +20,9 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
-from ..checks import OptionError, number_in, output_file
+from ..cli.options import OptionError, number_in, output_file
 from ..errors import CertifyError
-from ..table import grasps_table, is_parquet
+from ..files.reader import grasps_table, is_parquet
 from .contacts import RESOLUTION, TOLERANCE, fingertip_contacts, jaw_contacts
 from .errors import PoseError
 from .gripper import CONVENTIONS, ParallelJaw, builtin_grippers, load_gripper

@@ -56,7 +56,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..validation import number, show
+from ..core.validation import number, show
 from .errors import GripperError, PoseError
 
 __all__ = ["ParallelJaw", "PointHand", "Gripper", "CONVENTIONS", "builtin_grippers", "load_gripper",

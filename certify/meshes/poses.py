@@ -3,7 +3,7 @@
 Pose files
 ----------
 JSON Lines or Parquet (recognised by content, read in chunks by certify's reader,
-:func:`qualgrasp.certify.table.iter_chunks`), one pose per line or row:
+:func:`qualgrasp.certify.files.reader.iter_chunks`), one pose per line or row:
 
 * parallel jaws: ``pose`` (4x4, nested or 16 numbers row-major) in the file's convention
   (:mod:`qualgrasp.certify.meshes.gripper`), ``width`` (opening, m; default the gripper's
@@ -37,9 +37,9 @@ from typing import Any, Iterator
 import numpy as np
 
 from ..errors import GraspFileError
-from ..grasp import Contact, Grasp, grasp_to_dict
-from ..table import chunk_values, iter_chunks
-from ..validation import number, numbers, show
+from ..core.grasp import Contact, Grasp, grasp_to_dict
+from ..files.reader import chunk_values, iter_chunks
+from ..core.validation import number, numbers, show
 from .contacts import Outcome
 from .errors import PoseError, PoseFileError
 from .gripper import CONVENTIONS, Gripper, ParallelJaw, check_pose, to_qualgrasp

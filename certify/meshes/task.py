@@ -6,7 +6,7 @@ The programme
 A grasp's contacts (certify's cones: exact Lorentz cones for ``point`` and ``soft`` contacts,
 rays for frictionless ones) hold the object of mass ``m`` with centre of mass ``com`` against
 gravity ``g d`` (``d`` a unit direction, ``g`` = :data:`G`) when forces ``x`` on certify's
-certificate columns ``C`` (:func:`qualgrasp.certify.problem.grasp_system`; torques about the
+certificate columns ``C`` (:func:`qualgrasp.certify.core.problem.grasp_system`; torques about the
 grasp's ``center``, divided by its ``length``) satisfy
 
     C x + w(d) = 0,   x_b in K_b for every contact b,   nu_b(x) <= s for every contact b,
@@ -21,14 +21,14 @@ x_b in K_b, nu_b(x) <= 1`` (always feasible and bounded): ``s* = 1 / theta*``.
 Certificates (re-checked here without any solver, in exact rational arithmetic on the floats)
 -----------------------------------------------------------------------------------------------
 ``holds at s``: forces ``x``. The checker forms the exact residual ``r = C x + w`` and solves
-``C_B delta = -r`` exactly on a basis ``B`` of the columns (:mod:`qualgrasp.certify.exact`); the
-corrected forces must lie strictly inside every cone (:func:`qualgrasp.certify.cones.inside`)
+``C_B delta = -r`` exactly on a basis ``B`` of the columns (:mod:`qualgrasp.certify.core.exact`); the
+corrected forces must lie strictly inside every cone (:func:`qualgrasp.certify.core.cones.inside`)
 and have ``nu_b < s``. That exhibits exact forces holding the weight at grip force ``s``.
 
 ``slips at s`` (no forces exist at grip force ``s``): a Farkas certificate, a wrench functional
 ``y`` and multipliers ``lambda_b >= 0``, with a set of ``tight`` contacts that ``y`` is projected
 orthogonal to (exactly), such that for every other contact ``a_b = C_b' y - lambda_b nu_b`` lies
-strictly in the polar cone (:func:`qualgrasp.certify.cones.polar`) and ``-y . w > s sum lambda_b``.
+strictly in the polar cone (:func:`qualgrasp.certify.core.cones.polar`) and ``-y . w > s sum lambda_b``.
 For any forces in the cones with ``nu_b <= s``: ``-y . w = y . C x = sum_b a_b . x_b + sum_b
 lambda_b nu_b(x_b) <= s sum_b lambda_b``, a contradiction. With ``lambda = 0`` it proves that no
 grip force at all holds the weight (for example two point contacts and a weight off the line
@@ -63,7 +63,7 @@ ball, every unit ``d`` is a convex combination of the ``v_j``, and by sublineari
 certified by a Farkas certificate at the worst ``u_j`` (with ``|u_j| <= 1`` exactly) and by
 forces at every ``v_j`` (the checker also checks exactly that the faces of the ``v_j`` polytope
 are closed, positively oriented and at least 1 from the origin,
-:func:`qualgrasp.certify.evidence.exact_face`). ``r`` is 0.795 for the icosahedron (level 0),
+:func:`qualgrasp.certify.quality.evidence.exact_face`). ``r`` is 0.795 for the icosahedron (level 0),
 0.934 at level 1 (42 directions), 0.982 at level 2 (162) and 0.995 at level 3 (642).
 
 Closed form (the tests): a box of mass ``m`` held across two opposite faces by two point contacts
@@ -83,14 +83,14 @@ import numpy as np
 import scipy.sparse as sp
 import trimesh
 
-from .. import cones
-from .. import exact as ex
-from ..certificates import Check
-from ..evidence import cycle_check, exact_face
-from ..grasp import Grasp
-from ..problem import Block, grasp_system
+from ..core import cones
+from ..core import exact as ex
+from ..core.certificates import Check
+from ..quality.evidence import cycle_check, exact_face
+from ..core.grasp import Grasp
+from ..core.problem import Block, grasp_system
 from ..solvers.clarabel_direct import settings
-from ..wrench import to_exact, wrench
+from ..core.wrench import to_exact, wrench
 
 __all__ = ["G", "GripBound", "SlipCertificate", "EveryDirection", "gravity_wrench", "least_grip",
            "check_holds", "check_slips", "check_bound", "direction_polytope", "every_direction",

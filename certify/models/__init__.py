@@ -13,9 +13,15 @@ Examples
 Generator(offset=0.5, friction=1.0)
 """
 
+from typing import Literal
+
 from .base import (MAX_LENGTH, MAX_MU, MIN_LENGTH, ContactModel, Generator, Param, get, models,
                    names, register)
 from . import frictionless, point, soft, pad  # noqa: E402,F401  (registration, in code order)
 
-__all__ = ["ContactModel", "Param", "Generator", "register", "get", "names", "models",
+__all__ = ["ModelName", "ContactModel", "Param", "Generator", "register", "get", "names", "models",
            "MAX_MU", "MAX_LENGTH", "MIN_LENGTH"]
+
+#: The name of a built-in contact model, as validation accepts it (a model registered later with
+#: :func:`register` is accepted too, by its name).
+ModelName = Literal["frictionless", "point", "soft", "pad"]

@@ -30,7 +30,7 @@ the model's declaration, never re-stated elsewhere:
     the normal whose cone weight is that length parameter (the soft finger's torsional length).
     ``cone`` is the shape of the set of admissible values on those columns: ``"ray"``
     (non-negative multiples of the column) or ``"lorentz"`` (``norm((f_t, m |n| / g)) <= mu f_n``);
-    the cone tests themselves are written once per shape, in :mod:`qualgrasp.certify.cones`.
+    the cone tests themselves are written once per shape, in :mod:`qualgrasp.certify.core.cones`.
 ``frictionless``
     The model a contact becomes when friction is ignored (form closure).
 
@@ -45,6 +45,8 @@ from dataclasses import dataclass
 from typing import ClassVar, Mapping
 
 import numpy as np
+
+from ..errors import ArgumentError
 
 __all__ = ["Param", "Generator", "ContactModel", "register", "get", "names", "models",
            "MAX_MU", "MAX_LENGTH", "MIN_LENGTH"]
@@ -161,7 +163,7 @@ class ContactModel:
     def columns(self, dim: int) -> int:
         """Number of certificate columns of a contact in the conic form."""
         if self.forces is None:
-            raise ValueError(f"{self.name} contacts have no conic form")
+            raise ArgumentError(f"{self.name} contacts have no conic form")
         return (1 if self.forces == "normal" else dim) + len(self.extra)
 
     def __repr__(self) -> str:
@@ -174,7 +176,7 @@ _REGISTRY: dict[str, ContactModel] = {}
 def register(model: ContactModel) -> ContactModel:
     """Register ``model`` under its name; its code is the order of registration."""
     if model.name in _REGISTRY:
-        raise ValueError(f"contact model {model.name!r} is registered already")
+        raise ArgumentError(f"contact model {model.name!r} is registered already")
     model.code = len(_REGISTRY)
     _REGISTRY[model.name] = model
     return model

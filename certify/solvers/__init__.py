@@ -1,4 +1,4 @@
-"""Solver routes for the closure programme of :mod:`qualgrasp.certify.problem`.
+"""Solver routes for the closure programme of :mod:`qualgrasp.certify.core.problem`.
 
 Every route solves the same programme and returns a :class:`Solution`
 (:func:`make_solver` by name):
@@ -16,19 +16,32 @@ many grasps; nothing is cached globally.
 
 from __future__ import annotations
 
+from typing import Literal, get_args
+
+from ..errors import ArgumentError
 from .base import BARRIER_NEAR_ZERO, Solution
 from .clarabel_direct import ClarabelSolver
 from .enumeration import EnumerationSolver
 from .fast import FastSolver
 from .linprog import LinprogSolver
 
-__all__ = ["Solution", "BARRIER_NEAR_ZERO", "make_solver", "FastSolver"]
+__all__ = ["Solution", "BARRIER_NEAR_ZERO", "make_solver", "FastSolver", "Method", "METHODS"]
+
+#: A solver route (:func:`make_solver`).
+Method = Literal["fast", "reference", "clarabel", "enumeration", "linprog", "reference-rebuilt"]
+METHODS: tuple[str, ...] = get_args(Method)
 
 
-def make_solver(method: str = "fast"):
+def make_solver(method: Method = "fast"):
     """A solver instance for ``method`` in ``{'fast', 'reference', 'clarabel', 'enumeration',
     'linprog'}`` (``'reference-rebuilt'``: the reference formulation rebuilt for every problem,
-    as naive cvxpy code does, for benchmarks)."""
+    as naive cvxpy code does, for benchmarks).
+
+    Raises
+    ------
+    ArgumentError
+        Unknown ``method``.
+    """
     if method == "fast":
         return FastSolver()
     if method in ("reference", "reference-rebuilt"):
@@ -43,5 +56,5 @@ def make_solver(method: str = "fast"):
         return EnumerationSolver()
     if method == "linprog":
         return LinprogSolver()
-    raise ValueError(f"unknown method {method!r}; use 'fast', 'reference', 'clarabel', 'enumeration' "
+    raise ArgumentError(f"unknown method {method!r}; use 'fast', 'reference', 'clarabel', 'enumeration' "
                      "or 'linprog'")

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._kernels.barrier import socp_dual_barrier
-from ..problem import ClosureProblem
+from ..core.problem import ClosureProblem
 from .base import Solution
 
 __all__ = ["BarrierSolver", "barrier_arrays", "EXIT_BELOW", "GAP_TOL"]

@@ -17,7 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import SolverError
-from ..problem import ClosureProblem
+from ..core.problem import ClosureProblem
 from .base import Solution
 
 __all__ = ["ClarabelSolver", "settings"]

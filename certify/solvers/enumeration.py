@@ -24,7 +24,7 @@ from itertools import combinations
 import numpy as np
 
 from .._kernels.lp import lp_enumerate, lp_planar
-from ..problem import ClosureProblem
+from ..core.problem import ClosureProblem
 from .base import Solution
 
 __all__ = ["FEAS", "bases", "enumerate_lp", "solve_enumeration", "EnumerationSolver"]

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from math import comb
 
-from ..problem import ClosureProblem
+from ..core.problem import ClosureProblem
 from .barrier import BarrierSolver
 from .base import BARRIER_NEAR_ZERO, Solution
 from .clarabel_direct import ClarabelSolver

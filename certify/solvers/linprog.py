@@ -12,7 +12,7 @@ import numpy as np
 from scipy.optimize import linprog
 
 from ..errors import SolverError
-from ..problem import ClosureProblem
+from ..core.problem import ClosureProblem
 from .base import Solution
 
 __all__ = ["LinprogSolver"]

@@ -1,6 +1,6 @@
 """The readable reference formulation of the closure programme, in cvxpy (CLARABEL backend).
 
-This is the programme of :mod:`qualgrasp.certify.problem` written as it reads::
+This is the programme of :mod:`qualgrasp.certify.core.problem` written as it reads::
 
     maximise t
     subject to  columns @ x == 0, normal @ x == 1,
@@ -18,7 +18,7 @@ import cvxpy as cp
 import numpy as np
 
 from ..errors import SolverError
-from ..problem import ClosureProblem
+from ..core.problem import ClosureProblem
 from .base import Solution
 
 __all__ = ["CvxpySolver"]

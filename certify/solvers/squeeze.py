@@ -20,8 +20,8 @@ from itertools import combinations
 import numpy as np
 
 from .._kernels.cones import farkas_direction, squeeze_direction
-from ..cones import LORENTZ
-from ..problem import ClosureProblem, block_arrays
+from ..core.cones import LORENTZ
+from ..core.problem import ClosureProblem, block_arrays
 from .base import Solution
 
 __all__ = ["squeeze_solution", "squeeze_farkas"]
@@ -29,7 +29,7 @@ __all__ = ["squeeze_solution", "squeeze_farkas"]
 
 def squeeze_solution(problem: ClosureProblem) -> Solution | None:
     """``t* = 0`` with the squeeze direction of the first pair of point contacts (in index order)
-    that gives a Farkas certificate (:func:`qualgrasp.certify.closure.farkas_certificate`) with exactly
+    that gives a Farkas certificate (:func:`qualgrasp.certify.core.closure.farkas_certificate`) with exactly
     that pair tight; None if no pair does, or the system is not spatial.
 
     ``x`` is not returned: a verdict against closure does not use it.
@@ -43,8 +43,8 @@ def squeeze_solution(problem: ClosureProblem) -> Solution | None:
 
 def squeeze_farkas(C, cone, first, width, n, mu, g) -> np.ndarray | None:
     """The rule on a spatial certificate system given as block arrays
-    (:func:`qualgrasp.certify.problem.block_arrays`): the squeeze direction ``y`` (or ``-y``) of the first
-    pair of point blocks (Lorentz cones without moment columns) for which :func:`qualgrasp.certify.closure.farkas_certificate` gives a certificate
+    (:func:`qualgrasp.certify.core.problem.block_arrays`): the squeeze direction ``y`` (or ``-y``) of the first
+    pair of point blocks (Lorentz cones without moment columns) for which :func:`qualgrasp.certify.core.closure.farkas_certificate` gives a certificate
     with exactly that pair tight, else None."""
     points = np.flatnonzero((cone == LORENTZ) & (width == 3))
     for a, b in combinations(points, 2):

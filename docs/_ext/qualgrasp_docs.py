@@ -7,11 +7,11 @@ columns and public names is read from the package itself, never copied by hand.
   exactly as ``qualgrasp COMMAND --help`` prints them (``get_help_record``).
 * ``.. qualgrasp-columns:: DOTTED.NAME`` writes a table of a schema given as a sequence of
   objects with ``name``, ``type``, ``description`` and ``error`` (the results schema,
-  ``qualgrasp.certify.results.COLUMNS``).
+  ``qualgrasp.certify.files.results.COLUMNS``).
 * Math is written as MathML (``html_math_renderer = "mathml"``), which browsers render natively:
   no MathJax from a CDN, so the pages also read right offline.
 * Public names: a function or class re-exported by several modules (``qualgrasp.verify`` is
-  ``qualgrasp.certify.verify`` is ``qualgrasp.certify.certificates.verify``) gets one API page,
+  ``qualgrasp.certify.verify`` is ``qualgrasp.certify.core.certificates.verify``) gets one API page,
   under its shortest public name. :func:`public_names` finds, for every other path, that
   canonical name; the autosummary templates list such names as links rather than pages
   (``autosummary_context['elsewhere']``), and :func:`resolve_elsewhere` resolves a reference to

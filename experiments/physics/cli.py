@@ -13,7 +13,7 @@ from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from ...certify.checks import OptionError, count_in, output_folder
+from ...certify.cli.options import OptionError, count_in, output_folder
 from ..design import BUILTINS
 from ..silhouettes import available_silhouettes, available_wings
 from ..silhouettes import silhouettes as bundled

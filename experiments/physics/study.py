@@ -65,14 +65,13 @@ import numpy as np
 from scipy.stats import spearmanr
 from shapely.geometry import Polygon
 
-from qualgrasp.certify import Contact, Grasp, certify_grasp
-from qualgrasp.certify.errors import GraspError
-from qualgrasp.certify.region_boundary import Boundary as ArcBoundary
-from qualgrasp.qualitative.errors import QualitativeError
-from qualgrasp.qualitative.independent import independent_grasp, outline_boundary, planned_regions
-from qualgrasp.qualitative.outline import outline_image
-from qualgrasp.qualitative.synthesis import synthesize
-
+from ...certify import Contact, Grasp, certify_grasp
+from ...certify.errors import GraspError
+from ...certify.regions import Boundary as ArcBoundary
+from ...qualitative.errors import QualitativeError
+from ...qualitative.independent import independent_grasp, outline_boundary, planned_regions
+from ...qualitative.outline import outline_image
+from ...qualitative.synthesis import synthesize
 from ..baseline import Boundary, Budget, baseline, boundary, boundary_of_polygon, screen_grasps
 from ..design import QUICK, Route, Subject, routes
 from ..study import execute, subjects

@@ -1,0 +1,506 @@
+"""Columnar certification of a chunk of grasps: compiled kernels for whole groups at once.
+
+:func:`certify_table` takes a grasp table (any layout :func:`qualgrasp.certify.files.columns.grasp_columns`
+reads) and returns the results table (:data:`qualgrasp.certify.files.results.RESULT_SCHEMA`), row for
+row equal to what :func:`qualgrasp.certify.certify_grasp` gives grasp by grasp. Valid grasps are
+grouped by contact pattern (dimension, contact count, each contact's model and variant):
+
+* planar groups go through :func:`qualgrasp.certify._kernels.planar.planar_batch`: the LP (the
+  same kernel the per-grasp path calls), the certificate and its rigorous re-check in floating
+  point with error bounds; with quality, the exact planar epsilon and its evidence of every
+  closure row by :func:`qualgrasp.certify.quality.bounds.planar_epsilons`, the per-grasp path's own
+  function;
+* spatial groups through the compiled dual barrier method over exact cones, with clear verdicts
+  proved columnar, and near-boundary rows decided by the per-grasp rules on the arrays already
+  built (the squeeze rule, then clarabel); form closure with six or more contacts by the fast
+  solver's own route.
+
+Every row these rules do not settle (invalid input, numerically thin or near-degenerate problems,
+certificates the float re-check cannot prove, spatial rows that need the epsilon) goes through
+the per-grasp path, so the two agree by construction. This module solves; the results tables
+are built in Arrow by ``qualgrasp.certify.batch._arrow``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import pyarrow as pa
+
+from .._kernels.barrier import barrier_batch
+from .._kernels.linalg import projection_bound, world_values
+from .._kernels.planar import planar_batch, planar_generators
+from .._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
+from ..core.certificates import Tolerances, verify
+from ..core.closure import decide, farkas_from_arrays
+from ..files.columns import GraspColumns, grasp_columns
+from ..core.cones import LORENTZ, cone_code
+from ..core.grasp import Contact, Grasp
+from ..core.problem import Block, ClosureProblem, System, conic_columns, grasp_problem, grasp_system
+from ..quality.bounds import planar_epsilons
+from ..solvers import BARRIER_NEAR_ZERO, FastSolver, make_solver
+from ..solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
+from ..solvers.enumeration import FEAS, bases
+from ..solvers.squeeze import squeeze_farkas
+from ..files.reader import rows_to_table
+from ._arrow import assemble, group_table
+from .. import models as registry
+from ..core.wrench import force_column_errors, force_columns, generator_columns, generator_layout
+
+__all__ = ["certify_table", "PlanarScreen", "planar_screen"]
+
+
+def _planar_kernel(P, N, mu, width, c, L, models, variants, tol: Tolerances, quality: bool):
+    """:func:`qualgrasp.certify._kernels.planar.planar_batch` on grasps sharing the contact models
+    and variants: force and form closure (verdict codes, margins, weights, bases, directions)
+    and epsilons."""
+    owner, offset, friction = generator_layout(models, variants, 2)
+    owner_f, offset_f, friction_f = generator_layout(models, variants, 2, frictionless=True)
+    same = (np.array_equal(owner, owner_f) and np.array_equal(offset, offset_f)
+            and np.array_equal(friction, friction_f))  # frictionless contacts only: form is force
+    return planar_batch(
+        np.ascontiguousarray(P), np.ascontiguousarray(N), np.ascontiguousarray(mu),
+        np.ascontiguousarray(width), np.ascontiguousarray(c), np.ascontiguousarray(L),
+        owner, offset, friction, bases(len(owner), 3), owner_f, offset_f, friction_f,
+        bases(len(owner_f), 3), same, tol.margin, FEAS, tol.residual, quality)
+
+
+@dataclass(frozen=True, eq=False)
+class PlanarScreen:
+    """Columnar force-closure verdicts and exact epsilons of a batch of planar grasps.
+
+    Attributes
+    ----------
+    closure : numpy.ndarray
+        ``(B,)`` bool: force closure **proved** (LP optimum above the margin tolerance and the
+        interior certificate re-checked in floating point with rigorous error bounds).
+    settled : numpy.ndarray
+        ``(B,)`` bool: the columnar rules settled the verdict (closure proved, or a strict or
+        null-space Farkas certificate proved); unsettled rows (near-degenerate, tight contacts)
+        are what :func:`qualgrasp.certify.certify_grasp` decides grasp by grasp.
+    margin : numpy.ndarray
+        ``(B,)`` min-weight margin ``t*`` of force closure (``-inf`` when infeasible).
+    eps_l1, eps_linf : numpy.ndarray
+        ``(B,)`` exact Ferrari-Canny epsilon of the L1 and L-infinity grasp wrench spaces where
+        ``closure``, else 0 (with the batch's ``center`` and ``length``).
+    """
+
+    closure: np.ndarray
+    settled: np.ndarray
+    margin: np.ndarray
+    eps_l1: np.ndarray
+    eps_linf: np.ndarray
+
+
+def planar_screen(P, N, mu, center, length, *, quality: bool = True,
+                  tol: Tolerances = Tolerances()) -> PlanarScreen:
+    """Force closure and epsilon of many planar grasps sharing one contact pattern, columnar.
+
+    The same compiled kernels as :func:`certify_table` (:func:`qualgrasp.certify._kernels.planar.planar_batch`:
+    min-weight LP by basis enumeration, certificate re-checked in floating point, exact planar
+    epsilon), called directly on arrays, without building grasp tables or certificates. Use it
+    to screen large candidate sets (a grasp search); a grasp retained is then certified with
+    :func:`qualgrasp.certify.certify_grasp`, which decides exactly the rows left unsettled here.
+
+    Parameters
+    ----------
+    P, N : array_like
+        ``(B, m, 2)`` contact points and **inward** normals (normalised here).
+    mu : array_like
+        ``(B, m)`` friction coefficients; 0 is a frictionless contact. Every row must have the
+        same pattern of frictionless and ``point`` contacts.
+    center : array_like
+        ``(B, 2)`` or ``(2,)`` reference point of torques.
+    length : array_like or float
+        ``(B,)`` or scalar length dividing torques, ``> 0``.
+    quality : bool
+        Compute the epsilons (otherwise they are 0).
+    tol : Tolerances
+        Verdict tolerances (as for :func:`qualgrasp.certify.certify_grasp`).
+
+    Returns
+    -------
+    PlanarScreen
+
+    Raises
+    ------
+    ValueError
+        Shapes disagree, rows mix contact patterns, or a normal or length is not usable.
+    """
+    P = np.asarray(P, dtype=float)
+    N = np.asarray(N, dtype=float)
+    if P.ndim != 3 or P.shape[2] != 2 or N.shape != P.shape:
+        raise ValueError(f"P and N must both be (B, m, 2), got {P.shape} and {N.shape}")
+    B, m, _ = P.shape
+    mu = np.broadcast_to(np.asarray(mu, dtype=float), (B, m))
+    center = np.broadcast_to(np.asarray(center, dtype=float), (B, 2))
+    length = np.broadcast_to(np.asarray(length, dtype=float), (B,))
+    norm = np.linalg.norm(N, axis=2, keepdims=True)
+    if not (np.isfinite(P).all() and np.isfinite(N).all() and (norm >= 1e-9).all()):
+        raise ValueError("points and normals must be finite, normals non-zero")
+    if not (np.isfinite(mu).all() and (mu >= 0).all() and (length > 0).all() and np.isfinite(length).all()):
+        raise ValueError("mu must be finite and >= 0, length finite and > 0")
+    pattern = mu > 0
+    if B and not (pattern == pattern[0]).all():
+        raise ValueError("every row must have the same pattern of frictionless and point contacts")
+    N = np.where(np.abs(norm - 1.0) > 1e-12, N / norm, N)  # as certify.core.grasp.Contact stores it
+    if B == 0:
+        empty = np.zeros(0)
+        return PlanarScreen(empty.astype(bool), empty.astype(bool), empty, empty, empty)
+    models = tuple("point" if f else "frictionless" for f in pattern[0])
+    code, t, *_, eps = _planar_kernel(P, N, mu, np.zeros((B, m)), center, length, models, (0,) * m,
+                                      tol, quality)
+    closure = code == 1
+    return PlanarScreen(closure, code > 0, t, np.where(closure, eps[:, 0], 0.0),
+                        np.where(closure, eps[:, 1], 0.0))
+
+
+def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances):
+    """Certify the planar grasps ``rows`` (one contact pattern) with :func:`planar_batch`;
+    return the settled rows and their result columns."""
+    models, variants = cols.models_of(rows[0]), cols.variants_of(rows[0])
+    sizes = [len(generator_layout(models, variants, 2, frictionless=f)[0]) for f in (False, True)]
+    if not all(FastSolver.enumerates(k, 3) for k in sizes):
+        # the per-grasp fast route solves these by the barrier method: both routes give its rows
+        return np.zeros(len(rows), dtype=bool), {}
+    P, N, params = cols.contacts(rows)
+    P, N, mu, width = P[:, :, :2], N[:, :, :2], params["mu"], params["width"]
+    c, L = cols.center[rows, :2], cols.length[rows]
+    (code, t, lam, basis, y, code_f, t_f, lam_f, basis_f, y_f, _) = _planar_kernel(
+        P, N, mu, width, c, L, models, variants, tol, False)
+    settled = (code > 0) & (code_f > 0)
+    out = {"force": (code, t, lam, basis, y), "form": (code_f, t_f, lam_f, basis_f, y_f)}
+    if options.quality:
+        out["eps"] = _planar_quality(cols, rows, (code == 1) & settled, P, N, mu, width, c, L, models,
+                                     variants, options)
+    return settled, out
+
+
+def _planar_quality(cols, rows, closure, P, N, mu, width, c, L, models, variants, options):
+    """Epsilon columns of a planar group: :func:`qualgrasp.certify.quality.bounds.planar_epsilons`
+    (the per-grasp path's function, on the same generator floats) for every closure row; 0 and
+    no evidence elsewhere. Returns ``(l1_lo, l1_hi, linf_lo, linf_hi, limited, evidence)``."""
+    B, m = mu.shape
+    owner, offset, friction = generator_layout(models, variants, 2)
+    W = np.empty((3, len(owner)))
+    E = np.empty((3, len(owner)))
+    vals = np.zeros((B, 4))
+    limited = np.zeros(B, dtype=bool)
+    evidence = np.full(B, None, dtype=object)
+    for i in np.flatnonzero(closure):
+        planar_generators(P[i], N[i], mu[i], width[i], c[i], L[i], owner, offset, friction, W, E)
+        deadline = None if options.eps_time is None else time.perf_counter() + options.eps_time
+        exact = lambda i=i: grasp_system(cols.grasps([rows[i]])[0], exact=True).columns  # noqa: E731
+        eps = planar_epsilons(W, E, owner, m, deadline=deadline, exact=exact)
+        (a, b, _, ev1, lim1), (p, q, _, ev2, lim2) = eps["L1"], eps["Linf"]
+        vals[i] = a, b, p, q
+        limited[i] = lim1 or lim2
+        evidence[i] = {"l1": ev1.to_json(), "linf": ev2.to_json()}
+    return vals[:, 0], vals[:, 1], vals[:, 2], vals[:, 3], limited, evidence
+
+
+def _ray_blocks(m: int):
+    """``(cone, first, width)`` block arrays of ``m`` rays (generator columns)."""
+    return (np.zeros(m, dtype=np.int64), np.arange(m), np.ones(m, dtype=np.int64))
+
+
+def _polyhedral_rows(P, N, c, L, W, E, options, tol: Tolerances):
+    """Form closure of spatial grasps (also the force closure of frictionless ones) whose LP has
+    too many bases for a columnar rule: decided row by row exactly as the per-grasp path decides
+    it (same problem, same fast solver, same certificate), with the certificate then proved by
+    the rigorous float kernels instead of rationals (the exact checker only where floats cannot
+    decide). ``W`` and ``E`` are the frictionless generator columns and their error bounds
+    (:func:`qualgrasp.certify.core.wrench.force_column_errors`). Returns ``(code, t, lam, basis, y)`` and the tight blocks of
+    code-4 rows."""
+    B, m, d = P.shape
+    zeros = np.zeros((B, m))
+    cone, first, width = _ray_blocks(m)
+    code = np.zeros(B, dtype=np.int64)
+    t, lam = np.zeros(B), np.zeros((B, m))
+    basis, y = np.zeros((B, 2 * d), dtype=np.int64), np.zeros((B, 2 * d))
+    tight_rows = {}
+    solver = make_solver("fast")
+    for i in range(B):
+        grasp = Grasp(tuple(Contact(P[i, j], N[i, j]) for j in range(m)), center=c[i], length=L[i])
+        v = decide(grasp_problem(grasp, frictionless=True),
+                   lambda g=grasp: grasp_system(g, frictionless=True, exact=True).columns, solver, tol)
+        cert = v.certificate
+        if v.status == "closure":
+            t[i], lam[i], basis[i] = v.margin, cert.values, cert.basis
+            if not options.quality and verify_interior_general(
+                    W[i], E[i], cone, first, width, N[i], zeros[i], zeros[i], lam[i], basis[i],
+                    tol.residual):
+                code[i] = 1
+        elif v.status == "no_closure":
+            y[i] = cert.y
+            mask = np.zeros(m, dtype=bool)
+            mask[list(cert.tight)] = True
+            proved = not cert.null_space and not mask.any() and verify_farkas_general(
+                W[i], E[i], cone, first, width, N[i], zeros[i], zeros[i], y[i], mask, 0.0)
+            if proved or verify(grasp, cert, status="no_closure", frictionless=True):
+                code[i] = 3 if cert.null_space else 4 if mask.any() else 2
+                tight_rows[i] = np.flatnonzero(mask)
+    return (code, t, lam, basis, y), tight_rows
+
+
+def _polyhedral(P, N, c, L, options, tol: Tolerances):
+    """Form closure of spatial grasps with 6 or more contacts (also the force closure of
+    frictionless ones), by the fast solver's own route: LPs it solves by enumerating bases go
+    row by row (:func:`_polyhedral_rows`); larger ones, which it hands to the compiled barrier
+    method, are solved here by that method for the whole batch, and clear verdicts are proved
+    columnar. Rows near the boundary, thin, or with certificates not proved this way are decided
+    row by row. Returns ``(code, t, lam, basis, y)`` and the tight blocks of code-4 rows."""
+    B, m, d = P.shape
+    models = ("frictionless",) * m
+    zeros = np.zeros((B, m))
+    W, _ = generator_columns(P, N, zeros, models, c, L, frictionless=True, variants=(0,) * m)
+    W = np.ascontiguousarray(W)  # (B, 6, m): one ray per contact, as barrier_arrays lays it out
+    E = force_column_errors(P, N, models, c, L)
+    if FastSolver.enumerates(m, 2 * d):
+        return _polyhedral_rows(P, N, c, L, W, E, options, tol)
+    status, t, y, xn, _ = barrier_batch(np.ascontiguousarray(np.swapaxes(W, 1, 2)),
+                                        np.zeros((B, m, 1, 2 * d)), np.zeros(m, dtype=np.int64),
+                                        np.ones((B, m)), EXIT_BELOW, GAP_TOL, MAX_NEWTON)
+    sv = np.linalg.svd(W, compute_uv=False)
+    thin = sv[:, -1] <= 1e-6 * sv[:, 0]  # conservative: the per-grasp rank test is sharper
+    near = (status == 2) | (np.abs(t) < BARRIER_NEAR_ZERO)  # what FastSolver hands to clarabel
+    closure = ~thin & ~near & (status == 0) & (t >= tol.margin) & (not options.quality)
+    farkas = ~thin & ~near & (t < tol.margin)
+    values = world_values(np.ascontiguousarray(np.broadcast_to(np.eye(m), (B, m, m))), xn)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        yn = np.nan_to_num(y / np.sqrt(np.sum(y * y, axis=1, keepdims=True)))
+    cone, first, width = _ray_blocks(m)
+    code, basis = certify_rows(W, E, cone, first, width, np.ascontiguousarray(N), zeros, zeros,
+                               values, yn, closure, farkas, np.abs(W).max(axis=(1, 2)), tol.residual)
+    out = [code, np.where(code == 1, t, 0.0), values, basis, yn]
+    tight = {}
+    rest = np.flatnonzero(code == 0)
+    if len(rest):
+        sub, sub_tight = _polyhedral_rows(P[rest], N[rest], c[rest], L[rest], W[rest], E[rest],
+                                          options, tol)
+        for arr, part in zip(out, sub):
+            arr[rest] = part
+        tight = {int(rest[r]): v for r, v in sub_tight.items()}
+    return tuple(out), tight
+
+
+def _block_arrays_of(models, N, mu, params):
+    """Per-row cone block arrays of the conic form of a group sharing ``models``: ``(cone,
+    first, width)`` shared, and the per-row normals, friction and moment lengths."""
+    cone = np.array([cone_code(registry.get(name).cone) for name in models], dtype=np.int64)
+    width = np.array([registry.get(name).columns(3) for name in models], dtype=np.int64)
+    first = np.concatenate([[0], np.cumsum(width)[:-1]]).astype(np.int64)
+    g = np.zeros(mu.shape)
+    for i, name in enumerate(models):
+        extra = registry.get(name).extra
+        if extra:
+            g[:, i] = params[extra[0]][:, i]
+    return cone, first, width, np.ascontiguousarray(N), np.ascontiguousarray(mu), g
+
+
+SPATIAL_CONTACTS = 16
+"""Most contacts of a spatial grasp certified on the columnar path."""
+
+
+def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances):
+    """Certify the spatial grasps ``rows`` (one contact pattern with friction): force closure
+    by the compiled dual barrier method, form closure by the null-space direction (fewer than 6
+    contacts) or the enumerated LP, every certificate re-checked in floating point with error
+    bounds. Rows these rules do not settle (thin, near the boundary, tight contacts, unproved,
+    or needing the spatial epsilon) are left to the per-grasp path, and so are grasps of more
+    than :data:`SPATIAL_CONTACTS` contacts (the batch arrays grow with their square)."""
+    m = int(cols.count[rows[0]])
+    if m > SPATIAL_CONTACTS:
+        return np.zeros(len(rows), dtype=bool), {}
+    models = cols.models_of(rows[0])
+    P, N, params = cols.contacts(rows)
+    mu, c, L = params["mu"], cols.center[rows], cols.length[rows]
+    B = len(rows)
+    if all(name == "frictionless" for name in models):  # force closure is form closure
+        form, tight = _polyhedral(P, N, c, L, options, tol)
+        return form[0] > 0, {"force": form, "form": form, "tight": tight, "form_tight": tight}
+    # force closure: the barrier method on the solver columns
+    columns, rays, cones, to_values = conic_columns(P, N, params, models, c, L)
+    blocks = [(r, 1, np.ones(B)) for r in rays] + list(cones)
+    rmax = max(size - 1 for _, size, _ in cones)
+    Pm = np.zeros((B, len(blocks), 6))
+    T = np.zeros((B, len(blocks), rmax, 6))
+    rk = np.zeros(len(blocks), dtype=np.int64)
+    kappa = np.ones((B, len(blocks)))
+    for b, (start, size, k) in enumerate(blocks):
+        Pm[:, b] = columns[:, :, start]
+        if size > 1:
+            T[:, b, : size - 1] = np.swapaxes(columns[:, :, start + 1:start + size], 1, 2)
+            rk[b], kappa[:, b] = size - 1, k
+    status, t, y, xn, xt = barrier_batch(Pm, T, rk, kappa, EXIT_BELOW, GAP_TOL, MAX_NEWTON)
+    x = np.zeros((B, columns.shape[2]))
+    for b, (start, size, _) in enumerate(blocks):
+        x[:, start] = xn[:, b]
+        x[:, start + 1:start + size] = xt[:, b, : size - 1]
+    # the certificate system (world-frame force columns) and its error bounds
+    C, owner = force_columns(P, N, models, c, L)
+    C = np.ascontiguousarray(C)
+    E = force_column_errors(P, N, models, c, L)
+    cone, first, width, Nc, mu, g = _block_arrays_of(models, N, mu, params)
+    sv = np.linalg.svd(C, compute_uv=False)
+    thin = sv[:, -1] <= 1e-6 * sv[:, 0]
+    near = (status == 2) | ((status == 0) & (np.abs(t) < BARRIER_NEAR_ZERO))
+    closure = ~thin & ~near & (status == 0) & (t >= tol.margin)
+    if options.quality:
+        closure_ok = np.zeros(B, dtype=bool)  # the spatial epsilon is the per-grasp path's
+    else:
+        closure_ok = closure
+    values = world_values(np.ascontiguousarray(to_values), x)
+    farkas = ~thin & ~near & (t < tol.margin)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        yn = np.nan_to_num(y / np.sqrt(np.sum(y * y, axis=1, keepdims=True)))
+    scale = np.abs(C).max(axis=(1, 2))
+    funct = np.einsum("bdk,bd->bk", C, yn)
+    for b_ in range(m):
+        sel = owner == b_
+        farkas &= ~(np.abs(funct[:, sel]).max(axis=1) <= 1e-7 * scale)  # no tight contacts
+    code, basis = certify_rows(C, E, cone, first, width, Nc, mu, g, values, yn, closure_ok, farkas,
+                               scale, tol.residual)
+    # near the boundary the per-grasp rule re-solves with clarabel (tight contacts); settle those
+    # verdicts here too, with the float re-check
+    tight_rows = {}
+    # these rows are exactly those the fast solver hands from the barrier method to its
+    # near-boundary rule: the squeeze direction (tried below on the arrays), else clarabel
+    solver = make_solver("clarabel")
+
+    def grasp_of(i):
+        return cols.grasps([rows[i]])[0]
+
+    squeeze = ((cone == LORENTZ) & (width == 3)).sum() >= 2
+    for i in np.flatnonzero(near & ~thin):
+        # the squeeze rule first, on the arrays (the certificate decide makes of its direction),
+        # then the per-grasp decision on the columns already built
+        arrays = (cone, first, width, Nc[i], mu[i], g[i])
+        y_sq = squeeze_farkas(C[i], *arrays) if squeeze else None
+        if y_sq is not None:
+            status, cert = "no_closure", farkas_from_arrays(C[i], arrays, "forces", y_sq)
+        else:
+            system = System(C[i], tuple(Block(registry.get(models[b]).cone,
+                                              tuple(int(j) for j in np.flatnonzero(owner == b)),
+                                              tuple(N[i, b]), float(mu[i, b]), float(g[i, b]), b)
+                                        for b in range(m)), "forces")
+            problem = ClosureProblem(columns[i], rays, tuple((st, sz, float(k[i])) for st, sz, k in cones),
+                                     to_values[i], system)
+            v = decide(problem, lambda i=i: grasp_system(grasp_of(i), exact=True).columns, solver, tol)
+            status, cert = v.status, v.certificate
+        if status == "closure" and not options.quality:
+            values[i], basis[i], t[i] = cert.values, cert.basis, v.margin
+            if verify_interior_general(C[i], E[i], cone, first, width, Nc[i], mu[i], g[i], values[i],
+                                       basis[i], tol.residual):
+                code[i] = 1
+        elif status == "no_closure" and not cert.null_space:
+            yn[i] = cert.y
+            mask = np.zeros(m, dtype=bool)
+            mask[list(cert.tight)] = True
+            shift = 0.0
+            if mask.any():
+                shift = _tight_shift(C[i], E[i], owner, mask, models, P[i], yn[i])
+            proved = shift <= 1e-6 * np.sqrt(np.sum(yn[i] ** 2)) and verify_farkas_general(
+                C[i], E[i], cone, first, width, Nc[i], mu[i], g[i], yn[i], mask, shift)
+            # tight blocks of lower rank than their columns (two fingers squeezing) have an
+            # exact span that floats cannot certify: the exact checker decides those
+            if proved or verify(grasp_of(i), cert, status="no_closure"):
+                code[i] = 4 if mask.any() else 2
+                tight_rows[int(i)] = np.flatnonzero(mask)
+    # form closure: frictionless generators
+    Wf, _ = generator_columns(P, N, mu, models, c, L, frictionless=True, variants=(0,) * m)
+    Wf = np.ascontiguousarray(Wf)
+    Ef = force_column_errors(P, N, ("frictionless",) * m, c, L)
+    code_f = np.zeros(B, dtype=np.int64)
+    t_f = np.zeros(B)
+    lam_f = np.zeros((B, m))
+    basis_f = np.zeros((B, 6), dtype=np.int64)
+    y_f = np.zeros((B, 6))
+    if m < 6:
+        y_f = np.ascontiguousarray(np.linalg.svd(Wf)[0][:, :, -1])
+        code_f = null_rows(Wf, Ef, y_f)
+    form_tight = {}
+    if m >= 6:
+        (code_f, t_f, lam_f, basis_f, y_f), form_tight = _polyhedral(P, N, c, L, options, tol)
+    settled = (code > 0) & (code_f > 0)
+    out = {"force": (code, t, values, basis, np.nan_to_num(yn)),
+           "form": (code_f, t_f, lam_f, basis_f, y_f),
+           "force_layout": ("forces", m), "tight": tight_rows, "form_tight": form_tight}
+    return settled, out
+
+
+def _tight_shift(C, E, owner, mask, models, P, y) -> float:
+    """Rigorous bound on how far the exact projection of ``y`` off the span of the tight blocks'
+    columns moves it (``inf`` when not proved in floats).
+
+    The columns of one point contact are independent. Those of two point contacts at distinct
+    points, ``(e_j, (p_i - c) x e_j / L)``, have rank exactly 5 for any data: the map
+    ``(a, b) -> (a + b, (r_1 x a + r_2 x b) / L)`` has kernel ``{(a, -a) : a || r_1 - r_2}``. So
+    their span is that of any 5 of them proved independent, which floats can bound. Other tight
+    sets go to the exact checker. "Point contact" here is any model whose columns are the three
+    world-axis forces and no moments (:attr:`~qualgrasp.certify.models.ContactModel.forces`,
+    ``extra``)."""
+    tight = np.flatnonzero(mask)
+    cols = np.flatnonzero(mask[owner])
+    spec = [registry.get(models[b]) for b in tight]
+    if len(tight) == 2 and all(m.forces == "axes" and not m.extra for m in spec) and \
+            not np.array_equal(P[tight[0]], P[tight[1]]):
+        for drop in range(len(cols)):
+            keep = np.delete(cols, drop)
+            bound = projection_bound(np.ascontiguousarray(C[:, keep]), np.ascontiguousarray(E[:, keep]), y)
+            if np.isfinite(bound):
+                return bound
+        return np.inf
+    if len(tight) == 1 and not spec[0].extra:
+        return projection_bound(np.ascontiguousarray(C[:, cols]), np.ascontiguousarray(E[:, cols]), y)
+    return np.inf
+
+
+def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(), slow=None, *,
+                  columns: GraspColumns | None = None) -> pa.Table:
+    """Results table of an Arrow grasp table (rows in input order), with the table's extra
+    columns carried through.
+
+    ``slow(row_indices) -> list of results rows`` certifies rows grasp by grasp (the per-grasp
+    path, :func:`qualgrasp.certify.batch.chunk.certify_rows`); it receives every row that the columnar
+    rules do not settle, invalid rows included. ``columns``: the table's checked columns, when
+    the caller has them already.
+    """
+    cols = grasp_columns(table) if columns is None else columns
+    lines = (np.arange(lines.start, lines.stop, lines.step) if isinstance(lines, range)
+             else np.asarray(lines, dtype=np.int64))
+    n = len(lines)
+    done = np.zeros(n, dtype=bool)
+    pieces, order = [], []
+    if options.method == "fast" and cols.ok.any():
+        label = cols.pattern()
+        for k in np.unique(label[cols.ok]):
+            rows = np.flatnonzero(label == k)
+            group = _planar_group if cols.dim[rows[0]] == 2 else _spatial_group
+            settled, out = group(cols, rows, options, tol)
+            if settled.all():
+                sub = dict(out)
+            elif settled.any():
+                sub = {name: (value if name == "force_layout" else _take(value, settled))
+                       for name, value in out.items() if name not in ("tight", "form_tight")}
+                new = np.cumsum(settled) - 1  # re-index the per-row tight lists to the settled rows
+                for name in ("tight", "form_tight"):
+                    if name in out:
+                        sub[name] = {int(new[r]): v for r, v in out[name].items() if settled[r]}
+            if settled.any():
+                pieces.append(group_table(cols, rows[settled], lines[rows[settled]], sub, options))
+                order.append(rows[settled])
+                done[rows[settled]] = True
+    rest = np.flatnonzero(~done)
+    if len(rest):
+        pieces.append(rows_to_table(slow(rest)))
+        order.append(rest)
+    return assemble(pieces, order, table)
+
+
+def _take(value, mask):
+    if isinstance(value, tuple):
+        return tuple(v[mask] if isinstance(v, np.ndarray) else v for v in value)
+    return value[mask]

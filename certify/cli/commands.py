@@ -1,0 +1,201 @@
+"""The certify commands: ``qualgrasp certify``, ``verify``, ``certify-regions`` and ``sample``.
+
+Each command is a thin wrapper over a public function (:func:`qualgrasp.certify.batch.certify_file`,
+:func:`qualgrasp.certify.batch.verify_file`, :func:`qualgrasp.certify.regions.certify_region_file`,
+:func:`qualgrasp.certify.regions.verify_region_file`,
+:func:`qualgrasp.certify.batch.samples.write_random_grasp_file`); its checks and its one-line refusals are
+:mod:`qualgrasp.certify.cli.options`'.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.table import Table
+
+from .. import models
+from ..batch.jobs import certify_file, verify_file
+from ..errors import CertifyError
+from ..regions.files import DEFAULT_BUDGET, certify_region_file, verify_region_file
+from ..batch.samples import write_random_grasp_file
+from ..files.reader import count_grasps
+from ..core.validation import MAX_CONTACTS
+from .options import fail, printable
+
+__all__ = ["register"]
+
+console = Console(stderr=True)
+
+#: The solver routes a run may use (``qualgrasp bench`` times the others).
+METHODS = ("fast", "reference")
+
+
+def certify_command(
+    grasps: Path = typer.Argument(..., help="Grasp set: .jsonl (JSON Lines) or .parquet."),
+    output: Path = typer.Option(..., "-o", "--output", help="Results file: .jsonl or .parquet."),
+    method: str = typer.Option("fast", help="'fast' (enumeration/clarabel) or 'reference' (cvxpy)."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar or summary."),
+    quality: bool = typer.Option(True, help="Compute the epsilon columns (eps_l1_lo ... eps_linf_hi)."),
+    eps_gap: float = typer.Option(0.01, help="Spatial epsilon: stop when hi - lo <= gap * hi."),
+    eps_budget: int = typer.Option(200_000, help="Spatial epsilon: most work per grasp and norm, in directions examined."),
+    eps_time: float = typer.Option(10.0, help="Time limit of quality per grasp, in seconds (0: none); when hit, "
+                                              "the row keeps its closure verdict, states the epsilon bounds reached "
+                                              "and eps_limited (results then depend on the machine)."),
+    workers: int = typer.Option(0, help="Local worker processes (0: all cores)."),
+    dask: str = typer.Option(None, "--dask", help="'local' for a dask LocalCluster, or a scheduler address."),
+    resume: bool = typer.Option(False, "--resume", help="Continue an interrupted run, keeping its complete chunks."),
+    chunk_size: int = typer.Option(4096, help="Grasps per chunk (unit of work and checkpoint)."),
+) -> None:
+    """Certify form and force closure of every grasp, one results line per grasp line.
+
+    Exit code 1 when some rows are errors or failed their own re-check, 2 when the run could not
+    start (unreadable input, bad option, output naming the input or a folder, resume refused).
+    """
+    if method not in METHODS:
+        fail(f"--method must be one of {', '.join(METHODS)}, got {method!r}")
+    if not (math.isfinite(eps_gap) and 0 < eps_gap < 1):
+        fail(f"--eps-gap must be a fraction between 0 and 1 (relative gap hi - lo <= gap * hi), got {eps_gap}")
+    if eps_budget < 1:
+        fail(f"--eps-budget must be at least 1 direction cell, got {eps_budget}")
+    if workers < 0:
+        fail(f"--workers must be 0 (all cores) or a number of processes, got {workers}")
+    if chunk_size < 1:
+        fail(f"--chunk-size must be at least 1 grasp, got {chunk_size}")
+    total = count_grasps(grasps)
+    with Progress(TextColumn("certify"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
+                  console=console, disable=quiet) as bar:
+        task = bar.add_task("certify", total=total)
+        try:
+            summary = certify_file(grasps, output, method=method,
+                                   progress=lambda n: bar.advance(task, n), quality=quality,
+                                   eps_gap=eps_gap, eps_budget=eps_budget,
+                                   eps_time=eps_time if eps_time > 0 else None, workers=workers or None,
+                                   dask=dask, resume=resume, chunk_size=chunk_size)
+        except CertifyError as err:
+            fail(str(err))
+    if not quiet:
+        table = Table(title=f"{summary.rows} grasps -> {output}")
+        table.add_column("status")
+        table.add_column("rows", justify="right")
+        for status, count in sorted(summary.statuses.items()):
+            table.add_row(status, str(count))
+        table.add_row("unverified", str(summary.unverified))
+        if summary.resumed_chunks:
+            table.add_row("chunks kept from the interrupted run", str(summary.resumed_chunks))
+        console.print(table)
+        rate = summary.rows / summary.seconds if summary.seconds > 0 else 0.0
+        memory = "" if summary.peak_mb is None else f"; peak memory {summary.peak_mb:.0f} MB" + (
+            "" if summary.peak_worker_mb is None else f" (largest worker {summary.peak_worker_mb:.0f} MB)")
+        console.print(f"{summary.seconds:.1f} s, {rate:,.0f} grasps/s{memory}")
+    if summary.errors or summary.unverified:
+        raise typer.Exit(1)
+
+
+def verify_command(
+    results: Path = typer.Argument(..., help="Results file written by 'qualgrasp certify' or 'certify-regions'."),
+    grasps: Path | None = typer.Option(None, "--grasps", help="The grasp set the results came from."),
+    regions: Path | None = typer.Option(None, "--regions", help="The region set the results came from "
+                                        "(results of 'qualgrasp certify-regions')."),
+    workers: int = typer.Option(0, help="Worker processes (0: all cores; grasp sets only)."),
+) -> None:
+    """Re-check every certificate without a solver; print the id of each one that fails.
+
+    Give exactly one of --grasps (results of 'qualgrasp certify') and --regions (results of
+    'qualgrasp certify-regions'). Exit code 1 when a row fails, 2 when the run cannot start.
+    """
+    if (grasps is None) == (regions is None):
+        fail("give exactly one of --grasps and --regions")
+    if workers < 0:
+        fail(f"--workers must be 0 (all cores) or a number of processes, got {workers}")
+    try:
+        if regions is not None:
+            summary = verify_region_file(results, regions)
+        else:
+            summary = verify_file(results, grasps, workers=workers or None)
+    except CertifyError as err:
+        fail(str(err))
+    for gid, reason in summary.failures:
+        typer.echo(printable(f"{gid}\t{reason}"))
+    checked = summary.rows - summary.errors
+    missing = getattr(summary, "missing", 0)
+    console.print(f"{checked} certified rows re-checked, {summary.errors} error rows skipped, "
+                  f"{len(summary.failures)} failed"
+                  + (f"; {missing} of the {summary.grasps} grasps have no results row (a subset: not a failure)"
+                     if missing else ""), soft_wrap=True)
+    if summary.failures:
+        raise typer.Exit(1)
+
+
+def certify_regions_command(
+    regions: Path = typer.Argument(..., help="Region set: JSON Lines, one region tuple per line."),
+    output: Path = typer.Option(..., "-o", "--output", help="Results file (JSON Lines); never the input."),
+    budget: int = typer.Option(DEFAULT_BUDGET, help="Branch-and-bound work units per tuple (curved regions, "
+                               "normal_tol > 0); straight regions with normal_tol 0 are decided exactly."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar or summary."),
+) -> None:
+    """Certify region tuples: is every choice of one contact per region in force closure?
+
+    One results row per tuple line: status robust, not_robust (with a witness grasp and its
+    Farkas certificate), undecided or error, the certificate, and whether it re-checked. Exit
+    code 1 when some rows are errors or failed their own re-check, 2 when the run cannot start.
+    """
+    if budget < 1:
+        fail(f"--budget must be at least 1 work unit per tuple, got {budget}")
+    total = count_grasps(regions)  # for the progress bar only: the reader says what is wrong
+    with Progress(TextColumn("regions"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
+                  console=console, disable=quiet) as bar:
+        task = bar.add_task("regions", total=total)
+        try:
+            summary = certify_region_file(regions, output, budget=budget, progress=lambda n: bar.advance(task, n))
+        except CertifyError as err:
+            fail(str(err))
+    if not quiet:
+        table = Table(title=f"{summary.rows} region tuples -> {output}")
+        table.add_column("status")
+        table.add_column("rows", justify="right")
+        for status, count in sorted(summary.statuses.items()):
+            table.add_row(status, str(count))
+        table.add_row("unverified", str(summary.unverified))
+        console.print(table)
+        console.print(f"{summary.seconds:.1f} s")
+    if summary.errors or summary.unverified:
+        raise typer.Exit(1)
+def sample_command(
+    output: Path = typer.Argument(..., help="Grasp set to write: .parquet or .jsonl."),
+    n: int = typer.Option(100_000, "--n", help="Number of grasps."),
+    dim: int = typer.Option(2, help="2 (planar) or 3 (spatial)."),
+    contacts: int = typer.Option(3, help="Contacts per grasp."),
+    model: str = typer.Option("point", help="Contact model: " + ", ".join(models.names()) + "."),
+    seed: int = typer.Option(0, help="Random seed."),
+) -> None:
+    """Write a random grasp set, for trying the toolkit and for benchmarks at scale.
+
+    Contacts are placed around a random blob; about a third of the grasps are in closure."""
+    if n < 0:
+        fail(f"--n must be a number of grasps (>= 0), got {n}")
+    if dim not in (2, 3):
+        fail(f"--dim must be 2 (planar) or 3 (spatial), got {dim}")
+    if not 1 <= contacts <= MAX_CONTACTS:
+        fail(f"--contacts must be between 1 and {MAX_CONTACTS}, got {contacts}")
+    if model not in models.names():
+        fail(f"--model must be one of {', '.join(models.names())}, got {model!r}")
+    if dim not in models.get(model).dims:
+        fail(f"--model {model} exists in {' and '.join(map(str, models.get(model).dims))} dimensions only, "
+              f"not with --dim {dim}")
+    try:
+        count = write_random_grasp_file(output, n, seed=seed, dim=dim, n_contacts=contacts, model=model)
+    except CertifyError as err:
+        fail(str(err))
+    console.print(f"wrote {count} grasps to {output}")
+
+
+def register(app: typer.Typer) -> None:
+    """Add the certify commands to the ``qualgrasp`` application."""
+    app.command("certify")(certify_command)
+    app.command("verify")(verify_command)
+    app.command("certify-regions")(certify_regions_command)
+    app.command("sample")(sample_command)

@@ -1,0 +1,300 @@
+"""The closure programme shared by every solver route.
+
+Every closure question (form closure, force closure, positive spanning) is the same convex
+programme over variables ``x`` that are generator weights (rays) or contact forces in the contact
+frame (second-order cone blocks)::
+
+    maximise t
+    subject to  columns @ x = 0            (equilibrium: no net wrench)
+                normal @ x = 1             (total normal force, or total weight, is 1)
+                x_r >= t                   for every ray r
+                kappa x_n - norm(x_tan) >= t   for every cone block (x_n its normal force)
+
+``t*`` is the min-weight margin (Murray, Li & Sastry, Prop. 5.2; the min-weight LP of FRoGGeR):
+the set is in closure iff ``columns`` has full row rank and ``t* > 0``. For rays ``t*`` lies in
+``(0, 1/k]``; for a spatial frictional contact the slack is ``mu f_n - norm(f_t)`` (plus the
+torsional term for soft contacts), and for a frictionless one ``f_n``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import Any, NamedTuple, Sequence
+
+import numpy as np
+import scipy.sparse as sp
+
+from .grasp import Grasp
+from .. import models as registry
+from ..errors import ArgumentError, GraspError
+from .._kernels.linalg import world_values
+from .cones import cone_code
+from .wrench import (contact_frame, force_columns, generator_columns, grasp_arrays, tangent,
+                     to_exact, variants_of, wrench)
+
+__all__ = ["Block", "block_arrays", "System", "ClosureProblem", "grasp_problem", "span_problem", "grasp_system",
+           "span_system", "span_vectors", "is_polyhedral"]
+
+
+@dataclass(frozen=True)
+class Block:
+    """One cone block over certificate columns ``cols``: its shape ``cone`` (``'ray'`` or
+    ``'lorentz'``, :mod:`qualgrasp.certify.core.cones`), the stored normal ``n``, friction ``mu`` and
+    moment length ``g`` of a Lorentz block (0 for none), and the ``contact`` it belongs to."""
+
+    cone: str
+    cols: tuple[int, ...]
+    n: tuple = ()
+    mu: Any = 0
+    g: Any = 0
+    contact: int = -1
+
+
+def block_arrays(blocks: Sequence[Block], dim: int):
+    """``(cone, first, width, n, mu, g)`` arrays of cone blocks, the form the compiled kernels
+    take (:mod:`qualgrasp.certify._kernels.cones`); rays get zero normals."""
+    cone = np.array([cone_code(b.cone) for b in blocks], dtype=np.int64)
+    first = np.array([b.cols[0] for b in blocks], dtype=np.int64)
+    width = np.array([len(b.cols) for b in blocks], dtype=np.int64)
+    n = np.array([[float(v) for v in b.n] if b.n else [0.0] * dim for b in blocks]).reshape(len(blocks), dim)
+    mu = np.array([float(b.mu) for b in blocks])
+    g = np.array([float(b.g) for b in blocks])
+    return cone, first, width, n, mu, g
+
+
+class System(NamedTuple):
+    """What a certificate is written over: columns ``C`` (d x k), their cone blocks, the layout
+    name (``generators`` or ``forces``). Float for the solvers, exact for the checker."""
+
+    columns: np.ndarray
+    blocks: tuple[Block, ...]
+    layout: str
+
+
+@dataclass(frozen=True, eq=False)
+class ClosureProblem:
+    """Data of the closure programme (see module docstring).
+
+    Attributes
+    ----------
+    columns : ndarray, shape (d, nvar)
+        Wrench (or vector) of each variable.
+    rays : tuple of int
+        Variables constrained by ``x_r >= t``.
+    cones : tuple of (start, size, kappa)
+        Second-order cone blocks; ``x[start]`` is the normal force, the next ``size - 1`` entries
+        the tangential forces (and the scaled torsional moment).
+    to_values : ndarray or scipy.sparse.csr_array, shape (ncert, nvar)
+        Linear map from ``x`` to the certificate's values (world-frame forces): block diagonal,
+        stored sparse for one grasp (its size grows with the square of the contacts); see
+        :meth:`values`.
+    system : System
+        The float certificate system (for polyhedral problems its columns are ``columns``).
+    """
+
+    columns: np.ndarray
+    rays: tuple[int, ...]
+    cones: tuple[tuple[int, int, float], ...]
+    to_values: Any
+    system: System
+
+    def values(self, x: np.ndarray) -> np.ndarray:
+        """The certificate's values ``to_values @ x``, each summed in variable order as
+        :func:`qualgrasp.certify._kernels.linalg.world_values` sums the columnar batch (the
+        zeros a sparse map skips add nothing), so both routes state the same values."""
+        x = np.asarray(x, dtype=float)
+        if sp.issparse(self.to_values):
+            return np.asarray(self.to_values @ x, dtype=float)
+        return world_values(np.ascontiguousarray(self.to_values)[None], x[None])[0]
+
+    @property
+    def d(self) -> int:
+        return self.columns.shape[0]
+
+    @property
+    def nvar(self) -> int:
+        return self.columns.shape[1]
+
+    @property
+    def normal(self) -> np.ndarray:
+        """Coefficients of the normalisation row ``normal @ x = 1``."""
+        e = np.zeros(self.nvar)
+        e[list(self.rays)] = 1.0
+        e[[start for start, _, _ in self.cones]] = 1.0
+        return e
+
+    @property
+    def structure(self) -> tuple:
+        """Hashable sparsity structure: problems sharing it can reuse a prebuilt solver."""
+        return (self.d, self.nvar, self.rays, tuple((s, n) for s, n, _ in self.cones))
+
+
+def span_problem(vectors) -> ClosureProblem:
+    """Positive spanning of the rows of ``vectors`` (shape ``(k, d)``): every row is a ray."""
+    system = span_system(vectors)
+    k = system.columns.shape[1]
+    return ClosureProblem(system.columns, tuple(range(k)), (), sp.identity(k, format="csr"), system)
+
+
+def is_polyhedral(grasp: Grasp, frictionless: bool = False, socp: bool = False) -> bool:
+    """True when the programme uses generator rays: frictionless grasps (and form closure), and
+    planar grasps unless ``socp`` asks for their friction cones as 2-D second-order cones."""
+    return frictionless or grasp.frictionless or (grasp.dim == 2 and not socp)
+
+
+def _frames(N: np.ndarray) -> np.ndarray:
+    """Contact frames, shape ``(..., m, dim, dim)``: rows ``n, t`` (plane) or ``n, t1, t2``
+    (space)."""
+    if N.shape[-1] == 2:
+        return np.stack([N, tangent(N)], axis=-2)
+    T1, T2 = contact_frame(N.reshape(-1, 3))
+    return np.stack([N, T1.reshape(N.shape), T2.reshape(N.shape)], axis=-2)
+
+
+def grasp_problem(grasp: Grasp, *, frictionless: bool = False, socp: bool = False) -> ClosureProblem:
+    """The closure programme of ``grasp`` (form closure when ``frictionless=True``).
+
+    Frictionless grasps and planar grasps are polyhedral (rays = generator wrenches; a planar
+    friction cone is exactly its two edges, a pad's cone the edges at its two ends). Spatial
+    frictional contacts are exact second-order cones in the contact frame ``(n, t1, t2)``; a
+    soft contact's fourth variable is ``m / torsion``, so its cone is
+    ``norm((f_t, m / torsion)) <= mu f_n``. ``socp=True`` writes planar friction cones as 2-D
+    second-order cones ``abs(f_t) <= mu f_n`` instead of edges: the same verdict by another route
+    (the margin's scale differs), used to cross-check the LP (not for pads, which have no
+    conic form).
+    """
+    system = grasp_system(grasp, frictionless=frictionless, socp=socp)
+    if system.layout == "generators":
+        k = system.columns.shape[1]
+        return ClosureProblem(system.columns, tuple(range(k)), (), sp.identity(k, format="csr"), system)
+    P, N, mu, params, c, L = grasp_arrays(grasp)
+    models = tuple(contact.model for contact in grasp.contacts)
+    columns, rays, cones, to_values = conic_columns(P, N, params, models, c, L)
+    return ClosureProblem(columns, rays, cones, to_values, system)
+
+
+def conic_columns(P, N, params, models, center, length):
+    """Solver columns of a closure programme with cones, for one grasp or a batch.
+
+    Parameters
+    ----------
+    P, N : array, shape (..., m, dim)
+    params : mapping of str to array, shape (..., m)
+        Model parameters (``mu``, moment lengths such as ``torsion``).
+    models : sequence of str, length m (shared by the batch)
+    center : array, shape (..., dim)
+    length : array, shape (...)
+
+    Returns
+    -------
+    columns : array, shape (..., d, nvar)
+        Wrench of each variable: a ray contact one column (``n``); a Lorentz contact the normal
+        and tangential forces of the contact frame ``(n, t1, t2)`` (``(n, t)`` in the plane) and,
+        per moment of the model (a soft finger's torsion), the scaled moment ``m / g``.
+    to_values : array, shape (..., ncert, nvar)
+        Map from the variables to the certificate's world-frame values (forces, moments):
+        dense for a batch, a sparse block-diagonal ``scipy.sparse.csr_array`` for one grasp.
+    rays, cones : tuple
+        As :class:`ClosureProblem` (the structure, shared by the batch).
+    """
+    frames = _frames(N)  # (..., m, dim, dim)
+    c = np.asarray(center)[..., None, None, :]
+    L = np.asarray(length)[..., None, None]
+    wrenches = wrench(P[..., :, None, :], frames, c, L)  # (..., m, dim, d)
+    dim = P.shape[-1]
+    batch = P.shape[:-2]
+    cols, rays, cones, blocks = [], [], [], []
+    for i, name in enumerate(models):
+        model = registry.get(name)
+        start = len(cols)
+        if model.cone == "ray":
+            cols.append(wrenches[..., i, 0, :])
+            rays.append(start)
+            blocks.append(N[..., i, :, None])
+            continue
+        if model.cone != "lorentz":
+            raise ArgumentError(f"{name} contacts have no conic form (they are polyhedral: use the generators)")
+        cols.extend(wrenches[..., i, j, :] for j in range(dim))
+        frame = np.swapaxes(frames[..., i, :, :], -1, -2)
+        if model.extra:
+            size = dim + len(model.extra)
+            frame_x = np.zeros(batch + (size, size))
+            frame_x[..., :dim, :dim] = frame
+            L_ = np.asarray(length)[..., None]
+            for q, extra in enumerate(model.extra):
+                g = params[extra][..., i]
+                cols.append(np.concatenate([np.zeros(batch + (dim,)), g[..., None] * N[..., i, :] / L_], axis=-1))
+                frame_x[..., dim + q, dim + q] = g
+            frame = frame_x
+        cones.append((start, len(cols) - start, params["mu"][..., i]))
+        blocks.append(frame)
+    columns = np.stack(cols, axis=-1)
+    to_values = _block_diag(blocks, batch) if batch else sp.block_diag(blocks, format="csr")
+    if not batch:
+        cones = [(start, size, float(k)) for start, size, k in cones]
+    return columns, tuple(rays), tuple(cones), to_values
+
+
+def _block_diag(blocks: list[np.ndarray], batch: tuple = ()) -> np.ndarray:
+    rows = sum(b.shape[-2] for b in blocks)
+    cols = sum(b.shape[-1] for b in blocks)
+    out = np.zeros(batch + (rows, cols))
+    r = c = 0
+    for b in blocks:
+        out[..., r:r + b.shape[-2], c:c + b.shape[-1]] = b
+        r, c = r + b.shape[-2], c + b.shape[-1]
+    return out
+
+
+def grasp_system(grasp: Grasp, *, frictionless: bool = False, socp: bool = False,
+                 exact: bool = False):
+    """The certificate :class:`System` of ``grasp`` (exact: Fraction entries).
+
+    Polyhedral programmes (:func:`is_polyhedral`) are written over the generator wrenches, one
+    ray block per generator; the others over world-frame force (and moment) columns
+    (:func:`qualgrasp.certify.core.wrench.force_columns`), one block per contact with the model's cone.
+    """
+    P, N, mu, params, c, L = grasp_arrays(grasp, exact)
+    models = tuple(contact.model for contact in grasp.contacts)
+    if is_polyhedral(grasp, frictionless, socp):
+        C, owner = generator_columns(P, N, mu, models, c, L, frictionless=frictionless,
+                                     width=params["width"], variants=variants_of(grasp))
+        return System(C, tuple(Block("ray", (j,), contact=int(owner[j])) for j in range(C.shape[1])),
+                      "generators")
+    C, owner = force_columns(P, N, models, c, L)
+    conv = to_exact if exact else np.asarray
+    num = Fraction if exact else float
+    blocks = []
+    for i, contact in enumerate(grasp.contacts):
+        model = contact.contact_model
+        cols = tuple(int(j) for j in np.flatnonzero(owner == i))
+        g = num(contact.param(model.extra[0])) if model.extra else 0
+        blocks.append(Block(model.cone, cols, tuple(conv(np.array(contact.n))), num(contact.mu), g, i))
+    return System(C, tuple(blocks), "forces")
+
+
+def span_vectors(vectors) -> np.ndarray:
+    """``vectors`` as a finite float array ``(k, d)`` with ``k >= 1``, else :class:`GraspError`.
+
+    Examples
+    --------
+    >>> span_vectors([[1, 2], [3]])
+    Traceback (most recent call last):
+    ...
+    qualgrasp.certify.errors.GraspError: vectors must be a finite (k, d) array
+    """
+    try:
+        V = np.asarray(vectors, dtype=float)
+    except (TypeError, ValueError):
+        V = None
+    if V is None or V.ndim != 2 or V.size == 0 or not np.isfinite(V).all():
+        raise GraspError("vectors must be a finite (k, d) array")
+    return V
+
+
+def span_system(vectors, *, exact: bool = False):
+    """Certificate columns and blocks for positive spanning of the rows of ``vectors``."""
+    V = np.asarray(vectors, dtype=float)
+    C = (to_exact(V) if exact else V).T
+    return System(C, tuple(Block("ray", (j,)) for j in range(C.shape[1])), "generators")

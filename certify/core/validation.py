@@ -1,0 +1,505 @@
+"""Validation of grasp data: one set of rules and messages, whichever way grasps come in.
+
+Grasps arrive as Python values (:class:`qualgrasp.certify.Contact` and
+:class:`qualgrasp.certify.Grasp` keywords, JSON Lines parsed by :func:`json.loads`) or as Arrow
+columns (Parquet, in-memory tables). Both are turned into the same arrays, :class:`ContactData`
+(one row per contact) and :class:`GraspData` (one row per grasp), by a *reader* that only checks
+types: :func:`contact_data` and :func:`grasp_data` for Python values (numbers must be numbers:
+no string, boolean or mapping is coerced), :mod:`qualgrasp.certify.files.columns` for Arrow. Every rule
+on the values is then applied here, vectorised, by :func:`check_contacts` and :func:`check_grasps`,
+with the same messages for every source. A message names the field and the problem:
+``contacts[2].p: expected 2 or 3 finite numbers, got "abc"``.
+
+Rules and documented limits
+---------------------------
+* ``p`` and ``n``: 2 (planar) or 3 (spatial) finite numbers each, as many for both; coordinates
+  at most :data:`~qualgrasp.certify.models.MAX_LENGTH` in absolute value; ``n`` not shorter than
+  :data:`MIN_NORMAL`. Normals are normalised to unit length, except one already unit to within
+  ``1e-12`` (kept as given, so exact data stays exact); the length is computed without overflow.
+* ``model``: a registered model (:mod:`qualgrasp.certify.models`) that exists in the contact's
+  dimension. Without ``model``, a contact with ``mu`` is ``point``, otherwise ``frictionless``.
+* The model's parameters are required and must lie in their ranges
+  (:class:`qualgrasp.certify.models.Param`); a parameter of another model may only be 0 (it then
+  means nothing). Reductions then apply (``mu = 0``: frictionless; a pad of width 0: point).
+* A grasp has 1 to :data:`MAX_CONTACTS` contacts of one dimension; ``center`` (optional) has
+  that many finite coordinates, at most ``MAX_LENGTH`` in absolute value; ``length``
+  (optional) is a finite number in ``[MIN_LENGTH, MAX_GRASP_LENGTH]``. Defaults: ``center`` the
+  centroid of the contact points (their sum in contact order over their count), ``length`` the
+  largest distance from ``center`` to a contact point, or 1 when the contacts coincide (up to
+  the rounding of their centroid); a default length
+  outside ``[MIN_LENGTH, MAX_GRASP_LENGTH]`` is an error (the contacts are too close together
+  for the tolerances: give ``length`` or rescale), so a grasp's results always read back.
+* ``id`` (optional) is a string or an integer.
+* Other keys of a contact are ignored; other top-level keys of a grasp are kept (``meta``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from numbers import Integral, Real
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from .. import models as registry
+from ..models import MAX_LENGTH, MIN_LENGTH
+
+__all__ = ["MAX_CONTACTS", "MIN_NORMAL", "ABSENT", "UNKNOWN", "ContactData", "GraspData",
+           "Checked", "show", "number", "numbers", "contact_data", "grasp_data",
+           "check_contacts", "check_grasps", "grasp_rules", "CheckedGrasps", "param_names", "TOP_LEVEL",
+           "id_problem"]
+
+#: Most contacts in one grasp (documented limit; a longer row is an error).
+MAX_CONTACTS = 10_000
+#: A normal shorter than this is zero.
+MIN_NORMAL = 1e-9
+#: Model code of a contact without ``model`` (resolved by the default rule), and of an unknown name.
+ABSENT, UNKNOWN = -2, -1
+
+
+def show(value: Any, limit: int = 60) -> str:
+    """A short rendering of a user's value for messages (JSON where possible)."""
+    try:
+        text = json.dumps(value, allow_nan=True)
+    except (TypeError, ValueError, RecursionError):
+        text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def number(value: Any) -> float | None:
+    """``value`` as a float if it is a real number (not a boolean, string or container), else
+    None. Integers too large for a float become ``inf`` (rejected later as not finite)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (Real, np.number)):
+        return None
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf if value > 0 else -math.inf
+
+
+def numbers(value: Any) -> tuple[float, ...] | None:
+    """``value`` as a tuple of floats if it is a list, tuple or 1-D numeric array of real
+    numbers, else None."""
+    if isinstance(value, np.ndarray):
+        if value.ndim != 1 or value.dtype.kind not in "iuf":
+            return None
+        return tuple(float(v) for v in value.astype(float))
+    if not isinstance(value, (list, tuple)):
+        return None
+    out = tuple(number(v) for v in value)
+    return None if any(v is None for v in out) else out
+
+
+@dataclass
+class ContactData:
+    """Contacts as arrays, one row per contact (``k`` rows), before the value rules.
+
+    ``p``, ``n`` (k, 3) with lengths ``plen``, ``nlen`` (-1: absent); ``model`` codes
+    (:data:`ABSENT`, :data:`UNKNOWN`), ``names`` the given model names (for messages);
+    ``params`` NaN where not given, ``given`` masks; ``errors`` the reader's message per contact
+    (None when it read the contact); ``raw`` given values by ``(row, key)`` for messages."""
+
+    p: np.ndarray
+    plen: np.ndarray
+    n: np.ndarray
+    nlen: np.ndarray
+    model: np.ndarray
+    names: list
+    params: dict[str, np.ndarray]
+    given: dict[str, np.ndarray]
+    errors: list
+    raw: dict = field(default_factory=dict)
+
+    @classmethod
+    def empty(cls, k: int) -> "ContactData":
+        return cls(np.zeros((k, 3)), np.full(k, -1), np.zeros((k, 3)), np.full(k, -1),
+                   np.full(k, ABSENT, dtype=np.int64), [None] * k,
+                   {name: np.full(k, np.nan) for name in param_names()},
+                   {name: np.zeros(k, dtype=bool) for name in param_names()}, [None] * k)
+
+
+def param_names() -> tuple[str, ...]:
+    """Every registered model's parameter names (the optional keys of a contact), in order."""
+    out: list[str] = []
+    for model in registry.models():
+        out += [p.name for p in model.params if p.name not in out]
+    return tuple(out)
+
+
+def _vector_into(data: ContactData, j: int, key: str, value: Any) -> str | None:
+    vec = numbers(value)
+    if vec is None or not 2 <= len(vec) <= 3:
+        return f"{key}: expected 2 (planar) or 3 (spatial) finite numbers, got {show(value)}"
+    arr, lens = (data.p, data.plen) if key == "p" else (data.n, data.nlen)
+    arr[j, : len(vec)] = vec
+    lens[j] = len(vec)
+    data.raw[(j, key)] = value
+    return None
+
+
+def contact_data(values: Sequence[Any]) -> ContactData:
+    """Read contacts given as Python values (mappings with keys ``p``, ``n``, ``model`` and the
+    models' parameters), checking only types (the value rules are :func:`check_contacts`')."""
+    data = ContactData.empty(len(values))
+    names = registry.names()
+    for j, c in enumerate(values):
+        if not isinstance(c, Mapping):
+            data.errors[j] = f"expected an object with keys p, n, model, ..., got {show(c)}"
+            continue
+        error = None
+        for key in ("p", "n"):
+            if c.get(key) is None:
+                error = error or f"{key}: missing ({'the contact point' if key == 'p' else 'the inward normal'})"
+            else:
+                error = error or _vector_into(data, j, key, c[key])
+        model = c.get("model")
+        if model is not None:
+            if not isinstance(model, str):
+                error = error or f"model: expected one of {', '.join(map(repr, names))}, got {show(model)}"
+            else:
+                data.names[j] = model
+                data.model[j] = names.index(model) if model in names else UNKNOWN
+        for name in data.params:
+            if c.get(name) is None:
+                continue
+            x = number(c[name])
+            if x is None:
+                error = error or f"{name}: expected a number, got {show(c[name])}"
+                continue
+            data.params[name][j] = x
+            data.given[name][j] = True
+            data.raw[(j, name)] = c[name]
+        data.errors[j] = error
+    return data
+
+
+@dataclass
+class Checked:
+    """Contacts after the value rules: ``error`` per contact (None when valid); for valid
+    contacts the stored values: ``p``, unit ``n`` (k, 3), ``dim``, effective ``model`` codes
+    (after reductions and defaults), ``params`` (0 where the model does not take one) and the
+    model ``variant``."""
+
+    error: np.ndarray
+    p: np.ndarray
+    n: np.ndarray
+    dim: np.ndarray
+    model: np.ndarray
+    params: dict[str, np.ndarray]
+    variant: np.ndarray
+
+
+def _plain(value: Any) -> Any:
+    """A Python value of an Arrow scalar (``as_py``), other values as they are."""
+    return value.as_py() if hasattr(value, "as_py") else value
+
+
+def _unit_normals(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Normals as stored (unit, or kept when unit to within 1e-12) and their lengths, without
+    overflow for huge components."""
+    scale = np.abs(n).max(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        safe = np.where(scale > 0, scale, 1.0)
+        norm = safe * np.sqrt(((n / safe[:, None]) ** 2).sum(axis=1))
+        unit = np.abs(norm - 1.0) <= 1e-12
+        plain = np.sqrt((n * n).sum(axis=1))  # exact rounding as before for ordinary data
+        norm = np.where(np.isfinite(plain) & (plain > 1e-150), plain, norm)
+        stored = np.where(unit[:, None], n, n / np.where(norm > 0, norm, 1.0)[:, None])
+    return stored, norm
+
+
+def check_contacts(data: ContactData) -> Checked:
+    """Apply the value rules (module docstring) to every contact; messages name the field."""
+    k = len(data.plen)
+    error = np.array(data.errors, dtype=object) if k else np.zeros(0, dtype=object)
+    todo = np.equal(error, None)
+
+    def fail(mask, message) -> None:
+        """Record ``message(row)`` for the rows of ``mask`` still without an error."""
+        for j in np.flatnonzero(mask & todo):
+            error[j] = message(j)
+            todo[j] = False
+
+    def raw(j, key, value):
+        return show(data.raw.get((j, key), value))
+
+    plen, nlen = data.plen, data.nlen
+    fail(plen < 0, lambda j: "p: missing (the contact point)")
+    fail(nlen < 0, lambda j: "n: missing (the inward normal)")
+    fail(todo & (nlen != plen),
+         lambda j: f"n: contact point p has {plen[j]} coordinates but normal n has {nlen[j]}")
+    cols = np.arange(3)[None, :] < plen[:, None]
+    p = np.where(cols, data.p, 0.0)
+    n = np.where(cols, data.n, 0.0)
+    with np.errstate(invalid="ignore"):
+        fail(~(np.isfinite(p) & (np.abs(p) <= MAX_LENGTH)).all(axis=1),
+             lambda j: f"p: NaN or infinite coordinate, or one beyond {MAX_LENGTH:g}: expected 2 (planar) "
+                       f"or 3 (spatial) finite numbers, got {raw(j, 'p', list(p[j, :plen[j]]))}")
+        fail(~np.isfinite(n).all(axis=1),
+             lambda j: f"n: NaN or infinite coordinate: expected 2 (planar) or 3 (spatial) finite "
+                       f"numbers, got {raw(j, 'n', list(n[j, :plen[j]]))}")
+    stored, norm = _unit_normals(np.where(np.isfinite(n), n, 0.0))
+    fail(~(norm >= MIN_NORMAL),
+         lambda j: f"n: normal n is zero (length {norm[j]:.3g}); give the inward surface normal")
+
+    # model: the default rule, then known names existing in the contact's dimension
+    model = data.model.copy()
+    given = data.given
+    model[model == ABSENT] = np.where(given.get("mu", np.zeros(k, bool))[model == ABSENT],
+                                      registry.get("point").code, registry.get("frictionless").code)
+    names = registry.names()
+    fail(model == UNKNOWN, lambda j: f"model: unknown contact model {show(_plain(data.names[j]))}; use "
+                                     f"one of {', '.join(map(repr, names))}")
+    for m in registry.models():
+        fail((model == m.code) & ~np.isin(plen, m.dims),
+             lambda j, m=m: f"model: {m.name!r} contacts are {'planar' if m.dims == (2,) else 'spatial'} "
+                            f"only ({m.description}); this one has {plen[j]} coordinates")
+    # parameters: those of the model required and in range, others absent or 0
+    params = {name: np.where(given[name], data.params[name], 0.0) for name in data.params}
+    for m in registry.models():
+        rows = model == m.code
+        for par in m.params:
+            fail(rows & ~given[par.name], lambda j, m=m, par=par: f"{par.name}: missing: a {m.name!r} contact "
+                                                                  f"needs its {par.description} ({par.requirement()})")
+            fail(rows & ~np.isfinite(params[par.name]),
+                 lambda j, par=par: f"{par.name}: {par.description} {par.name} must be finite, "
+                                    f"got {raw(j, par.name, params[par.name][j])}")
+            fail(rows & ~par.admissible(params[par.name]),
+                 lambda j, par=par: f"{par.name}: {par.description} {par.name} must be {par.bounds()}, "
+                                    f"got {raw(j, par.name, params[par.name][j])}")
+        for name in data.params:
+            if name in m.param_names:
+                continue
+            owners = [o.name for o in registry.models() if name in o.param_names]
+            fail(rows & given[name] & (params[name] != 0),
+                 lambda j, m=m, name=name, owners=owners: f"{name}: a {m.name} contact takes no {name}; "
+                                                          f"'{name}' applies to {' and '.join(owners)} "
+                                                          f"contacts only, not to {m.name!r}")
+    valid = error == None  # noqa: E711  (elementwise on an object array)
+    model = np.where(valid, model, -1)
+    # reductions, until none applies (a pad of width 0 is a point, a point with mu 0 frictionless)
+    changed = True
+    while changed:
+        changed = False
+        for m in registry.models():
+            for name, target in m.reductions:
+                hit = (model == m.code) & (params[name] == 0)
+                if hit.any():
+                    keep = registry.get(target).param_names
+                    for other in m.param_names:
+                        if other not in keep:
+                            params[other] = np.where(hit, 0.0, params[other])
+                    model = np.where(hit, registry.get(target).code, model)
+                    changed = True
+    variant = np.zeros(k, dtype=np.int64)
+    for m in registry.models():
+        rows = model == m.code
+        if rows.any():
+            variant[rows] = m.variant({name: params[name][rows] for name in m.param_names})
+    return Checked(error, p, np.where(valid[:, None], stored, 0.0), np.where(valid, plen, 0), model,
+                   params, variant)
+
+
+@dataclass
+class GraspData:
+    """Grasps as arrays, before the value rules: contacts per grasp ``count`` (their rows in
+    :class:`ContactData` are consecutive, in grasp order), ``center`` (g, 3) with length
+    ``clen`` (-1: not given), ``length`` (NaN: not given), ``ids`` (str, int or None),
+    ``errors`` the reader's message per grasp, ``meta`` other top-level keys, ``raw`` values
+    for messages."""
+
+    count: np.ndarray
+    center: np.ndarray
+    clen: np.ndarray
+    length: np.ndarray
+    length_given: np.ndarray
+    ids: list
+    errors: list
+    meta: list
+    raw: dict = field(default_factory=dict)
+
+
+#: The top-level keys of a grasp (other keys are kept as ``meta`` and carried through).
+TOP_LEVEL = ("id", "contacts", "center", "length")
+
+
+def grasp_data(values: Sequence[Any]) -> tuple[GraspData, ContactData]:
+    """Read grasps given as Python values (mappings in the grasp-set schema), checking only
+    types; returns the grasp rows and their contacts (see :func:`check_grasps`)."""
+    g = len(values)
+    data = GraspData(np.zeros(g, dtype=np.int64), np.zeros((g, 3)), np.full(g, -1), np.full(g, np.nan),
+                     np.zeros(g, dtype=bool), [None] * g, [None] * g, [{} for _ in range(g)])
+    contacts: list = []
+    for i, d in enumerate(values):
+        if not isinstance(d, Mapping):
+            data.errors[i] = f"expected a JSON object with a 'contacts' list, got {show(d)}"
+            continue
+        gid = d.get("id")
+        problem = id_problem(gid)
+        if problem:
+            data.errors[i] = problem
+        elif gid is not None:
+            data.ids[i] = gid if isinstance(gid, str) else int(gid)
+        data.meta[i] = {k: v for k, v in d.items() if k not in TOP_LEVEL}
+        cs = d.get("contacts")
+        if not isinstance(cs, (list, tuple)):
+            data.errors[i] = data.errors[i] or (
+                "contacts: missing (a grasp needs a 'contacts' list)" if cs is None else
+                f"contacts: expected a list of contacts, got {show(cs)}")
+            continue
+        if len(cs) > MAX_CONTACTS:
+            data.errors[i] = data.errors[i] or f"contacts: {len(cs)} contacts, more than the limit of {MAX_CONTACTS}"
+            continue
+        data.count[i] = len(cs)
+        contacts.extend(cs)
+        if d.get("center") is not None:
+            vec = numbers(d["center"])
+            if vec is None or not 2 <= len(vec) <= 3:
+                data.errors[i] = data.errors[i] or f"center: expected 2 or 3 finite numbers, got {show(d['center'])}"
+            else:
+                data.center[i, : len(vec)] = vec
+                data.clen[i] = len(vec)
+                data.raw[(i, "center")] = d["center"]
+        if d.get("length") is not None:
+            x = number(d["length"])
+            if x is None:
+                data.errors[i] = data.errors[i] or f"length: expected a number, got {show(d['length'])}"
+            else:
+                data.length[i] = x
+                data.length_given[i] = True
+                data.raw[(i, "length")] = d["length"]
+    return data, contact_data(contacts)
+
+
+def id_problem(gid: Any) -> str | None:
+    """Why ``gid`` cannot be an id (a string of valid Unicode or an integer; None for none), or
+    None when it can.
+
+    Examples
+    --------
+    >>> id_problem("g1") is None, id_problem(7) is None, id_problem(None) is None
+    (True, True, True)
+    >>> print(id_problem("a\\ud800b"))
+    id: not valid Unicode (it holds a lone surrogate), got "a\ud800b"
+    """
+    if gid is not None and (isinstance(gid, bool) or not isinstance(gid, (str, Integral))):
+        return f"id: expected a string or an integer, got {show(gid)}"
+    if isinstance(gid, str) and not _is_unicode(gid):
+        return f"id: not valid Unicode (it holds a lone surrogate), got {show(gid)}"
+    return None
+
+
+def _is_unicode(text: str) -> bool:
+    """False for a string holding a lone surrogate (JSON allows ``"\\ud800"``; UTF-8 does not)."""
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
+@dataclass
+class CheckedGrasps:
+    """Grasps after the value rules: ``error`` per grasp (the first problem, prefixed with the
+    contact's index), ``dim``, ``center`` (g, 3), ``length``, and the checked contacts with their
+    grasp's ``offsets`` (g + 1)."""
+
+    error: np.ndarray
+    dim: np.ndarray
+    center: np.ndarray
+    length: np.ndarray
+    contacts: Checked
+    offsets: np.ndarray
+
+
+MAX_GRASP_LENGTH = 4 * MAX_LENGTH
+"""Largest ``length`` (given or default): about the largest distance between a center and a
+point whose coordinates are within ``MAX_LENGTH`` (``2 sqrt(3) MAX_LENGTH``)."""
+
+
+def _reach(d: np.ndarray) -> np.ndarray:
+    """Euclidean norms of the rows of ``d``, scaled so that neither tiny nor huge coordinates
+    underflow or overflow (0 for rows that are not finite)."""
+    scale = np.abs(d).max(axis=1) if d.size else np.zeros(len(d))
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        safe = np.where(scale > 0, scale, 1.0)
+        norm = scale * np.sqrt(((d / safe[:, None]) ** 2).sum(axis=1))
+    return np.where(np.isfinite(norm), norm, 0.0)
+
+
+def check_grasps(data: GraspData, contacts: ContactData) -> CheckedGrasps:
+    """Apply the grasp and contact value rules (module docstring); one message per bad grasp."""
+    return grasp_rules(data, check_contacts(contacts))
+
+
+def grasp_rules(data: GraspData, checked: Checked) -> CheckedGrasps:
+    """The grasp rules and defaults on grasps whose contacts are already checked."""
+    g = len(data.count)
+    offsets = np.concatenate([[0], np.cumsum(data.count)])
+    error = np.array(data.errors, dtype=object) if g else np.zeros(0, dtype=object)
+    todo = np.equal(error, None)
+
+    def fail(mask, message) -> None:
+        for i in np.flatnonzero(mask & todo):
+            error[i] = message(i)
+            todo[i] = False
+
+    # the first bad contact of each grasp names the grasp's problem
+    owner = np.repeat(np.arange(g), data.count)
+    bad = np.flatnonzero(checked.error != None)  # noqa: E711
+    for j in bad[::-1]:  # reversed, so the first bad contact of a grasp is the one kept
+        i = owner[j]
+        if todo[i]:
+            error[i] = f"contacts[{j - offsets[i]}].{checked.error[j]}"
+    for j in bad:
+        todo[owner[j]] = False
+    fail(data.count == 0, lambda i: "contacts: a grasp needs at least one contact")
+    dim = np.zeros(g, dtype=np.int64)
+    has = data.count > 0
+    dim[has] = checked.dim[offsets[:-1][has]]
+    if len(owner):
+        mixed = np.zeros(g, dtype=bool)
+        np.logical_or.at(mixed, owner, checked.dim != dim[owner])
+        fail(mixed, lambda i: "contacts: mix dimensions "
+                              f"{sorted(set(checked.dim[offsets[i]:offsets[i + 1]].tolist()))}; "
+                              "a grasp is planar or spatial")
+    given = data.clen >= 0
+    fail(given & (data.clen != dim),
+         lambda i: f"center: center has {data.clen[i]} coordinates, the contacts have {dim[i]}")
+    with np.errstate(invalid="ignore"):
+        finite = (np.isfinite(data.center) & (np.abs(data.center) <= MAX_LENGTH)).all(axis=1)
+        fail(given & ~finite, lambda i: f"center: NaN or infinite coordinate, or one beyond {MAX_LENGTH:g}: "
+                                        f"expected {dim[i]} finite numbers, got {show(data.raw.get((i, 'center')))}")
+        L = data.length
+        fail(data.length_given & ~((L >= MIN_LENGTH) & (L <= MAX_GRASP_LENGTH)),
+             lambda i: f"length: length must be > 0 (at least {MIN_LENGTH:g}), finite and <= "
+                       f"{MAX_GRASP_LENGTH:g}, got {show(data.raw.get((i, 'length'), L[i]))}")
+    ok = todo
+    center = data.center.copy()
+    length = data.length.copy()
+    need_c = ok & ~given
+    if need_c.any():
+        # the centroid: the sum of the points in contact order over their count
+        p = np.where(np.isfinite(checked.p), checked.p, 0.0)
+        sums = np.stack([np.bincount(owner, p[:, q], minlength=g) for q in range(3)], axis=1)
+        center[need_c] = sums[need_c] / np.maximum(data.count[need_c], 1)[:, None]
+    need_l = ok & ~data.length_given
+    if need_l.any():
+        far, size = np.zeros(g), np.zeros(g)
+        has = data.count > 0
+        if has.any():
+            far[has] = np.maximum.reduceat(_reach(checked.p - center[owner]), offsets[:-1][has])
+            with np.errstate(invalid="ignore"):
+                size[has] = np.maximum.reduceat(np.nan_to_num(np.abs(checked.p)).max(axis=1), offsets[:-1][has])
+        # contacts that coincide up to the rounding of their centroid: no lever arm to scale
+        apart = far > 8 * 2.0**-53 * size
+        length[need_l] = np.where(apart[need_l], far[need_l], 1.0)
+        with np.errstate(invalid="ignore"):
+            fail(need_l & ~((length >= MIN_LENGTH) & (length <= MAX_GRASP_LENGTH)),
+                 lambda i: f"contacts: the contacts lie within {length[i]:.3g} of the center, outside the "
+                           f"usable range [{MIN_LENGTH:g}, {MAX_GRASP_LENGTH:g}] of the length that divides "
+                           "torques: give 'length' or rescale the coordinates")
+    return CheckedGrasps(error, np.where(ok, dim, 0), np.where(ok[:, None], center, 0.0),
+                         np.where(ok, length, 1.0), checked, offsets)

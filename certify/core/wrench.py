@@ -1,0 +1,252 @@
+"""Wrenches, friction-cone edges and contact frames: the one place where they are computed.
+
+Wrench of a force ``f`` applied at ``p`` about the reference point ``c``, with characteristic
+length ``L``: planar ``w = (f_x, f_y, ((p - c) x f) / L)``, spatial ``w = (f, ((p - c) x f) / L)``.
+
+The functions work on float arrays and equally on object arrays of :class:`fractions.Fraction`
+(see :func:`to_exact`): every operation is a sum, product or quotient, so the certificate checker
+evaluates the very same formulas in exact rational arithmetic.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from typing import Sequence
+
+import numpy as np
+
+from .. import models as registry
+from ..errors import ArgumentError
+from .._kernels.linalg import ETA
+from .grasp import Grasp
+from .validation import param_names
+
+__all__ = [
+    "to_exact",
+    "tangent",
+    "cross",
+    "torque",
+    "wrench",
+    "contact_frame",
+    "generator_layout",
+    "generator_columns",
+    "force_columns",
+    "grasp_arrays",
+    "variants_of",
+    "force_column_errors",
+]
+
+
+def to_exact(a) -> np.ndarray:
+    """Object array of :class:`~fractions.Fraction` holding the exact values of the floats in ``a``."""
+    a = np.asarray(a, dtype=float)
+    return np.array([Fraction(v) for v in a.ravel()], dtype=object).reshape(a.shape)
+
+
+def tangent(n: np.ndarray) -> np.ndarray:
+    """Planar unit tangent ``t = (-n_y, n_x)``: ``n`` turned a quarter turn counter-clockwise."""
+    return np.stack([-n[..., 1], n[..., 0]], axis=-1)
+
+
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product of rows: the scalar ``a_x b_y - a_y b_x`` per row in the plane, the 3-vector
+    ``a x b`` per row in space (the one product the torques, face normals and twist axes use)."""
+    if a.shape[-1] == 2:
+        return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return np.stack(
+        [
+            a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+            a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+            a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0],
+        ],
+        axis=-1,
+    )
+
+
+def torque(r: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """Moment ``r x f`` of force(s) ``f`` at lever(s) ``r``: a scalar per row in the plane, a
+    3-vector per row in space."""
+    return cross(r, f)
+
+
+def wrench(p: np.ndarray, f: np.ndarray, center: np.ndarray, length) -> np.ndarray:
+    """Wrench(es) of force(s) ``f`` at point(s) ``p``, shape ``(..., 3)`` or ``(..., 6)``.
+
+    Torques are taken about ``center`` (broadcast against ``p``) and divided by ``length``
+    (broadcast against ``p.shape[:-1]``) so that every row is a force.
+    """
+    p, f = np.broadcast_arrays(p, f)
+    L = np.asarray(length)
+    tau = torque(p - center, f)
+    tau = (tau / L)[..., None] if p.shape[-1] == 2 else tau / L[..., None]
+    return np.concatenate([f, tau], axis=-1)
+
+
+def contact_frame(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit tangents ``t1, t2`` completing the unit normal ``n`` (spatial, float) to a
+    right-handed orthonormal frame ``(n, t1, t2)``."""
+    n = np.asarray(n, dtype=float)
+    axis = np.zeros_like(n)
+    axis[np.arange(len(n)), np.argmin(np.abs(n), axis=1)] = 1.0
+    t1 = cross(n, axis)
+    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+    return t1, torque(n, t1)
+
+
+def grasp_arrays(grasp: Grasp, exact: bool = False):
+    """``(P, N, mu, params, center, length)`` of ``grasp`` as arrays (exact: Fraction objects);
+    ``params`` maps every registered parameter name to its values per contact (0 where a
+    contact's model does not take it), ``mu`` is ``params["mu"]``."""
+    conv = to_exact if exact else (lambda a: np.asarray(a, dtype=float))
+    params = {name: conv([float(c.param(name, 0.0)) for c in grasp.contacts]) for name in param_names()}
+    length = Fraction(grasp.length) if exact else grasp.length
+    return (conv(grasp.points), conv(grasp.normals), params["mu"], params, conv(grasp.center), length)
+
+
+def variants_of(grasp: Grasp) -> tuple[int, ...]:
+    """The model variant of each contact of ``grasp`` (see :meth:`ContactModel.variant`)."""
+    return tuple(int(c.contact_model.variant({k: np.array([v]) for k, v in c.params})[0])
+                 if c.params else 0 for c in grasp.contacts)
+
+
+def generator_layout(models: Sequence[str], variants: Sequence[int], dim: int, *,
+                     frictionless: bool = False):
+    """Owner contact, offset and friction factors of every generator of a polyhedral grasp
+    wrench cone (:class:`~qualgrasp.certify.models.Generator`), in contact order.
+
+    ``frictionless=True`` uses each model's frictionless counterpart (form closure). Raises
+    ValueError when a model has no finite generators in ``dim`` (spatial friction cones).
+    """
+    owner, offset, friction = [], [], []
+    for i, (name, variant) in enumerate(zip(models, variants)):
+        model = registry.get(name)
+        if frictionless:
+            target, _, variant = model.frictionless()
+            model = registry.get(target)
+        gens = model.generators(dim, variant)
+        if gens is None:
+            raise ArgumentError(f"{model.name} contacts have no finite generators in {dim} dimensions; "
+                             "use force_columns (the conic form)")
+        for g in gens:
+            owner.append(i), offset.append(g.offset), friction.append(g.friction)
+    return (np.array(owner, dtype=np.int64), np.array(offset, dtype=float),
+            np.array(friction, dtype=float))
+
+
+def generator_columns(P, N, mu, models, center, length, *, frictionless: bool = False,
+                      width=None, variants: Sequence[int] | None = None):
+    """Generator wrenches of a polyhedral grasp wrench cone, as columns.
+
+    Generator ``j`` of contact ``i`` (:func:`generator_layout`) is the force
+    ``n + friction_j mu_i t`` applied at ``p + offset_j width_i t`` (``t`` the planar tangent):
+    a frictionless contact contributes ``n``; a planar point contact the two edges of its friction
+    cone, ``n + mu t`` and ``n - mu t`` (exact in the plane); a pad the edges at its two ends. With
+    ``frictionless=True`` every contact is replaced by its frictionless counterpart (form closure).
+    The arithmetic is that of :func:`qualgrasp.certify._kernels.planar.planar_generators`, term
+    for term, so both give the same floats; on Fraction arrays it is exact.
+
+    Parameters
+    ----------
+    P, N : array, shape (..., m, dim)
+        Contact points and inward unit normals (leading batch dimensions allowed).
+    mu : array, shape (..., m)
+    models : sequence of str, length m
+        Contact model of each contact (shared by the batch).
+    center : array, shape (..., dim)
+    length : scalar or array, shape (...)
+    width : array, shape (..., m), optional
+        Pad widths (zeros by default).
+    variants : sequence of int, optional
+        Model variant of each contact (shared by the batch); default: from the first grasp's
+        ``mu`` and ``width``.
+
+    Returns
+    -------
+    W : array, shape (..., d, k)
+        Generator wrenches (d = 3 planar, 6 spatial).
+    owner : ndarray of int, shape (k,)
+        Index of the contact each column belongs to.
+    """
+    exact = np.asarray(N).dtype == object
+    width = np.zeros(np.shape(mu)) if width is None else width
+    if variants is None:
+        first = (0,) * (np.ndim(mu) - 1)
+        variants = [int(registry.get(name).variant({"mu": np.array([float(np.asarray(mu)[first + (i,)])]),
+                                                     "width": np.array([float(np.asarray(width)[first + (i,)])]),
+                                                     "torsion": np.zeros(1)})[0])
+                    for i, name in enumerate(models)]
+    owner, offset, friction = generator_layout(models, variants, P.shape[-1], frictionless=frictionless)
+    conv = to_exact if exact else (lambda a: a)
+    Nk = N[..., owner, :]
+    Pk = P[..., owner, :]
+    F = Nk
+    if friction.any() or offset.any():
+        T = tangent(Nk)
+        if friction.any():
+            F = np.where((friction != 0)[:, None], Nk + (conv(friction) * mu[..., owner])[..., None] * T, Nk)
+        if offset.any():
+            Pk = np.where((offset != 0)[:, None], Pk + (conv(offset) * width[..., owner])[..., None] * T, Pk)
+    W = wrench(Pk, F, np.asarray(center)[..., None, :], np.asarray(length)[..., None])
+    return np.swapaxes(W, -1, -2), owner
+
+
+def force_columns(P, N, models, center, length):
+    """Wrenches of the unit values of the conic form's certificate columns, as columns.
+
+    Layout per contact (:class:`~qualgrasp.certify.models.ContactModel`): ``forces == "normal"``
+    one column ``[n]``; ``"axes"`` one per world axis ``[e_1, ..., e_dim]``; then one column
+    ``(0, n / L)`` per moment in ``extra`` (a unit moment about the stored, unit up to rounding,
+    normal ``n``). Arguments as in :func:`generator_columns` (leading batch dimensions allowed).
+
+    Returns
+    -------
+    C : array, shape (..., d, k)
+    owner : ndarray of int, shape (k,)
+    """
+    dim = P.shape[-1]
+    batch = P.shape[:-2]
+    eye = to_exact(np.eye(dim)) if N.dtype == object else np.eye(dim)
+    c = np.asarray(center)[..., None, :]
+    L = np.asarray(length)[..., None]
+    cols, owner = [], []
+    for i, name in enumerate(models):
+        model = registry.get(name)
+        if model.forces is None:
+            raise ArgumentError(f"{name} contacts have no conic form (they are polyhedral: use the generators)")
+        forces = N[..., i:i + 1, :] if model.forces == "normal" else np.broadcast_to(eye, batch + (dim, dim))
+        w = wrench(P[..., i:i + 1, :], forces, c, L)
+        cols += [w[..., j, :] for j in range(w.shape[-2])]
+        owner += [i] * w.shape[-2]
+        for _ in model.extra:
+            cols.append(np.concatenate([N[..., i, :] * 0, N[..., i, :] / np.asarray(length)[..., None]], axis=-1))
+            owner.append(i)
+    return np.stack(cols, axis=-1), np.array(owner, dtype=int)
+
+
+def force_column_errors(P, N, models, center, length) -> np.ndarray:
+    """Bounds (B, 6, k) on the distance between the float spatial columns of
+    :func:`force_columns` and their exact values on the same data, for a batch (B, m, 3):
+    forces are exact (world axes or stored normals); torques ``(r x f) / L`` within
+    ``(gamma_8 (|r_a| |f_b| + |r_b| |f_a|) + 4 eta) / L + eta`` per component
+    (``gamma_n = n u / (1 - n u)``, ``eta`` the smallest subnormal, for products that
+    underflow); a moment column ``n / L`` within ``2u |n| / L + eta``."""
+    B = P.shape[0]
+    k = sum(registry.get(name).columns(3) for name in models)
+    E = np.zeros((B, 6, k))
+    L = np.asarray(length)
+    g8 = 8 * 2.0**-53 / (1 - 8 * 2.0**-53)
+    j = 0
+    for i, name in enumerate(models):
+        model = registry.get(name)
+        r = np.abs(P[:, i, :] - center)
+        forces = ([np.abs(N[:, i, :])] if model.forces == "normal"
+                  else [np.broadcast_to(np.eye(3)[q], (B, 3)) for q in range(3)])
+        for f in forces:
+            E[:, 3, j] = (g8 * (r[:, 1] * f[:, 2] + r[:, 2] * f[:, 1]) + 4 * ETA) / L + ETA
+            E[:, 4, j] = (g8 * (r[:, 2] * f[:, 0] + r[:, 0] * f[:, 2]) + 4 * ETA) / L + ETA
+            E[:, 5, j] = (g8 * (r[:, 0] * f[:, 1] + r[:, 1] * f[:, 0]) + 4 * ETA) / L + ETA
+            j += 1
+        for _ in model.extra:
+            E[:, 3:, j] = 2 * 2.0**-53 * np.abs(N[:, i, :]) / L[:, None] + ETA
+            j += 1
+    return E

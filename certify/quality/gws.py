@@ -1,0 +1,325 @@
+"""The grasp wrench space (GWS) of a grasp as the epsilon bounds see it: its generators, its
+support points along given directions and the hulls of points of it, in floating point with
+error bounds.
+
+Computing the bounds (:mod:`qualgrasp.certify.quality.bounds`) and proving them
+(:mod:`qualgrasp.certify.quality.evidence`) build the vertices of an inscribed polytope with the
+same functions, so that a vertex the evidence names is the vertex that was computed:
+
+* planar grasps: the generator wrenches with their error bounds (:func:`planar_generator_arrays`),
+  the support point along a direction (:func:`planar_support_choice`, the first generator of each
+  contact with the largest ``v . g``) and sums of generators (:func:`sum_rows`);
+* spatial grasps with exact cones: the support forces of every contact (:class:`ConicSupport`),
+  pulled inside their cones by :data:`SHRINK` and scaled towards the origin by
+  :func:`vertex_scale`;
+* hulls: qhull's faces oriented about the origin (:func:`surface_faces`) and their float distances.
+"""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+from typing import Sequence
+
+import numpy as np
+from scipy.spatial import ConvexHull, QhullError
+
+from .._kernels.planar import planar_generators
+from ..core import cones
+from ..core.grasp import Grasp
+from ..core.problem import grasp_system
+from ..core.wrench import force_column_errors, generator_layout, grasp_arrays, to_exact, variants_of
+
+__all__ = ["SHRINK", "surface_faces", "orient_faces", "generalised_cross", "face_distances",
+           "planar_generator_arrays", "sum_errors", "planar_support_choice", "planar_support_vertices",
+           "sum_rows", "sqrt_bounds", "vertex_scale", "ConicSupport"]
+
+#: Support forces are pulled this far inside their cones (tangential part times ``SHRINK``).
+SHRINK = 1.0 - 2.0**-30
+
+# --- surfaces ------------------------------------------------------------------------------------
+
+def surface_faces(points: np.ndarray) -> np.ndarray | None:
+    """Faces of the hull of ``points`` (n, d) from qhull, each ordered so that its float
+    determinant ``det(v_1, ..., v_d)`` is positive (outward about an interior origin); None when
+    qhull fails."""
+    try:
+        hull = ConvexHull(points)
+    except (QhullError, ValueError):
+        return None
+    return orient_faces(points, hull.simplices)
+
+
+def orient_faces(points: np.ndarray, simplices: np.ndarray) -> np.ndarray:
+    """``simplices`` with the first two vertices swapped where the float determinant of the
+    vertices is negative."""
+    faces = np.array(simplices, dtype=np.int64)
+    flip = np.linalg.det(points[faces]) < 0
+    faces[flip, 0], faces[flip, 1] = faces[flip, 1], faces[flip, 0].copy()
+    return faces
+
+
+def generalised_cross(simplices: np.ndarray) -> np.ndarray:
+    """Generalised cross product of ``v_2 - v_1, ..., v_d - v_1`` for simplices (F, d, d) of
+    vertex rows: ``n_r = (-1)^r det(D without coordinate r)``, so that ``n . v_1 = det(v_1, ...,
+    v_d)`` and ``n`` is normal to the face (floats)."""
+    D = simplices[:, 1:, :] - simplices[:, :1, :]  # (F, d-1, d)
+    d = simplices.shape[2]
+    out = np.empty((simplices.shape[0], d))
+    for r in range(d):
+        minor = np.delete(D, r, axis=2)
+        out[:, r] = (-1.0) ** r * (np.linalg.det(minor) if d > 2 else minor[:, 0, 0])
+    return out
+
+
+def face_distances(points: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Signed distance of each face's hyperplane from the origin, ``det / |n|`` (floats; NaN for
+    a degenerate face)."""
+    S = points[faces]
+    n = generalised_cross(S)
+    det = np.einsum("fd,fd->f", n, S[:, 0, :])
+    norm = np.linalg.norm(n, axis=1)
+    return np.divide(det, norm, out=np.full(len(det), np.nan), where=norm > 0)
+
+
+# --- planar generators and support points -------------------------------------------------------
+
+def planar_generator_arrays(grasp: Grasp):
+    """Generator wrenches ``W`` (3, k) of a planar grasp, bounds ``E`` on their distance to the
+    exact values (:func:`qualgrasp.certify._kernels.planar.planar_generators`: the floats of
+    :func:`qualgrasp.certify.core.problem.grasp_system`), and the owner contact of each (sorted)."""
+    P, N, mu, params, c, L = grasp_arrays(grasp)
+    models = tuple(ct.model for ct in grasp.contacts)
+    owner, offset, friction = generator_layout(models, variants_of(grasp), 2)
+    W = np.empty((3, len(owner)))
+    E = np.empty((3, len(owner)))
+    planar_generators(P, N, mu, params["width"], c, float(L), owner, offset, friction, W, E)
+    return W, E, owner
+
+
+def sum_errors(E: np.ndarray, mag: np.ndarray, terms: int) -> np.ndarray:
+    """Error bound of a float sum of ``terms`` points whose own errors add up to ``E`` and whose
+    magnitudes add up to ``mag``."""
+    return E + 2 * (terms + 1) * 2.0**-53 * mag
+
+
+def planar_support_choice(W: np.ndarray, owner: np.ndarray, m: int, v: np.ndarray) -> np.ndarray:
+    """The vertex of planar ``support`` evidence along ``v``: for each contact the first of its
+    generators (columns of ``W``, ``owner`` sorted) with the largest ``v @ g``, or -1 (the
+    origin) when that is not positive."""
+    vals = v @ W
+    start = np.searchsorted(owner, np.arange(m))
+    best = np.maximum.reduceat(vals, start)
+    k = len(vals)
+    first = np.minimum.reduceat(np.where(vals == best[owner], np.arange(k), k), start)
+    return np.where(best > 0, first, -1)
+
+
+def planar_support_vertices(W, E, owner, m, dirs: np.ndarray):
+    """Float vertices, error bounds and generator choices (rows, -1 for the origin) of planar
+    ``support`` evidence along the rows of ``dirs``."""
+    R = np.array([planar_support_choice(W, owner, m, v) for v in dirs], dtype=np.int64).reshape(-1, m)
+    return sum_rows(W, E, R) + (R,)
+
+
+def sum_rows(W, E, R):
+    used = R >= 0
+    idx = np.where(used, R, 0)
+    V = np.einsum("vi,vir->vr", used.astype(float), W.T[idx]) if R.size else np.zeros((len(R), 3))
+    EV = np.einsum("vi,vir->vr", used.astype(float), E.T[idx]) if R.size else np.zeros((len(R), 3))
+    mag = np.einsum("vi,vir->vr", used.astype(float), np.abs(W.T[idx])) if R.size else np.zeros((len(R), 3))
+    return V, sum_errors(EV, mag, R.shape[1])
+
+
+def sqrt_bounds(q: Fraction, bits: int = 60) -> tuple[Fraction, Fraction]:
+    """Rational bounds of ``sqrt(q)`` (``q >= 0``) to about ``bits`` bits."""
+    q = Fraction(q)
+    if q <= 0:
+        return Fraction(0), Fraction(0)
+    num, den = q.numerator, q.denominator
+    scale = 1 << (2 * bits)
+    r = math.isqrt(num * den * scale)  # sqrt(q) = sqrt(num den scale) / (den 2^bits)
+    lo = Fraction(r, den << bits)
+    hi = lo if r * r == num * den * scale else Fraction(r + 1, den << bits)
+    return lo, hi
+
+
+# --- spatial support points ---------------------------------------------------------------------
+
+def vertex_scale(i: int) -> float:
+    """Scale of the ``i``-th vertex of ``support`` evidence: ``1 - 2^-14 j / 2^16`` with ``j``
+    Knuth's multiplicative hash of ``i`` (an exact dyadic number in ``[1 - 2^-14, 1]``)."""
+    return 1.0 - ((i * 40503) % 65536) * 2.0**-30
+
+
+class ConicSupport:
+    """Support forces of a spatial grasp's contacts (the vertices of ``support`` evidence).
+
+    Parameters
+    ----------
+    grasp : Grasp
+        A spatial grasp; its conic system (:func:`qualgrasp.certify.core.problem.grasp_system`,
+        ``socp=True``) gives the columns of every contact block.
+    """
+
+    def __init__(self, grasp: Grasp) -> None:
+        system = grasp_system(grasp, socp=True)
+        self.grasp = grasp
+        self.C = np.asarray(system.columns, dtype=float)
+        self.absC = np.abs(self.C)
+        self.blocks = system.blocks
+        self._Cx = None
+        P, N, mu, params, c, L = grasp_arrays(grasp)
+        models = tuple(ct.model for ct in grasp.contacts)
+        self.errors = force_column_errors(P[None], N[None], models, c[None], np.array([L]))[0]
+        self.data = []
+        ray, lor = [], []
+        for i, b in enumerate(self.blocks):
+            cols = np.array(b.cols)
+            if b.cone == "ray":
+                self.data.append((cols, None, None, 0.0, 0.0, 0.0))
+                ray.append(i)
+                continue
+            n = np.asarray(b.n, dtype=float)
+            rn = math.sqrt(float(n @ n))
+            self.data.append((cols, n, n / rn, float(b.mu), float(b.g), rn))
+            lor.append(i)
+        self.ray = np.array(ray, dtype=np.int64)
+        self.ray_col = np.array([self.data[i][0][0] for i in ray], dtype=np.int64)
+        self.lor = np.array(lor, dtype=np.int64)
+        self.f_col = np.array([self.data[i][0][:3] for i in lor], dtype=np.int64).reshape(-1, 3)
+        self.m_col = np.array([self.data[i][0][3] if len(self.data[i][0]) > 3 else -1 for i in lor],
+                              dtype=np.int64)
+        self.n = np.array([self.data[i][1] for i in lor]).reshape(-1, 3)
+        self.nh = np.array([self.data[i][2] for i in lor]).reshape(-1, 3)
+        self.mu = np.array([self.data[i][3] for i in lor])
+        self.g = np.array([self.data[i][4] for i in lor])
+        self.gr = np.array([self.data[i][4] / self.data[i][5] for i in lor])
+        self.nn = np.einsum("bi,bi->b", self.n, self.n)
+
+    @property
+    def Cx(self):
+        """Exact columns (built on first use)."""
+        if self._Cx is None:
+            self._Cx = grasp_system(self.grasp, socp=True, exact=True).columns
+        return self._Cx
+
+    def forces(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Each block's support value ``c_b(v)`` (the largest ``v . w`` over its wrenches with
+        unit normal force) and the values on every column (forces, moments) reaching them,
+        pulled inside by :data:`SHRINK`: ``f = n/|n| + SHRINK mu z_t / |z|``, ``m = (g / |n|)
+        SHRINK mu z_m / |z|`` with ``z = (a_t, a_m g / |n|)``, ``a`` the functional ``C_b' v``; a
+        ray's value is 1. A fixed float formula, so producer and checker compute the same."""
+        a = self.C.T @ v
+        c = np.empty(len(self.blocks))
+        X = np.zeros(self.C.shape[1])
+        c[self.ray] = a[self.ray_col]
+        X[self.ray_col] = 1.0
+        if len(self.lor):
+            af = a[self.f_col]
+            an = np.einsum("bi,bi->b", af, self.nh)
+            at = af - an[:, None] * self.nh
+            am = np.where(self.m_col >= 0, a[self.m_col] * self.gr, 0.0)
+            nz = np.sqrt(np.einsum("bi,bi->b", at, at) + am * am)
+            c[self.lor] = an + self.mu * nz
+            k = np.divide(SHRINK * self.mu, nz, out=np.zeros_like(nz), where=nz > 0)
+            X[self.f_col] = self.nh + k[:, None] * at
+            has_m = self.m_col >= 0
+            X[self.m_col[has_m]] = (k * am * self.gr)[has_m]
+        return c, X
+
+    def inside(self, b: int, x: np.ndarray) -> bool:
+        """Is the block value ``x`` strictly inside block ``b``'s cone? Exact
+        (:func:`qualgrasp.certify.core.cones.inside`)."""
+        cols, n, nh, mu, g, rn = self.data[b]
+        if n is None:
+            return bool(x[0] > 0)
+        blk = self.blocks[b]
+        return cones.inside(blk.cone, list(to_exact(x)), list(to_exact(n)), Fraction(mu), Fraction(g))
+
+    def _inside_all(self, X: np.ndarray, use: np.ndarray) -> bool:
+        """Every used block's values strictly inside its cone: a float test with a rigorous
+        margin (the rounding of ``|n|^2 |f|^2 - (f . n)^2 + (m |n|^2 / g)^2`` is far below
+        ``1e-14`` of its terms), then the exact test for the blocks it leaves open."""
+        sel = np.zeros(len(self.blocks), dtype=bool)
+        sel[use] = True
+        if not (X[self.ray_col[sel[self.ray]]] > 0).all():
+            return False
+        on = sel[self.lor]
+        f = X[self.f_col[on]]
+        fn = np.einsum("bi,bi->b", f, self.n[on])
+        ff = np.einsum("bi,bi->b", f, f)
+        nn = self.nn[on]
+        mcol = self.m_col[on]
+        extra = np.where(mcol >= 0, (X[mcol] * nn / np.where(self.g[on] > 0, self.g[on], 1.0)) ** 2, 0.0)
+        tang = nn * ff - fn * fn + extra
+        mu2 = self.mu[on] ** 2 * fn * fn
+        err = 1e-14 * (nn * ff + fn * fn + extra + mu2)
+        good = (fn > 0) & (tang + err < mu2 - err)
+        for b in self.lor[on][~good]:
+            if not self.inside(int(b), X[self.data[b][0]]):
+                return False
+        return True
+
+    def vertex(self, v: np.ndarray, norm: str, index: int, ref: int | None = None):
+        """Vertex ``index`` of ``support`` evidence: the support point along ``v`` scaled by
+        :func:`vertex_scale`, as ``(w, err, x)``: float wrench, bound on its distance to the
+        exact one, and the values on every column (0 off the blocks it sums); None when a value
+        could not be proved inside its cone. ``ref`` (L1): the contact to use (default: the one
+        with the largest term)."""
+        c, X = self.forces(v)
+        if norm == "L1":
+            use = np.array([int(np.argmax(c)) if ref is None else ref])
+        else:
+            use = np.flatnonzero(c > 0)
+        keep = np.zeros(self.C.shape[1], dtype=bool)
+        for b in use:
+            keep[self.data[b][0]] = True
+        x = np.where(keep, X * vertex_scale(index), 0.0)
+        if not self._inside_all(x, use):
+            return None
+        ax = np.abs(x)
+        return self.C @ x, sum_errors(self.errors @ ax, self.absC @ ax, int(keep.sum())), x
+
+    def exact_vertex(self, x: np.ndarray) -> list[Fraction]:
+        """The exact wrench of the column values ``x``."""
+        Cx = self.Cx
+        nz = [(j, Fraction(float(x[j]))) for j in np.flatnonzero(x)]
+        return [sum((Cx[r, j] * t for j, t in nz), Fraction(0)) for r in range(Cx.shape[0])]
+
+    def h_bounds(self, u: Sequence[float], norm: str) -> tuple[Fraction, Fraction]:
+        """Rigorous bounds ``(lo, hi)`` of ``h(u) / |u|`` (exact columns, integer square roots;
+        ``hi < 0`` for a zero ``u``)."""
+        ux = [Fraction(float(t)) for t in u]
+        Cx = self.Cx
+        d = Cx.shape[0]
+        a = [sum(Cx[r, j] * ux[r] for r in range(d)) for j in range(Cx.shape[1])]
+        terms = []
+        for cols, n, nh, mu, g, rn in self.data:
+            if n is None:
+                t = a[cols[0]]
+                terms.append((t, t))
+                continue
+            dim = len(n)
+            nx = [Fraction(float(t)) for t in n]
+            af = [a[j] for j in cols[:dim]]
+            an = sum(x * y for x, y in zip(af, nx))
+            nn = sum(x * x for x in nx)
+            tang = nn * sum(x * x for x in af) - an * an
+            for j in cols[dim:]:
+                tang += (a[j] * Fraction(g)) ** 2
+            mu_x = Fraction(mu)
+            s_lo, s_hi = sqrt_bounds(tang)
+            r_lo, r_hi = sqrt_bounds(nn)
+            num_lo, num_hi = an + mu_x * s_lo, an + mu_x * s_hi
+            terms.append((num_lo / (r_hi if num_lo >= 0 else r_lo), num_hi / (r_lo if num_hi >= 0 else r_hi)))
+        if norm == "L1":
+            lo = max(max(t[0] for t in terms), Fraction(0))
+            hi = max(max(t[1] for t in terms), Fraction(0))
+        else:
+            lo = sum(max(t[0], Fraction(0)) for t in terms)
+            hi = sum(max(t[1], Fraction(0)) for t in terms)
+        u_lo, u_hi = sqrt_bounds(sum(x * x for x in ux))
+        if u_lo <= 0:
+            return Fraction(0), Fraction(-1)
+        return lo / u_hi, hi / u_lo
