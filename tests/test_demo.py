@@ -12,6 +12,10 @@ from qualgrasp.experiments.study import BUILTINS
 
 runner = CliRunner()
 
+# The whole job (figures, synthesis, certification, the quick study): `.ci/run` also runs it as the
+# README's demo command before the tests.
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def demo(tmp_path_factory):

@@ -57,3 +57,17 @@ def test_readme_python_api_example_runs_as_written():
     namespace: dict = {}
     exec(compile(tree, "README.md", "exec"), namespace)
     assert eval(compile(ast.Expression(last.value), "README.md", "eval"), namespace) is True
+
+
+def _readme_command(marker: str) -> str:
+    lines = (Path(__file__).resolve().parents[1] / "README.md").read_text().splitlines()
+    return lines[lines.index(f"<!-- {marker} -->") + 2]
+
+
+@pytest.mark.parametrize("marker", ["demo-command", "test-command", "slow-test-command"])
+def test_getting_started_gives_the_readme_commands(marker):
+    """The documentation site's getting-started page gives the README's commands as written
+    (``.ci/run`` runs the README's)."""
+    page = (Path(__file__).resolve().parents[1] / "docs" / "getting-started.rst").read_text()
+    assert _readme_command(marker).startswith(("python3 ", ". .venv"))
+    assert f"   {_readme_command(marker)}\n" in page

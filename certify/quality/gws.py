@@ -60,9 +60,12 @@ def orient_faces(points: np.ndarray, simplices: np.ndarray) -> np.ndarray:
 
 
 def generalised_cross(simplices: np.ndarray) -> np.ndarray:
-    """Generalised cross product of ``v_2 - v_1, ..., v_d - v_1`` for simplices (F, d, d) of
-    vertex rows: ``n_r = (-1)^r det(D without coordinate r)``, so that ``n . v_1 = det(v_1, ...,
-    v_d)`` and ``n`` is normal to the face (floats)."""
+    """Generalised cross product ``n`` of the edges ``v_i - v_1`` (i = 2..d) of simplices
+    (F, d, d) of vertex rows, normal to each face (floats).
+
+    ``n_r = (-1)^r det(D without coordinate r)`` with ``D`` the edges, so that the dot product
+    ``n·v_1`` equals ``det(v_1, ..., v_d)``.
+    """
     D = simplices[:, 1:, :] - simplices[:, :1, :]  # (F, d-1, d)
     d = simplices.shape[2]
     out = np.empty((simplices.shape[0], d))
@@ -122,7 +125,10 @@ def planar_support_vertices(W, E, owner, m, dirs: np.ndarray):
     return sum_rows(W, E, R) + (R,)
 
 
-def sum_rows(W, E, R):
+def sum_rows(W: np.ndarray, E: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Sums of generator rows: for each vertex the sum of the generators ``W`` (3, k) it picks in
+    ``R`` (vertices, contacts; -1 picks none), with the bound of :func:`sum_errors` on its error
+    from the generators' own bounds ``E``. Returns ``(V, bounds)``, both (vertices, 3)."""
     used = R >= 0
     idx = np.where(used, R, 0)
     V = np.einsum("vi,vir->vr", used.astype(float), W.T[idx]) if R.size else np.zeros((len(R), 3))
