@@ -19,7 +19,7 @@ from ..qualitative.procedures import Procedure
 from ..qualitative.synthesis import NOT_COUNTED
 from .baseline import MU, Budget
 
-__all__ = ["Route", "routes", "KINDS", "UNITS", "BUILTINS", "ROUTES", "QUICK", "FULL",
+__all__ = ["Route", "routes", "compared_procedure", "KINDS", "UNITS", "BUILTINS", "ROUTES", "QUICK", "FULL",
            "SETTINGS", "REASONS", "OBJECT_COLUMNS", "OVERALL_COLUMNS", "ROBUSTNESS_COLUMNS", "GRASP_COLUMNS",
            "DETERMINISTIC", "Settings", "Subject", "RouteSummary", "StudyResult"]
 
@@ -52,6 +52,16 @@ def routes() -> tuple[Route, ...]:
     baselines = {(p.fingers, p.model): p for p in reversed(procs)}  # the first registered wins
     return tuple(Route("qualitative", p) for p in procs) + tuple(
         Route("baseline", p) for p in procs if baselines[(p.fingers, p.model)] is p)
+
+
+def compared_procedure(procedure: Procedure, method: str) -> Procedure:
+    """The procedure whose rows carry ``method``'s route for ``procedure``: itself for the
+    qualitative route, else the procedure the baseline with the same fingers and contact model
+    carries (:func:`routes`; PairGrasp 3 is compared with the baseline ForceGrasp 3 carries)."""
+    if method == "qualitative":
+        return procedure
+    return next(r.procedure for r in routes() if r.method == method
+                and (r.procedure.fingers, r.procedure.model) == (procedure.fingers, procedure.model))
 
 
 KINDS = ("rotation", "translation", "noise", "blur", "threshold")
@@ -94,9 +104,11 @@ OVERALL_COLUMNS = ("route", "method", "fingers", "objects", "objects_with_grasps
 and not excluded by a reason of :data:`REASONS`), grasps, certified fraction (pooled), medians over
 objects of the per-object median and best epsilon and of the ratios (objects where both routes
 found grasps), median and total seconds, robustness pooled over every perturbation (not ``none``),
-and the same over the trials where both methods planned a counted grasp with the route's finger
-count (``paired``: the qualitative route finds no grasp on some objects, where the baseline's
-grasps may be the most fragile); the median over objects of the best grasp's certified slide
+and the same over the trials where the route's partner planned a counted grasp too
+(``robustness_paired``; the partner of a qualitative route is the baseline with the same fingers
+and contact model, that of a baseline the qualitative route of the procedure it carries: the
+qualitative route finds no grasp on some objects, where the baseline's grasps may be the most
+fragile); the median over objects of the best grasp's certified slide
 (``slide_median``, fraction of the size; objects where it was computed) and the share of those
 objects where some sliding is certified (``slide_robust``), and the same of ``delta`` before
 clipping (``delta_median``, ``delta_robust``); the grasps counted, and per reason the certified

@@ -87,6 +87,7 @@ from shapely.geometry import Polygon
 
 from qualgrasp.certify import Contact, Grasp
 from qualgrasp.certify.errors import GraspError
+from qualgrasp.qualitative import procedures
 from qualgrasp.qualitative.errors import QualitativeError
 from qualgrasp.qualitative.formgrasp import ray_edges
 from qualgrasp.qualitative.independent import independent_grasp, planned_regions
@@ -98,7 +99,7 @@ from qualgrasp.qualitative.vision import read_image, segment
 from .baseline import Boundary, Budget, baseline, boundary, boundary_of_polygon, screen_grasps
 from .design import (BUILTINS, DETERMINISTIC, FULL, GRASP_COLUMNS, KINDS, OBJECT_COLUMNS,
                      OVERALL_COLUMNS, QUICK, REASONS, ROBUSTNESS_COLUMNS, ROUTES, SETTINGS, UNITS, Route,
-                     RouteSummary, Settings, StudyResult, Subject, routes)
+                     RouteSummary, Settings, StudyResult, Subject, compared_procedure, routes)
 from .silhouettes import Silhouette
 from .study_plots import plot_all
 from .study_tables import overall_rows, robustness_rows, summarise, write_tables
@@ -410,8 +411,10 @@ def _with_ratios(rows: list[dict]) -> list[dict]:
     """Fill ``ratio_best``/``ratio_median`` of qualitative rows from the baseline's best."""
     best = {r["procedure"]: r["eps_best"] for r in rows if r["method"] == "baseline"}
     for r in rows:
-        ref = best.get(r["procedure"])
-        if r["method"] == "qualitative" and ref and r["eps_best"] is not None:
+        if r["method"] != "qualitative":
+            continue
+        ref = best.get(compared_procedure(procedures.get(r["procedure"]), "baseline").name)
+        if ref and r["eps_best"] is not None:
             r["ratio_best"] = r["eps_best"] / ref
             r["ratio_median"] = r["eps_median"] / ref
     return rows

@@ -30,7 +30,7 @@ import numpy as np
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from ..qualitative import procedures
-from .design import KINDS, UNITS
+from .design import KINDS, UNITS, compared_procedure
 from .style import context, new_figure, save
 
 __all__ = ["plot_epsilon", "plot_quality_time", "plot_robustness", "plot_tolerance", "plot_all"]
@@ -63,12 +63,13 @@ def plot_epsilon(out: Path, object_rows: list[dict], grasp_rows: list[dict]) -> 
         for ax, p in zip(axes, procs):
             ticks = []
             for x, method in enumerate(("qualitative", "baseline")):
+                name = compared_procedure(p, method).name
                 eps = [g["eps"] for g in grasp_rows
-                       if g["procedure"] == p.name and g["method"] == method and g["counted"]]
-                best = [r["eps_best"] for r in object_rows if r["procedure"] == p.name
+                       if g["procedure"] == name and g["method"] == method and g["counted"]]
+                best = [r["eps_best"] for r in object_rows if r["procedure"] == name
                         and r["method"] == method and r["eps_best"] is not None and r["counted"]]
                 dropped = sum(g["certified"] and not g["counted"] for g in grasp_rows
-                              if g["procedure"] == p.name and g["method"] == method)
+                              if g["procedure"] == name and g["method"] == method)
                 color = p.colour
                 if eps:
                     ax.boxplot([eps], positions=[x], widths=0.5, showfliers=False,
@@ -77,7 +78,7 @@ def plot_epsilon(out: Path, object_rows: list[dict], grasp_rows: list[dict]) -> 
                                capprops={"color": "0.4"})
                 ax.scatter(_jitter(len(best), x, rng), best, s=9, color=color, alpha=0.8,
                            marker=_METHOD[method][1], zorder=3, linewidths=0)
-                total = sum(1 for r in object_rows if r["procedure"] == p.name and r["method"] == method)
+                total = sum(1 for r in object_rows if r["procedure"] == name and r["method"] == method)
                 ticks.append(f"{method}\n{len(best)}/{total} objects"
                              + (f"\n{dropped} not counted" if dropped else ""))
             ax.set_xticks([0, 1], ticks)
@@ -134,7 +135,8 @@ def plot_robustness(out: Path, robust: list[dict], mu: dict | None = None) -> li
         for row, p in enumerate(procs):
             for ax, kind in zip(axes[row], KINDS):
                 for method in ("qualitative", "baseline"):
-                    routes = {r["route"] for r in robust if r["procedure"] == p.name and r["method"] == method}
+                    name = compared_procedure(p, method).name
+                    routes = {r["route"] for r in robust if r["procedure"] == name and r["method"] == method}
                     for route in routes:
                         x, y = _curve(robust, route, kind)
                         style, marker, name = _METHOD[method]
@@ -173,7 +175,8 @@ def plot_tolerance(out: Path, object_rows: list[dict], robust: list[dict]) -> li
         for ax, p in zip(axes, procs):
             ticks = []
             for x, method in enumerate(("qualitative", "baseline")):
-                delta = [r["slide_best"] for r in object_rows if r["procedure"] == p.name
+                name = compared_procedure(p, method).name
+                delta = [r["slide_best"] for r in object_rows if r["procedure"] == name
                          and r["method"] == method and r.get("slide_best") is not None]
                 if delta:
                     ax.boxplot([delta], positions=[x], widths=0.5, showfliers=False,
@@ -182,7 +185,7 @@ def plot_tolerance(out: Path, object_rows: list[dict], robust: list[dict]) -> li
                                capprops={"color": "0.4"})
                 ax.scatter(_jitter(len(delta), x, rng), delta, s=9, color=p.colour, alpha=0.8,
                            marker=_METHOD[method][1], zorder=3, linewidths=0)
-                held = _held(robust, p.name, method)
+                held = _held(robust, name, method)
                 positive = sum(d > 0 for d in delta)
                 ticks.append(f"{method}\n{positive}/{len(delta)}: slide > 0\n"
                              f"held {'-' if held is None else format(held, '.3f')}")

@@ -15,9 +15,9 @@ import numpy as np
 from qualgrasp.certify.files import atomic_output
 
 from .design import (GRASP_COLUMNS, KINDS, OBJECT_COLUMNS, OVERALL_COLUMNS, REASONS, ROBUSTNESS_COLUMNS,
-                     UNITS, RouteSummary, Settings, routes)
+                     UNITS, Route, RouteSummary, Settings, compared_procedure, routes)
 
-__all__ = ["robustness_rows", "overall_rows", "summarise", "write_csv", "write_markdown",
+__all__ = ["robustness_rows", "partner", "overall_rows", "summarise", "write_csv", "write_markdown",
            "write_tables"]
 
 _TRIAL_COLUMNS = ("object", "route", "method", "fingers", "kind", "size", "trial", "planned",
@@ -53,17 +53,23 @@ def robustness_rows(trial_rows: list[dict], settings: Settings) -> list[dict]:
     return out
 
 
-def _pooled(trial_rows: list[dict], route: str, kinds: Sequence[str], paired: bool = False) -> float | None:
-    """Held over planned for ``route`` and ``kinds``; ``paired``: only the trials where both
-    methods planned a certified grasp for the route's procedure."""
+def partner(route: Route) -> str:
+    """The route whose trials ``route``'s paired robustness is restricted to: the baseline with the
+    same fingers and contact model for a qualitative route, the qualitative route of the procedure
+    it carries for a baseline."""
+    if route.method == "qualitative":
+        return Route("baseline", compared_procedure(route.procedure, "baseline")).name
+    return Route("qualitative", route.procedure).name
+
+
+def _pooled(trial_rows: list[dict], route: str, kinds: Sequence[str], partner: str | None = None) -> float | None:
+    """Held over planned for ``route`` and ``kinds``; with ``partner`` only the trials where the
+    partner route planned a certified grasp too."""
     rows = [r for r in trial_rows if r["route"] == route and r["kind"] in kinds]
-    if paired:
-        key = lambda r: (r["object"], r["kind"], r["size"], r["trial"], r["procedure"])  # noqa: E731
-        methods: dict[tuple, set] = {}
-        for r in trial_rows:
-            if r["planned"]:
-                methods.setdefault(key(r), set()).add(r["method"])
-        rows = [r for r in rows if len(methods.get(key(r), ())) == 2]
+    if partner is not None:
+        key = lambda r: (r["object"], r["kind"], r["size"], r["trial"])  # noqa: E731
+        both = {key(r) for r in trial_rows if r["route"] == partner and r["planned"]}
+        rows = [r for r in rows if key(r) in both]
     planned = sum(r["planned"] for r in rows)
     return sum(r["held"] for r in rows) / planned if planned else None
 
@@ -90,7 +96,7 @@ def overall_rows(object_rows: list[dict], grasp_rows: list[dict], trial_rows: li
             "ratio_median": _median([r["ratio_median"] for r in rows]),
             "seconds_median": _median(seconds), "seconds_total": float(sum(seconds)),
             "robustness": _pooled(trial_rows, route, KINDS),
-            "robustness_paired": _pooled(trial_rows, route, KINDS, paired=True),
+            "robustness_paired": _pooled(trial_rows, route, KINDS, partner(r_)),
             "delta_median": _median(deltas),
             "delta_robust": sum(d > 0 for d in deltas) / len(deltas) if deltas else None,
             "slide_median": _median(slides),

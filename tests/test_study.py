@@ -325,3 +325,25 @@ def test_route_names_are_unique_and_baselines_one_per_contact_pattern():
     assert len(names) == len(set(names))
     patterns = [(r.fingers, r.procedure.model) for r in routes() if r.method == "baseline"]
     assert len(patterns) == len(set(patterns))
+
+
+def test_every_qualitative_route_is_compared_with_the_baseline_of_its_contacts():
+    """PairGrasp 3 has no baseline of its own: its ratios, paired robustness and plot panels use
+    Baseline 3 (its rows carry forcegrasp3), and Baseline 3's paired robustness ForceGrasp 3's."""
+    from qualgrasp.experiments.design import compared_procedure, routes
+    from qualgrasp.experiments.study import _with_ratios
+    from qualgrasp.experiments.study_tables import overall_rows, partner
+    from qualgrasp.qualitative import procedures
+    assert compared_procedure(procedures.get("pairgrasp3"), "baseline").name == "forcegrasp3"
+    assert compared_procedure(procedures.get("pairgrasp3"), "qualitative").name == "pairgrasp3"
+    by_name = {r.name: r for r in routes()}
+    assert partner(by_name["PairGrasp 3"]) == "Baseline 3" == partner(by_name["ForceGrasp 3"])
+    assert partner(by_name["Baseline 3"]) == "ForceGrasp 3"
+    rows = [{"method": "baseline", "procedure": "forcegrasp3", "eps_best": 0.4},
+            {"method": "qualitative", "procedure": "pairgrasp3", "eps_best": 0.1, "eps_median": 0.05}]
+    assert _with_ratios(rows)[1]["ratio_best"] == pytest.approx(0.25)
+    trial = {"object": "o", "kind": "rotation", "size": 8.0, "trial": 0, "planned": 1}
+    trials = [dict(trial, route="PairGrasp 3", held=1), dict(trial, route="Baseline 3", held=0),
+              dict(trial, route="PairGrasp 3", trial=1, held=0)]  # the baseline planned nothing here
+    pair = next(r for r in overall_rows([], [], trials) if r["route"] == "PairGrasp 3")
+    assert pair["robustness"] == 0.5 and pair["robustness_paired"] == 1.0
