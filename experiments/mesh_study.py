@@ -52,6 +52,18 @@ __all__ = ["made_up_meshes", "real_meshes", "independent_travel", "edge8_forces"
            "real_study", "main"]
 
 
+def _tally_edge8(report: dict, grasp, props, verdict: str, hold: float) -> None:
+    """Count in ``report`` a grasp whose 8-edge linearised verdict (Dex-Net's cones) differs from
+    the exact ``verdict`` at grip force ``hold``, and whether its optimistic forces leave the exact
+    cones."""
+    e8 = edge8_forces(grasp, props.mass, props.com, (0, 0, -1), hold)
+    if (e8 is not None) != (verdict == "holds"):
+        report["edge8_differs"] += 1
+        report["edge8_optimistic" if e8 is not None else "edge8_pessimistic"] += 1
+        if e8 is not None:
+            report["optimistic_forces_outside_exact_cones"] += int(not in_exact_cones(grasp, e8))
+
+
 def made_up_meshes() -> dict:
     """The study's objects, in metres."""
     L = np.array([(-0.05, -0.01), (0.05, -0.01), (0.05, 0.09), (0.03, 0.09), (0.03, 0.01), (-0.05, 0.01)])
@@ -263,12 +275,7 @@ def real_study(args) -> dict:
             mine["holds"] += int(verdict == "holds")
             if verdict == "undecided":
                 continue
-            e8 = edge8_forces(grasp, props.mass, props.com, (0, 0, -1), args.hold)
-            if (e8 is not None) != (verdict == "holds"):
-                report["edge8_differs"] += 1
-                report["edge8_optimistic" if e8 is not None else "edge8_pessimistic"] += 1
-                if e8 is not None:
-                    report["optimistic_forces_outside_exact_cones"] += int(not in_exact_cones(grasp, e8))
+            _tally_edge8(report, grasp, props, verdict, args.hold)
         report["per_mesh"][name] = mine
         print(name, mine, flush=True)
     tc, tq = np.array(report.pop("t_contacts")), np.array(report.pop("t_certify"))
@@ -357,12 +364,7 @@ def main(argv: list[str] | None = None) -> dict:
             if verdict == "undecided":
                 report["undecided"] += 1
                 continue
-            e8 = edge8_forces(grasp, props.mass, props.com, (0, 0, -1), args.hold)
-            if (e8 is not None) != (verdict == "holds"):
-                report["edge8_differs"] += 1
-                report["edge8_optimistic" if e8 is not None else "edge8_pessimistic"] += 1
-                if e8 is not None:
-                    report["optimistic_forces_outside_exact_cones"] += int(not in_exact_cones(grasp, e8))
+            _tally_edge8(report, grasp, props, verdict, args.hold)
         print(name, len(outs), "poses", flush=True)
     tc, tq = np.array(report.pop("t_contacts")), np.array(report.pop("t_certify"))
     report["contacts_s_median"], report["contacts_s_p95"] = float(np.median(tc)), float(np.percentile(tc, 95))
