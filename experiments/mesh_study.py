@@ -237,6 +237,9 @@ def real_study(args) -> dict:
     verdict on the same grasps; where they differ, which one the exact cones support."""
     gripper = load_gripper("franka_panda")
     meshes, skipped = real_meshes()
+    if not meshes:
+        packages = sorted({package for package, _, _ in REAL_SOURCES})
+        raise SystemExit(f"mesh_study --real: no object mesh found; install one of {', '.join(packages)}")
     report = {"meshes": len(meshes), "sources": {}, "skipped": skipped, "poses": 0, "reasons": {},
               "t_contacts": [], "t_certify": [], "certified": 0, "unverified": 0, "noted": 0, "withdrawn": 0,
               "verdicts": {"holds": 0, "slips": 0, "undecided": 0}, "edge8_differs": 0, "edge8_optimistic": 0,
