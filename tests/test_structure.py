@@ -31,7 +31,7 @@ def _imports():
 
 
 def test_modules_are_found():
-    assert {"qualgrasp.certify.core.grasp", "qualgrasp.qualitative.synthesis", "qualgrasp.experiments.study",
+    assert {"qualgrasp.certify.core.grasp", "qualgrasp.qualitative.synthesis.pipeline", "qualgrasp.experiments.study",
             "qualgrasp.cli", "qualgrasp.certify.models.pad"} <= set(MODULES)
 
 

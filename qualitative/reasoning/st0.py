@@ -2,7 +2,7 @@
 
 A *trace* is a sequence of frames, one per instant (instants 0, 1, ..., n - 1). A frame maps an
 ordered pair of region names ``(x, y)`` (a tuple) to the name of the RCC-8 base relation that
-holds between x and y at that instant (see :mod:`qualgrasp.qualitative.rcc8`). A pair missing from a frame
+holds between x and y at that instant (see :mod:`qualgrasp.qualitative.reasoning.rcc8`). A pair missing from a frame
 is read as the converse of the reversed pair; a pair missing both ways is an error. A region is
 always ``EQ`` to itself.
 
@@ -60,7 +60,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import FormulaError, TraceError
+from ..errors import FormulaError, TraceError
 from .rcc8 import RELATIONS, path_consistency
 
 #: Longest formula accepted, in characters.
