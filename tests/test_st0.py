@@ -12,8 +12,9 @@ from qualgrasp.qualitative.cli import st0_command
 from qualgrasp.qualitative.errors import FormulaError, TraceError
 from qualgrasp.qualitative.reasoning.rcc8 import RELATIONS
 from qualgrasp.qualitative.reasoning.st0 import (Always, And, Atom, Const, Historically, Implies, Next, Not, Once, Or,
-                                                 Previous, Since, Sometime, Until, evaluate_file, evaluate_reference,
-                                                 parse, read_trace, write_trace)
+                                                 Previous, Since, Sometime, Until, evaluate_file, parse, read_trace,
+                                                 write_trace)
+from st0_reference import evaluate_reference
 
 CONV = {"DC": "DC", "EC": "EC", "PO": "PO", "EQ": "EQ",
         "TPP": "TPPi", "TPPi": "TPP", "NTPP": "NTPPi", "NTPPi": "NTPP"}

@@ -22,7 +22,7 @@ from .rcc8 import (RELATIONS, compose, consistent, consistent_scenario, converse
                    relations_among)
 from .st0 import (MAX_ARRANGEMENT_WORK, MAX_DEPTH, MAX_EVALUATION_WORK, MAX_FORMULA, MAX_TRACE_BYTES, Always, And,
                   Atom, Const, Formula, Historically, Implies, Next, Not, Once, Or, Previous, Since, Sometime, Until,
-                  evaluate_file, evaluate_reference, parse, read_trace, write_trace)
+                  evaluate_file, parse, read_trace, write_trace)
 from .scene import approach_zone, finger_disc, grasp_region, grasp_scene, scene_regions
 from .phases import PHASES, grasp_trace, no_penetration, phase_formulas, phase_sequence, phases_of, placement_order
 
@@ -30,7 +30,7 @@ __all__ = [
     "RELATIONS", "relation", "converse", "compose", "relations_among", "path_consistency", "consistent_scenario",
     "consistent",
     "Formula", "Const", "Atom", "Not", "And", "Or", "Implies", "Next", "Sometime", "Always", "Until", "Previous",
-    "Once", "Historically", "Since", "parse", "read_trace", "write_trace", "evaluate_file", "evaluate_reference",
+    "Once", "Historically", "Since", "parse", "read_trace", "write_trace", "evaluate_file",
     "MAX_FORMULA", "MAX_DEPTH", "MAX_TRACE_BYTES", "MAX_ARRANGEMENT_WORK", "MAX_EVALUATION_WORK",
     "finger_disc", "approach_zone", "grasp_region", "scene_regions", "grasp_scene",
     "PHASES", "phase_formulas", "phase_sequence", "placement_order", "no_penetration", "phases_of", "grasp_trace",
