@@ -1,10 +1,10 @@
 """Quantitative baseline: grasps of maximal certified epsilon on a densely sampled boundary.
 
 The baseline sees exactly what the qualitative route sees: the object's contour extracted from the
-image (:func:`boundary`: :func:`qualgrasp.qualitative.vision.extract_contour`, resampled and smoothed by
-:func:`qualgrasp.qualitative.outline.outline_contour`, inward normals of the smoothed contour), and uses the
-same torque scaling as :func:`qualgrasp.qualitative.synthesis.synthesize`: ``center`` = the contour's area
-centroid, ``length`` = its radius (:func:`qualgrasp.qualitative.candidates.object_frame`). Epsilons of both
+image (:func:`boundary`: :func:`qualgrasp.qualitative.vision.contour.extract_contour`, resampled and smoothed by
+:func:`qualgrasp.qualitative.vision.outline.outline_contour`, inward normals of the smoothed contour), and uses the
+same torque scaling as :func:`qualgrasp.qualitative.synthesis.pipeline.synthesize`: ``center`` = the contour's area
+centroid, ``length`` = its radius (:func:`qualgrasp.qualitative.synthesis.candidates.object_frame`). Epsilons of both
 routes are therefore comparable.
 
 Search (:func:`search`), on ``Budget.samples`` contacts evenly spaced by arc length:
@@ -32,13 +32,13 @@ random 4-tuples and improvement (16 starts, up to 4 rounds of 4 x 192), about 70
 Keep 5, separation 2. The study's ``quick`` setting uses 128 samples, 32 extended pairs, 4 000
 random tuples, 8 starts and 2 rounds.
 
-Every grasp records its field ``resolution`` (:func:`qualgrasp.qualitative.synthesis.resolution`:
+Every grasp records its field ``resolution`` (:func:`qualgrasp.qualitative.synthesis.pipeline.resolution`:
 contact points known to a pixel, normals estimated over four smoothing standard deviations of the
-outline, :func:`~qualgrasp.qualitative.synthesis.normal_span`), so that the study judges it by the
-rule it judges the qualitative grasps by (:func:`qualgrasp.qualitative.synthesis.counted`): a
+outline, :func:`~qualgrasp.qualitative.synthesis.pipeline.normal_span`), so that the study judges it by the
+rule it judges the qualitative grasps by (:func:`qualgrasp.qualitative.synthesis.pipeline.counted`): a
 certified grasp whose epsilon is not above it (a frictionless closure of a disc's pixel polygon)
 is not counted as found. Planned on an image, every grasp also records its field
-``edge_strength`` (:func:`qualgrasp.qualitative.synthesis.set_edge_strength`), so that a grasp on
+``edge_strength`` (:func:`qualgrasp.qualitative.synthesis.pipeline.set_edge_strength`), so that a grasp on
 a shadow's or a texture's boundary is not counted either, by the same rule.
 
 Units: pixels of the image (x = column, y = row); normals are inward unit vectors; epsilon is
@@ -60,12 +60,12 @@ from shapely.geometry import Polygon
 from qualgrasp.certify import Contact, Grasp, Report, certify_grasp
 from qualgrasp.certify.batch import planar_screen
 from qualgrasp.certify.quality import edge_samples
-from qualgrasp.qualitative.candidates import object_frame
+from qualgrasp.qualitative.synthesis.candidates import object_frame
 from qualgrasp.qualitative.errors import QualitativeError
-from qualgrasp.qualitative.outline import DEFAULT_SCALE, Outline, outline_contour, resample
-from qualgrasp.qualitative.procedures import Procedure
-from qualgrasp.qualitative.synthesis import MU, choose, normal_span, resolution, set_edge_strength
-from qualgrasp.qualitative.vision import ImageSource, extract_contour
+from qualgrasp.qualitative.vision.outline import DEFAULT_SCALE, Outline, outline_contour, resample
+from qualgrasp.qualitative.synthesis.procedures import Procedure
+from qualgrasp.qualitative.synthesis.pipeline import MU, choose, normal_span, resolution, set_edge_strength
+from qualgrasp.qualitative.vision.contour import ImageSource, extract_contour
 
 __all__ = ["MU", "Budget", "Boundary", "BaselineResult", "boundary", "boundary_of", "boundary_of_polygon", "search",
            "baseline", "screen_grasps"]
@@ -126,7 +126,7 @@ class Boundary:
         Diameter of the minimum enclosing circle, pixels.
     span : float or None
         Length over which the normals are estimated, pixels (as perceived:
-        :func:`~qualgrasp.qualitative.synthesis.normal_span` of the outline); None for an exact
+        :func:`~qualgrasp.qualitative.synthesis.pipeline.normal_span` of the outline); None for an exact
         boundary, whose normals are not estimated.
     """
 
@@ -182,7 +182,7 @@ class BaselineResult:
 
 def boundary_of(outline: Outline) -> Boundary:
     """The boundary of a qualitative outline (its contour and smoothed normals, estimated over
-    :func:`~qualgrasp.qualitative.synthesis.normal_span` of it)."""
+    :func:`~qualgrasp.qualitative.synthesis.pipeline.normal_span` of it)."""
     center, length = object_frame(outline.contour)
     return Boundary(outline.contour, outline.normals(), center, length, outline.size, normal_span(outline))
 
@@ -221,8 +221,8 @@ def boundary_of_polygon(polygon: Polygon, spacing: float = 0.25) -> Boundary:
 def boundary(image: ImageSource, *, threshold: float | None = None, largest: bool = True) -> Boundary:
     """The boundary the qualitative route sees in an image.
 
-    The contour of :func:`qualgrasp.qualitative.vision.extract_contour` described by
-    :func:`qualgrasp.qualitative.outline.outline_contour` (resampled at 1024 points, smoothed at 0.4 % of the
+    The contour of :func:`qualgrasp.qualitative.vision.contour.extract_contour` described by
+    :func:`qualgrasp.qualitative.vision.outline.outline_contour` (resampled at 1024 points, smoothed at 0.4 % of the
     perimeter). When no well-formed qualitative description exists, the same resampling and
     smoothing are applied without it, so the baseline still runs where the qualitative route
     cannot.
@@ -394,7 +394,7 @@ def baseline(image: ImageSource | Boundary, procedure: int | str | Procedure, mu
         The image (its boundary is extracted by :func:`boundary`), or a boundary already extracted.
     procedure : Procedure, str or int
         The synthesis procedure whose fingers and contact model the baseline uses (a registered
-        one, :mod:`qualgrasp.qualitative.procedures`, by object, name, or finger count: 2 and 3
+        one, :mod:`qualgrasp.qualitative.synthesis.procedures`, by object, name, or finger count: 2 and 3
         point contacts with friction, 4 frictionless).
     mu : float
         Friction coefficient of procedures with friction (ignored for frictionless ones).
@@ -403,7 +403,7 @@ def baseline(image: ImageSource | Boundary, procedure: int | str | Procedure, mu
     name : str
         Used in grasp ids ``<name>-base<fingers>-<k>``.
     threshold, largest
-        Segmentation (:func:`qualgrasp.qualitative.vision.extract_contour`).
+        Segmentation (:func:`qualgrasp.qualitative.vision.contour.extract_contour`).
 
     Returns
     -------

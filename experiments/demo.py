@@ -24,9 +24,9 @@ from typing import Callable
 from qualgrasp.certify.batch import RunSummary, Summary, certify_file, textbook_grasps, verify_file
 from qualgrasp.certify.files import atomic_output, write_grasps
 from qualgrasp.qualitative.objects import render
-from qualgrasp.qualitative.synthesis import MU, synthesize
+from qualgrasp.qualitative.synthesis.pipeline import MU, synthesize
 
-from ..qualitative import procedures
+from ..qualitative.synthesis import procedures
 from .figures import STEMS, make_figures
 from .study import BUILTINS, StudyResult, compare, workload
 

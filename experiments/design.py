@@ -14,9 +14,9 @@ from typing import Mapping
 import numpy as np
 from shapely.geometry import Polygon
 
-from ..qualitative import procedures
-from ..qualitative.procedures import Procedure
-from ..qualitative.synthesis import NOT_COUNTED
+from ..qualitative.synthesis import procedures
+from ..qualitative.synthesis.procedures import Procedure
+from ..qualitative.synthesis.pipeline import NOT_COUNTED
 from .baseline import MU, Budget
 
 __all__ = ["Route", "routes", "compared_procedure", "KINDS", "UNITS", "BUILTINS", "ROUTES", "QUICK", "FULL",
@@ -74,7 +74,7 @@ ROUTES = tuple((r.name.rsplit(" ", 1)[0], r.fingers) for r in routes())
 
 REASONS = tuple(r.name for r in NOT_COUNTED)
 """Why a certified grasp is not counted as found, for every route alike
-(:data:`qualgrasp.qualitative.synthesis.NOT_COUNTED`: ``below_resolution``, a certified epsilon not
+(:data:`qualgrasp.qualitative.synthesis.pipeline.NOT_COUNTED`: ``below_resolution``, a certified epsilon not
 above the wrench change the image's uncertainty can cause); each is a column of the tables below."""
 
 OBJECT_COLUMNS = ("object", "route", "method", "fingers", "mu", "grasps", "certified",
@@ -89,7 +89,7 @@ same fingers (empty for the baseline), seconds (image to certified grasps), cand
 counted grasp (largest certified epsilon, the one the route would execute): how far every finger
 may slide along the unperturbed outline either way with closure certified (the smallest certified
 extent of its independent contact regions, fraction of the object's size;
-:func:`qualgrasp.qualitative.independent.independent_grasp`), ``slide_best``, with the status
+:func:`qualgrasp.qualitative.synthesis.independent.independent_grasp`), ``slide_best``, with the status
 (``robust``; ``undecided``: no sliding certified, 0; ``none: <why>``: a contact on a corner, where
 no finger can slide, 0), ``delta_status``, and ``delta_best``, the search's half-width of the
 stretches before they are clipped at the feasible regions (not how far a finger may slide);

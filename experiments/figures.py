@@ -51,16 +51,16 @@ from shapely.geometry import Polygon as ShapelyPolygon
 
 from qualgrasp.certify import Contact, Grasp, Report, Verdict, certify_grasp, positive_span
 from qualgrasp.certify.regions import CurvedRegion, RegionTuple, RegionVerdict, StraightRegion, certify_regions
-from qualgrasp.qualitative.candidates import separated
-from qualgrasp.qualitative.forcegrasp import GAP, ForceGrasp, friction_zone, positively_spans, span_margin
-from qualgrasp.qualitative.formgrasp import zone_steps
-from qualgrasp.qualitative.grasp_plot import plot_contacts, plot_form_step, plot_grasp
+from qualgrasp.qualitative.synthesis.candidates import separated
+from qualgrasp.qualitative.synthesis.forcegrasp import GAP, ForceGrasp, friction_zone, positively_spans, span_margin
+from qualgrasp.qualitative.synthesis.formgrasp import zone_steps
+from qualgrasp.qualitative.plots.grasp import plot_contacts, plot_form_step, plot_grasp
 from qualgrasp.qualitative.objects import render
-from qualgrasp.qualitative.outline import NAMES, Outline, outline_image
-from qualgrasp.qualitative.plot import curvature_handles, draw_frame, plot_outline, plot_regions
-from qualgrasp.qualitative.regions import ALPHA, feasible_regions
-from qualgrasp.qualitative.synthesis import MU, Synthesis, synthesize
-from qualgrasp.qualitative.zones import Zones
+from qualgrasp.qualitative.vision.outline import NAMES, Outline, outline_image
+from qualgrasp.qualitative.plots.outline import curvature_handles, draw_frame, plot_outline, plot_regions
+from qualgrasp.qualitative.synthesis.regions import ALPHA, feasible_regions
+from qualgrasp.qualitative.synthesis.pipeline import MU, Synthesis, synthesize
+from qualgrasp.qualitative.synthesis.zones import Zones
 
 from . import style
 
@@ -133,7 +133,7 @@ class Spanning:
     points, normals : numpy.ndarray
         ``(3, 2)`` contact points and inward unit normals, pixels.
     spans : bool
-        :func:`qualgrasp.qualitative.forcegrasp.positively_spans` of the normals (angular-gap rule).
+        :func:`qualgrasp.qualitative.synthesis.forcegrasp.positively_spans` of the normals (angular-gap rule).
     gap : float
         Largest angular gap between the normals, radians (``spans`` iff below pi).
     certified : Verdict
@@ -650,7 +650,7 @@ def fig9_regions(synth: Synthesis | None = None, image: np.ndarray | None = None
     is not robust, with its witness.
 
     Left: a synthesised grasp with its certified independent regions (every choice of one contact
-    per green stretch is in force closure; :func:`qualgrasp.qualitative.independent.independent_grasp`),
+    per green stretch is in force closure; :func:`qualgrasp.qualitative.synthesis.independent.independent_grasp`),
     titled with its certified slide (how far every finger may slide either way), each finger's
     certified extents before and after it below. Right: the same fingers anywhere on the whole feasible regions they lie on, which is not robust:
     the witness grasp (one contact per region) is not in force closure, with a Farkas certificate.

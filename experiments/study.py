@@ -4,8 +4,8 @@
 
 Routes
 ------
-* qualitative: :func:`qualgrasp.qualitative.synthesis.synthesize` with every registered procedure
-  (:mod:`qualgrasp.qualitative.procedures`: FormGrasp with 4 frictionless fingers, ForceGrasp
+* qualitative: :func:`qualgrasp.qualitative.synthesis.pipeline.synthesize` with every registered procedure
+  (:mod:`qualgrasp.qualitative.synthesis.procedures`: FormGrasp with 4 frictionless fingers, ForceGrasp
   with 2 and 3 point contacts at ``mu``, 0.5);
 * baseline: :func:`qualgrasp.experiments.baseline.baseline` for each procedure's fingers and contact model,
   the grasps of largest certified L1 epsilon on a densely sampled boundary (its docstring states
@@ -16,7 +16,7 @@ L1 epsilons are comparable. A grasp is **certified** when force closure is certi
 certificates re-verify) by :mod:`qualgrasp.certify`; uncertified grasps have epsilon 0. ``seconds`` is image
 to certified grasps (vision, search, certification) for both routes.
 
-Both are judged by one rule (:func:`qualgrasp.qualitative.synthesis.counted`): a certified grasp
+Both are judged by one rule (:func:`qualgrasp.qualitative.synthesis.pipeline.counted`): a certified grasp
 is **counted** as found unless a reason of :data:`REASONS` applies, today a certified epsilon not
 above the wrench change the image's uncertainty can cause (``below_resolution``: a closure of the
 pixel polygon, such as four frictionless fingers on a disc). Grasps not counted weigh 0 in the
@@ -87,14 +87,14 @@ from shapely.geometry import Polygon
 
 from qualgrasp.certify import Contact, Grasp
 from qualgrasp.certify.errors import GraspError
-from qualgrasp.qualitative import procedures
+from qualgrasp.qualitative.synthesis import procedures
 from qualgrasp.qualitative.errors import QualitativeError
-from qualgrasp.qualitative.formgrasp import ray_edges
-from qualgrasp.qualitative.independent import independent_grasp, planned_regions
+from qualgrasp.qualitative.synthesis.formgrasp import ray_edges
+from qualgrasp.qualitative.synthesis.independent import independent_grasp, planned_regions
 from qualgrasp.qualitative.objects import NAMES, render, shape
-from qualgrasp.qualitative.outline import Outline, outline_image
-from qualgrasp.qualitative.synthesis import synthesize, unresolved_reasons
-from qualgrasp.qualitative.vision import read_image, segment
+from qualgrasp.qualitative.vision.outline import Outline, outline_image
+from qualgrasp.qualitative.synthesis.pipeline import synthesize, unresolved_reasons
+from qualgrasp.qualitative.vision.contour import read_image, segment
 
 from .baseline import Boundary, Budget, baseline, boundary, boundary_of_polygon, screen_grasps
 from .design import (BUILTINS, DETERMINISTIC, FULL, GRASP_COLUMNS, KINDS, OBJECT_COLUMNS,
@@ -342,7 +342,7 @@ def _stats(eps: np.ndarray) -> tuple[float | None, float | None]:
 
 def not_counted(grasps: Sequence[Grasp], certified: np.ndarray, eps: np.ndarray) -> list[tuple[str, ...]]:
     """Per grasp, why it is not counted as found although certified
-    (:func:`qualgrasp.qualitative.synthesis.unresolved_reasons`, the rule of every route; empty
+    (:func:`qualgrasp.qualitative.synthesis.pipeline.unresolved_reasons`, the rule of every route; empty
     for a grasp not certified, or certified and counted)."""
     return [unresolved_reasons(g, float(e)) if c else () for g, c, e in zip(grasps, certified, eps)]
 
@@ -398,7 +398,7 @@ def best_tolerance(outline: Outline, grasp: Grasp,
 
     ``outline`` is the image's outline at the default scale; a qualitative grasp keeps the
     feasible regions it was planned on (its fields ``scale`` and ``alpha``, as
-    :func:`qualgrasp.qualitative.synthesis.synthesize` does), read from ``image``."""
+    :func:`qualgrasp.qualitative.synthesis.pipeline.synthesize` does), read from ``image``."""
     try:
         regions = None if image is None else planned_regions(image, grasp, largest=True, outline=outline)
         found = independent_grasp(outline, grasp, regions=regions)

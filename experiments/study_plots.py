@@ -17,7 +17,7 @@ Every plot is written as PNG and PDF with :func:`qualgrasp.experiments.style.sav
   fraction of the object's size; 0 when none is certified), per route, one panel per finger
   count, beside the route's sampled robustness (pooled fraction held, in the tick labels).
 
-Panels, labels and colours come from the procedure registry (:mod:`qualgrasp.qualitative.procedures`):
+Panels, labels and colours come from the procedure registry (:mod:`qualgrasp.qualitative.synthesis.procedures`):
 one panel (or row) per registered procedure, with its baseline; colours tell the procedure, line
 style and marker the method (solid and circles: qualitative; dashed and triangles: baseline).
 """
@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
-from ..qualitative import procedures
+from ..qualitative.synthesis import procedures
 from .design import KINDS, UNITS, compared_procedure
 from .style import context, new_figure, save
 

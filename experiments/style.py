@@ -2,8 +2,8 @@
 
 Colours are shared with the plotting helpers so that a symbol, a zone sign or a friction cone has
 the same colour in every figure the project draws: curvature types come from
-:data:`qualgrasp.qualitative.plot.STYLE`, zones of freedom and friction cones from
-:mod:`qualgrasp.qualitative.grasp_plot`. Settings are applied with :func:`context`, a
+:data:`qualgrasp.qualitative.plots.outline.STYLE`, zones of freedom and friction cones from
+:mod:`qualgrasp.qualitative.plots.grasp`. Settings are applied with :func:`context`, a
 :func:`matplotlib.rc_context`, around building **and** saving a figure (some settings, such as
 the hatch width and the PDF font type, are read only when the figure is drawn), so nothing leaks
 into the caller's matplotlib state. Figures are plain :class:`matplotlib.figure.Figure` objects bound
@@ -23,9 +23,9 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from qualgrasp.certify.files import atomic_output
-from qualgrasp.qualitative.grasp_plot import CONE, TCOLOR, ZMINUS, ZPLUS
+from qualgrasp.qualitative.plots.grasp import CONE, TCOLOR, ZMINUS, ZPLUS
 from qualgrasp.qualitative.objects import BACKGROUND, FOREGROUND
-from qualgrasp.qualitative.plot import STYLE as CURVATURE
+from qualgrasp.qualitative.plots.outline import STYLE as CURVATURE
 
 __all__ = ["RC", "DPI", "CURVATURE", "ZPLUS", "ZMINUS", "TCOLOR", "CONE", "GOOD", "BAD", "GRASP_LINE",
            "ZONE", "MEET", "OBJECT", "context", "new_figure", "show_image", "clean", "check_formats", "save"]
@@ -33,7 +33,7 @@ __all__ = ["RC", "DPI", "CURVATURE", "ZPLUS", "ZMINUS", "TCOLOR", "CONE", "GOOD"
 DPI = 200
 GOOD = "tab:green"  # a verdict that holds: closure, positive spanning
 BAD = "tab:red"  # one that does not
-GRASP_LINE = "tab:red"  # the two-finger grasp line, as drawn by qualitative.grasp_plot
+GRASP_LINE = "tab:red"  # the two-finger grasp line, as drawn by qualitative.plots.grasp
 ZONE = {"facecolor": "tab:green", "edgecolor": "darkgreen", "alpha": 0.45}  # friction zone, idem
 MEET = "darkgreen"  # where the three forces meet, idem
 OBJECT = 0.84  # grey level of the object as shown (1 = white background)

@@ -14,16 +14,16 @@ from ..certify.errors import CertifyError
 from ..certify.files import write_grasps
 from ..certify.models import MAX_MU
 from ..certify.regions.boundary import SEARCH_BUDGET
-from . import procedures
+from .synthesis import procedures
 from .errors import FormulaError, QualitativeError, TraceError
-from .grasp_plot import synthesis_figure
-from .independent import independent_file
-from .outline import SCALE_MAX, SCALE_MIN, outline_contour, outline_scales, outline_to_dict, planning_scale
-from .plot import outline_figure
-from .regions import ALPHA_MAX, FINGER_WIDTH, MARGIN, planning_regions, regions_to_dict
-from .st0 import evaluate_file
-from .synthesis import NOT_COUNTED, synthesize
-from .vision import extract_contour, read_image
+from .plots.grasp import synthesis_figure
+from .synthesis.independent import independent_file
+from .vision.outline import SCALE_MAX, SCALE_MIN, outline_contour, outline_scales, outline_to_dict, planning_scale
+from .plots.outline import outline_figure
+from .synthesis.regions import ALPHA_MAX, FINGER_WIDTH, MARGIN, planning_regions, regions_to_dict
+from .reasoning.st0 import evaluate_file
+from .synthesis.pipeline import NOT_COUNTED, synthesize
+from .vision.contour import extract_contour, read_image
 
 __all__ = ["register", "TOL_MIN", "TOL_MAX"]
 

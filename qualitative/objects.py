@@ -7,7 +7,7 @@ The objects follow the paper (Sinha et al., figures 3 and 4):
 ``"nut"``
     A regular hexagonal nut with a circular hole, like figure 4b. The hole is part of the exact
     geometry and is drawn in the image, but outlines describe the **outer** contour only: fingers
-    grasp the nut from outside, so the hole is ignored by :mod:`qualgrasp.qualitative.vision`.
+    grasp the nut from outside, so the hole is ignored by :mod:`qualgrasp.qualitative.vision.contour`.
 ``"disc"``
     A circular contour, like figure 4c.
 ``"figure3"``

@@ -19,11 +19,11 @@ from extents_oracle import Polygon, closure_margin, every_choice_holds, placemen
 from qualgrasp.certify import Contact, Grasp
 from qualgrasp.certify.regions import independent_regions, tuple_from_dict, verify_regions
 from qualgrasp.cli import app
-from qualgrasp.qualitative.candidates import object_frame
-from qualgrasp.qualitative.independent import independent_grasp, outline_boundary
+from qualgrasp.qualitative.synthesis.candidates import object_frame
+from qualgrasp.qualitative.synthesis.independent import independent_grasp, outline_boundary
 from qualgrasp.qualitative.objects import render
-from qualgrasp.qualitative.outline import outline_image
-from qualgrasp.qualitative.synthesis import synthesize
+from qualgrasp.qualitative.vision.outline import outline_image
+from qualgrasp.qualitative.synthesis.pipeline import synthesize
 
 RECTANGLE = [(0, 0), (4, 0), (4, 2), (0, 2)]
 L_SHAPE = [(0, 0), (4, 0), (4, 1), (1, 1), (1, 3), (0, 3)]

@@ -18,16 +18,16 @@ from extents_oracle import region_extents
 from qualgrasp.experiments import figures, style
 from qualgrasp.cli import app
 from qualgrasp.experiments.figures import (STEMS, fig3_outline, fig4_regions, fig5_zones, fig6_two_fingers,
-                                 fig7_three_fingers, fig8_spanning, fig9_regions, form_example, make_figures,
-                                 nguyen_example, spanning_examples)
+                                           fig7_three_fingers, fig8_spanning, fig9_regions, form_example, make_figures,
+                                           nguyen_example, spanning_examples)
 from qualgrasp.certify import force_closure
 from qualgrasp.certify.regions import certify_regions
 from qualgrasp.certify.regions import verify_regions
-from qualgrasp.qualitative.forcegrasp import friction_zone, nguyen_angles, positively_spans
+from qualgrasp.qualitative.synthesis.forcegrasp import friction_zone, nguyen_angles, positively_spans
 from qualgrasp.qualitative.objects import render
-from qualgrasp.qualitative.outline import outline_image
-from qualgrasp.qualitative.regions import feasible_regions
-from qualgrasp.qualitative.synthesis import synthesize
+from qualgrasp.qualitative.vision.outline import outline_image
+from qualgrasp.qualitative.synthesis.regions import feasible_regions
+from qualgrasp.qualitative.synthesis.pipeline import synthesize
 
 
 @pytest.fixture(scope="module")

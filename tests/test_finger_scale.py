@@ -15,18 +15,18 @@ from typer.testing import CliRunner
 from qualgrasp.certify import force_closure
 from qualgrasp.cli import app
 from qualgrasp.experiments.silhouettes import select_cells
-from qualgrasp.qualitative import procedures
+from qualgrasp.qualitative.synthesis import procedures
 from qualgrasp.experiments.baseline import boundary_of_polygon, screen_grasps
 from qualgrasp.experiments.study import execute
-from qualgrasp.qualitative.candidates import Candidates, candidates
+from qualgrasp.qualitative.synthesis.candidates import Candidates, candidates
 from qualgrasp.qualitative.errors import SynthesisError
-from qualgrasp.qualitative.forcegrasp import best_triplet_margins, triplet_grasps
-from qualgrasp.qualitative.formgrasp import deepest_closure
+from qualgrasp.qualitative.synthesis.forcegrasp import best_triplet_margins, triplet_grasps
+from qualgrasp.qualitative.synthesis.formgrasp import deepest_closure
 from qualgrasp.qualitative.objects import render, render_polygon, shape
-from qualgrasp.qualitative.outline import DEFAULT_SCALE, finger_scale, outline_image
-from qualgrasp.qualitative.procedures import SearchInput
-from qualgrasp.qualitative.regions import ALPHA, FINGER_WIDTH, feasible_regions
-from qualgrasp.qualitative.synthesis import FALLBACK_STEP, synthesize
+from qualgrasp.qualitative.vision.outline import DEFAULT_SCALE, finger_scale, outline_image
+from qualgrasp.qualitative.synthesis.procedures import SearchInput
+from qualgrasp.qualitative.synthesis.regions import ALPHA, FINGER_WIDTH, feasible_regions
+from qualgrasp.qualitative.synthesis.pipeline import FALLBACK_STEP, synthesize
 
 
 def _bumpy_square():

@@ -8,13 +8,13 @@ import shapely
 
 from qualgrasp.certify import Contact, Grasp, force_closure, positive_span
 from helpers import nguyen
-from qualgrasp.qualitative.candidates import candidates, object_frame
+from qualgrasp.qualitative.synthesis.candidates import candidates, object_frame
 from qualgrasp.qualitative.errors import SynthesisError
-from qualgrasp.qualitative.forcegrasp import (GAP, MARGIN, friction, friction_cone, friction_zone, nguyen_angles,
-                                    pair_grasps, positively_spans, span_margin, triplet_grasps)
+from qualgrasp.qualitative.synthesis.forcegrasp import (GAP, MARGIN, friction, friction_cone, friction_zone, nguyen_angles,
+                                                        pair_grasps, positively_spans, span_margin, triplet_grasps)
 from qualgrasp.qualitative.objects import render
-from qualgrasp.qualitative.outline import outline_image
-from qualgrasp.qualitative.regions import feasible_regions
+from qualgrasp.qualitative.vision.outline import outline_image
+from qualgrasp.qualitative.synthesis.regions import feasible_regions
 
 THETA = math.atan(0.5)
 

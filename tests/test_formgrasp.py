@@ -7,13 +7,13 @@ import pytest
 import shapely
 
 from qualgrasp.certify import Contact, Grasp, form_closure
-from qualgrasp.qualitative.candidates import Candidates, candidates, object_frame
+from qualgrasp.qualitative.synthesis.candidates import Candidates, candidates, object_frame
 from qualgrasp.qualitative.errors import SynthesisError
-from qualgrasp.qualitative.formgrasp import ERROR, GAP, closure_depth4, form_grasps, line_of_action_exit, zone_steps
+from qualgrasp.qualitative.synthesis.formgrasp import ERROR, GAP, closure_depth4, form_grasps, line_of_action_exit, zone_steps
 from qualgrasp.qualitative.objects import render, shape
-from qualgrasp.qualitative.outline import outline_image
-from qualgrasp.qualitative.regions import feasible_regions
-from qualgrasp.qualitative.zones import free_depth, zones
+from qualgrasp.qualitative.vision.outline import outline_image
+from qualgrasp.qualitative.synthesis.regions import feasible_regions
+from qualgrasp.qualitative.synthesis.zones import free_depth, zones
 
 
 def setup(name, **pose):

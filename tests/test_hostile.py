@@ -26,7 +26,7 @@ from qualgrasp.certify.files import table_to_rows
 from qualgrasp.certify.core import MAX_CONTACTS
 from qualgrasp.cli import app
 from qualgrasp.qualitative.errors import FormulaError, TraceError
-from qualgrasp.qualitative.st0 import parse, read_trace
+from qualgrasp.qualitative.reasoning.st0 import parse, read_trace
 
 DATA = pathlib.Path(__file__).parent / "data" / "hostile"
 GOOD = [b'{"id": "g1", "contacts": [{"p": [1, 0], "n": [-1, 0], "mu": 0.5}, {"p": [-1, 0], "n": [1, 0], "mu": 0.5}]}',

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from qualgrasp.qualitative.errors import ImageError
-from qualgrasp.qualitative.headers import header_size
-from qualgrasp.qualitative.vision import MAX_PIXELS, read_image
+from qualgrasp.qualitative.vision.headers import header_size
+from qualgrasp.qualitative.vision.contour import MAX_PIXELS, read_image
 
 HUGE = 20_000
 

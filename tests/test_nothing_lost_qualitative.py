@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 from qualgrasp.certify.regions.boundary import TOL_FLOOR
 from qualgrasp.cli import app
 from qualgrasp.qualitative.objects import render
-from qualgrasp.qualitative.synthesis import synthesize
+from qualgrasp.qualitative.synthesis.pipeline import synthesize
 
 
 def run(*args):
@@ -101,7 +101,7 @@ def test_independent_regions_tol_is_checked_before_any_work(scene, tmp_path, tol
 
 def test_the_bisection_tolerance_is_bounded_in_the_library_too():
     from qualgrasp.certify.errors import GraspError
-    from qualgrasp.qualitative.independent import independent_grasp
+    from qualgrasp.qualitative.synthesis.independent import independent_grasp
     s = synthesize(render("polygon"), fingers=2, certify=False, tolerance=False)
     with pytest.raises(GraspError, match="at least"):
         independent_grasp(s.outline, s.grasps[0], tol=TOL_FLOOR * s.outline.size / 2)

@@ -14,9 +14,9 @@ from typer.testing import CliRunner
 from qualgrasp.cli import app
 from qualgrasp.qualitative.errors import QualitativeError
 from qualgrasp.qualitative.objects import BACKGROUND, FOREGROUND, NAMES, RADIUS, render, shape
-from qualgrasp.qualitative.outline import outline_image
-from qualgrasp.qualitative.plot import outline_figure, plot_outline, plot_regions
-from qualgrasp.qualitative.regions import feasible_regions
+from qualgrasp.qualitative.vision.outline import outline_image
+from qualgrasp.qualitative.plots.outline import outline_figure, plot_outline, plot_regions
+from qualgrasp.qualitative.synthesis.regions import feasible_regions
 
 runner = CliRunner()
 

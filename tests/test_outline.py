@@ -12,9 +12,9 @@ from skimage.transform import rescale, rotate
 
 from qualgrasp.qualitative.errors import ContourError, OutlineError
 from qualgrasp.qualitative.objects import NAMES, RADIUS, render, shape
-from qualgrasp.qualitative.outline import (SYMBOLS, Outline, canonical, is_well_formed, outline_contour,
-                                 outline_image, validate)
-from qualgrasp.qualitative.vision import signed_area
+from qualgrasp.qualitative.vision.outline import (SYMBOLS, Outline, canonical, is_well_formed, outline_contour,
+                                                  outline_image, validate)
+from qualgrasp.qualitative.vision.contour import signed_area
 
 ORDER = "/)(><}{"  # the documented canonical symbol order
 

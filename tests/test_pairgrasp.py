@@ -12,9 +12,9 @@ from shapely.geometry import Polygon
 
 from qualgrasp.certify import Contact, Grasp, force_closure
 from qualgrasp.experiments.design import ROUTES
-from qualgrasp.qualitative import procedures
+from qualgrasp.qualitative.synthesis import procedures
 from qualgrasp.qualitative.objects import render_polygon
-from qualgrasp.qualitative.synthesis import synthesize
+from qualgrasp.qualitative.synthesis.pipeline import synthesize
 
 
 def _regular(n, r=150.0):

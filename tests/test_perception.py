@@ -10,14 +10,14 @@ import pytest
 import shapely
 from skimage import data
 
-from qualgrasp.qualitative.edges import WEAK_EDGE, edge_contrast, edge_strength
+from qualgrasp.qualitative.vision.edges import WEAK_EDGE, edge_contrast, edge_strength
 from qualgrasp.qualitative.errors import ContourError, ImageError, SegmentationError
 from qualgrasp.qualitative.objects import NAMES, render, shape
-from qualgrasp.qualitative.outline import outline_image, outline_scales
-from qualgrasp.qualitative.segmentation import METHODS, grabcut_rect
-from qualgrasp.qualitative.segmentation_plot import segmentation_figure
-from qualgrasp.qualitative.synthesis import synthesize
-from qualgrasp.qualitative.vision import extract_contour, read_mask, segment
+from qualgrasp.qualitative.vision.outline import outline_image, outline_scales
+from qualgrasp.qualitative.vision.segmentation import METHODS, grabcut_rect
+from qualgrasp.qualitative.plots.segmentation import segmentation_figure
+from qualgrasp.qualitative.synthesis.pipeline import synthesize
+from qualgrasp.qualitative.vision.contour import extract_contour, read_mask, segment
 
 from scenes import SCENES, coverage, plain, shadow, textured, uneven
 
@@ -315,7 +315,7 @@ from typer.testing import CliRunner  # noqa: E402
 
 from qualgrasp.cli import app  # noqa: E402
 from qualgrasp.experiments.baseline import baseline  # noqa: E402
-from qualgrasp.qualitative.synthesis import on_weak_edge  # noqa: E402
+from qualgrasp.qualitative.synthesis.pipeline import on_weak_edge  # noqa: E402
 
 
 def test_synthesis_records_edge_evidence_and_does_not_count_grasps_on_the_shadow():

@@ -130,7 +130,7 @@ def test_placements_inside_stay_on_the_certified_regions():
     from qualgrasp.certify.regions.boundary import Boundary
     from qualgrasp.experiments.physics.study import grasps_of, placement
     from qualgrasp.experiments.study import subjects
-    from qualgrasp.qualitative.independent import outline_boundary
+    from qualgrasp.qualitative.synthesis.independent import outline_boundary
 
     subject = subjects(["figure3"])[0]
     planned, outline = grasps_of(subject, TINY)

@@ -11,7 +11,7 @@ from qualgrasp.cli import app
 from qualgrasp.experiments.demo import demo_steps
 from qualgrasp.experiments.figures import STEMS
 from qualgrasp.experiments.study import BUILTINS, workload
-from qualgrasp.qualitative import procedures
+from qualgrasp.qualitative.synthesis import procedures
 from qualgrasp.qualitative.objects import render
 
 runner = CliRunner()

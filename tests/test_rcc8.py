@@ -10,9 +10,9 @@ from shapely.geometry import LineString, Point, Polygon, box
 from shapely.ops import unary_union
 
 from qualgrasp.qualitative.errors import NetworkError, RegionError
-from qualgrasp.qualitative.rcc8 import (DE9IM_PATTERNS, RELATIONS, _relation_from_matrix, _relation_tolerant,
-                              compose, consistent, consistent_scenario, converse, path_consistency,
-                              relation, relations_among)
+from qualgrasp.qualitative.reasoning.rcc8 import (DE9IM_PATTERNS, RELATIONS, _relation_from_matrix, _relation_tolerant,
+                                                  compose, consistent, consistent_scenario, converse, path_consistency,
+                                                  relation, relations_among)
 
 ALL = frozenset(RELATIONS)
 CONV = {"DC": "DC", "EC": "EC", "PO": "PO", "EQ": "EQ",

@@ -15,8 +15,8 @@ from typer.testing import CliRunner
 from qualgrasp.cli import app
 from qualgrasp.experiments.silhouettes import (available_wings, read_wings, select_wings, silhouettes,
                                                wing_outline, write_wing_data)
-from qualgrasp.qualitative.outline import outline_image
-from qualgrasp.qualitative.vision import extract_contour
+from qualgrasp.qualitative.vision.outline import outline_image
+from qualgrasp.qualitative.vision.contour import extract_contour
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -13,7 +13,7 @@ from shapely import affinity
 from shapely.geometry import Polygon
 
 from qualgrasp.qualitative.objects import render_polygon
-from qualgrasp.qualitative.regions import FINGER_WIDTH, MARGIN, regions_image
+from qualgrasp.qualitative.synthesis.regions import FINGER_WIDTH, MARGIN, regions_image
 
 
 def _regular(n: int, r: float = 150.0) -> Polygon:

@@ -10,9 +10,9 @@ from shapely.geometry import LineString
 from skimage import data
 
 from qualgrasp.qualitative.objects import RADIUS, render, shape
-from qualgrasp.qualitative.outline import outline_image
-from qualgrasp.qualitative.regions import (ALPHA, FINGER_WIDTH, MARGIN, feasible_regions, regions_image,
-                                 regions_to_dict)
+from qualgrasp.qualitative.vision.outline import outline_image
+from qualgrasp.qualitative.synthesis.regions import (ALPHA, FINGER_WIDTH, MARGIN, feasible_regions, regions_image,
+                                                     regions_to_dict)
 
 
 def exact_frame(ring, points, step=0.05):

@@ -16,9 +16,9 @@ from qualgrasp.experiments.baseline import baseline
 from qualgrasp.experiments.design import QUICK, REASONS, Settings
 from qualgrasp.experiments.study import compare, evaluate_object, subjects
 from qualgrasp.experiments.study_tables import overall_rows
-from qualgrasp.qualitative import synthesis
+from qualgrasp.qualitative.synthesis import pipeline
 from qualgrasp.qualitative.objects import render, render_polygon
-from qualgrasp.qualitative.synthesis import NOT_COUNTED, counted, synthesize
+from qualgrasp.qualitative.synthesis.pipeline import NOT_COUNTED, counted, synthesize
 
 STADIUM = LineString([(156, 256), (356, 256)]).buffer(30, quad_segs=64)
 """A stadium 260 px long and 60 px wide (as in tests/test_finger_scale.py): round ends centred
@@ -99,7 +99,7 @@ def test_one_rule_for_both_routes(monkeypatch, tmp_path):
     s = synthesize(image, procedure="forcegrasp2", quality=False, tolerance=False)
     assert s.grasps and all(s.resolved) and s.summary()["below_resolution"] == 0
     assert s.resolved == tuple(counted(g, c, r.eps_l1) for g, c, r in zip(s.grasps, s.certified, s.reports))
-    monkeypatch.setattr(synthesis, "resolution", lambda grasp, spans: 10.0)
+    monkeypatch.setattr(pipeline, "resolution", lambda grasp, spans: 10.0)
     monkeypatch.setattr("qualgrasp.experiments.baseline.resolution", lambda grasp, spans: 10.0)
     s = synthesize(image, procedure="forcegrasp2", quality=False, tolerance=False)
     assert s.grasps and not any(s.resolved) and s.summary()["below_resolution"] == len(s.grasps)

@@ -14,9 +14,9 @@ from typer.testing import CliRunner
 
 from qualgrasp.cli import app
 from qualgrasp.qualitative.objects import render, render_polygon, shape
-from qualgrasp.qualitative.outline import DEFAULT_SCALE, outline_image, planning_scale
-from qualgrasp.qualitative.regions import FINGER_WIDTH, regions_image
-from qualgrasp.qualitative.synthesis import synthesize
+from qualgrasp.qualitative.vision.outline import DEFAULT_SCALE, outline_image, planning_scale
+from qualgrasp.qualitative.synthesis.regions import FINGER_WIDTH, regions_image
+from qualgrasp.qualitative.synthesis.pipeline import synthesize
 
 runner = CliRunner()
 SQUARE = "/>/>/>/>"

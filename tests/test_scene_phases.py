@@ -8,11 +8,11 @@ from hypothesis import given, settings, strategies as st
 from shapely.geometry import Polygon, box
 
 from qualgrasp.qualitative.errors import FormulaError, RegionError
-from qualgrasp.qualitative.phases import (PHASES, grasp_trace, no_penetration, phase_formulas, phase_sequence,
-                                phases_of, placement_order)
-from qualgrasp.qualitative.rcc8 import path_consistency
-from qualgrasp.qualitative.scene import grasp_scene, scene_regions
-from qualgrasp.qualitative.st0 import evaluate_file, parse, write_trace
+from qualgrasp.qualitative.reasoning.phases import (PHASES, grasp_trace, no_penetration, phase_formulas, phase_sequence,
+                                                    phases_of, placement_order)
+from qualgrasp.qualitative.reasoning.rcc8 import path_consistency
+from qualgrasp.qualitative.reasoning.scene import grasp_scene, scene_regions
+from qualgrasp.qualitative.reasoning.st0 import evaluate_file, parse, write_trace
 
 RADIUS = 4.0
 SQUARE = box(0, 0, 100, 100)

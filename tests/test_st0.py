@@ -10,10 +10,11 @@ from typer.testing import CliRunner
 
 from qualgrasp.qualitative.cli import st0_command
 from qualgrasp.qualitative.errors import FormulaError, TraceError
-from qualgrasp.qualitative.rcc8 import RELATIONS
-from qualgrasp.qualitative.st0 import (Always, And, Atom, Const, Historically, Implies, Next, Not, Once, Or,
-                             Previous, Since, Sometime, Until, evaluate_file, evaluate_reference,
-                             parse, read_trace, write_trace)
+from qualgrasp.qualitative.reasoning.rcc8 import RELATIONS
+from qualgrasp.qualitative.reasoning.st0 import (Always, And, Atom, Const, Historically, Implies, Next, Not, Once, Or,
+                                                 Previous, Since, Sometime, Until, evaluate_file, parse, read_trace,
+                                                 write_trace)
+from st0_reference import evaluate_reference
 
 CONV = {"DC": "DC", "EC": "EC", "PO": "PO", "EQ": "EQ",
         "TPP": "TPPi", "TPPi": "TPP", "NTPP": "NTPPi", "NTPPi": "NTPP"}
@@ -243,8 +244,8 @@ def test_st0_command_exit_code_2_on_bad_input(tmp_path, formula, content, messag
 
 # ------------------------------------------------------------------- limits (what they measure)
 
-from qualgrasp.qualitative import st0 as st0_module  # noqa: E402
-from qualgrasp.qualitative.st0 import MAX_DEPTH  # noqa: E402
+from qualgrasp.qualitative.reasoning import st0 as st0_module  # noqa: E402
+from qualgrasp.qualitative.reasoning.st0 import MAX_DEPTH  # noqa: E402
 
 
 def _chain(kind: str, levels: int) -> str:

@@ -1,7 +1,8 @@
 """The package's structure: one top-level name, its layers (certify imports nothing of the other
-halves, qualitative nothing of experiments), no import cycles, no private name imported across
-modules and no private module imported from outside its package, imports inside functions only
-for optional dependencies, and the registries. The import graph is read with ``ast``
+halves, qualitative nothing of experiments; inside qualitative, reasoning nothing of vision or
+synthesis and no domain subpackage anything of the plots), no import cycles, no private name
+imported across modules and no private module imported from outside its package, imports inside
+functions only for optional dependencies, and the registries. The import graph is read with ``ast``
 (``import_graph.py``)."""
 
 import ast
@@ -31,8 +32,9 @@ def _imports():
 
 
 def test_modules_are_found():
-    assert {"qualgrasp.certify.core.grasp", "qualgrasp.qualitative.synthesis", "qualgrasp.experiments.study",
-            "qualgrasp.cli", "qualgrasp.certify.models.pad"} <= set(MODULES)
+    assert {"qualgrasp.certify.core.grasp", "qualgrasp.qualitative.synthesis.pipeline", "qualgrasp.experiments.study",
+            "qualgrasp.cli", "qualgrasp.certify.models.pad", "qualgrasp.qualitative.vision.outline",
+            "qualgrasp.qualitative.reasoning.st0", "qualgrasp.qualitative.plots.grasp"} <= set(MODULES)
 
 
 def test_no_private_name_is_imported_across_modules():
@@ -61,14 +63,27 @@ def test_the_graph_checks_find_faults():
                                                    ("q.x", "q.c._kernels.lp")]
 
 
+VISION, REASONING, SYNTHESIS, PLOTS = (f"qualgrasp.qualitative.{p}" for p in ("vision", "reasoning", "synthesis", "plots"))
+
+
+def _under(module: str, packages: tuple[str, ...]) -> bool:
+    return any(module == p or module.startswith(p + ".") for p in packages)
+
+
 @pytest.mark.parametrize("half, never", [("qualgrasp.certify", ("qualgrasp.qualitative", "qualgrasp.experiments")),
-                                         ("qualgrasp.qualitative", ("qualgrasp.experiments",))])
+                                         ("qualgrasp.qualitative", ("qualgrasp.experiments",)),
+                                         (REASONING, (VISION, SYNTHESIS, PLOTS)),
+                                         (VISION, (SYNTHESIS, PLOTS)),
+                                         (SYNTHESIS, (PLOTS,))],
+                         ids=["certify", "qualitative", "reasoning", "vision", "synthesis"])
 def test_layers(half, never):
     """certify is the base layer: it imports nothing of qualitative or experiments; qualitative
-    imports nothing of experiments (inside functions neither)."""
+    imports nothing of experiments. Inside qualitative, reasoning (RCC-8, ST0) imports nothing of
+    vision, synthesis or the plots, vision nothing of synthesis or the plots, and synthesis nothing
+    of the plots: the figures sit above the domain code. Inside functions neither."""
     graph = import_graph.edges(MODULES, inner=True)
-    bad = sorted((m, t) for m, targets in graph.items() if m.startswith(half)
-                 for t in targets if t.startswith(never))
+    bad = sorted((m, t) for m, targets in graph.items() if _under(m, (half,))
+                 for t in targets if _under(t, never))
     assert not bad
 
 

@@ -16,11 +16,11 @@ from qualgrasp.certify.quality import epsilon
 from qualgrasp.experiments.baseline import Boundary, Budget, baseline, boundary, boundary_of_polygon, search
 from qualgrasp.experiments.silhouettes import horse, select_cells, write_silhouettes
 from qualgrasp.experiments.study import (GRASP_COLUMNS, OBJECT_COLUMNS, OVERALL_COLUMNS, ROBUSTNESS_COLUMNS,
-                               ROUTES, Settings, compare, execute, perturb, robustness_trial,
-                               subjects)
+                                         ROUTES, Settings, compare, execute, perturb, robustness_trial,
+                                         subjects)
 from qualgrasp.qualitative.objects import render, render_polygon, shape
-from qualgrasp.qualitative.synthesis import synthesize
-from qualgrasp.qualitative.vision import extract_contour, segment
+from qualgrasp.qualitative.synthesis.pipeline import synthesize
+from qualgrasp.qualitative.vision.contour import extract_contour, segment
 
 TINY = Budget(samples=48, extend=8, random=300, starts=3, rounds=2, keep=3)
 
@@ -333,7 +333,7 @@ def test_every_qualitative_route_is_compared_with_the_baseline_of_its_contacts()
     from qualgrasp.experiments.design import compared_procedure, routes
     from qualgrasp.experiments.study import _with_ratios
     from qualgrasp.experiments.study_tables import overall_rows, partner
-    from qualgrasp.qualitative import procedures
+    from qualgrasp.qualitative.synthesis import procedures
     assert compared_procedure(procedures.get("pairgrasp3"), "baseline").name == "forcegrasp3"
     assert compared_procedure(procedures.get("pairgrasp3"), "qualitative").name == "pairgrasp3"
     by_name = {r.name: r for r in routes()}

@@ -14,11 +14,11 @@ from typer.testing import CliRunner
 from qualgrasp.certify import grasp_from_dict
 from qualgrasp.certify.files import read_results
 from qualgrasp.cli import app
-from qualgrasp.qualitative.candidates import object_frame
+from qualgrasp.qualitative.synthesis.candidates import object_frame
 from qualgrasp.qualitative.errors import QualitativeError, SynthesisError
-from qualgrasp.qualitative.grasp_plot import plot_grasp, synthesis_figure
+from qualgrasp.qualitative.plots.grasp import plot_grasp, synthesis_figure
 from qualgrasp.qualitative.objects import render, shape
-from qualgrasp.qualitative.synthesis import synthesize
+from qualgrasp.qualitative.synthesis.pipeline import synthesize
 
 runner = CliRunner()
 OBJECTS = ("polygon", "nut", "figure3", "disc")

@@ -16,7 +16,7 @@ from qualgrasp.cli import app
 from qualgrasp.experiments.study import evaluate_object, subjects
 from qualgrasp.experiments.study_tables import overall_rows
 from qualgrasp.qualitative.objects import render
-from qualgrasp.qualitative.synthesis import synthesize
+from qualgrasp.qualitative.synthesis.pipeline import synthesize
 
 
 @pytest.fixture(scope="module", params=["forcegrasp2", "forcegrasp3", "formgrasp"])

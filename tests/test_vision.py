@@ -8,7 +8,7 @@ from skimage import data
 
 from qualgrasp.qualitative.errors import ContourError, ImageError, QualitativeError, SegmentationError
 from qualgrasp.qualitative.objects import render, shape
-from qualgrasp.qualitative.vision import MIN_AREA, extract_contour, read_image, segment, signed_area
+from qualgrasp.qualitative.vision.contour import MIN_AREA, extract_contour, read_image, segment, signed_area
 
 
 def _distances(contour, polygon):

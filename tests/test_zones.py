@@ -12,8 +12,8 @@ from shapely.geometry import Polygon
 
 from qualgrasp.certify import Contact, Grasp, form_closure
 from qualgrasp.qualitative.errors import QualitativeError, ZoneError
-from qualgrasp.qualitative.formgrasp import closure_depth4
-from qualgrasp.qualitative.zones import TOL, free_depth, grasp_zones, twist_constraints, zones
+from qualgrasp.qualitative.synthesis.formgrasp import closure_depth4
+from qualgrasp.qualitative.synthesis.zones import TOL, free_depth, grasp_zones, twist_constraints, zones
 
 # Band used when one route calls a grasp degenerate: the other must be degenerate too, or the case
 # must lie within this band on its own scale (zone depth, or the LP's min-weight margin).

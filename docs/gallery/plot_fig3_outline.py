@@ -4,7 +4,7 @@ Figure 3: the qualitative outline
 
 The figure-3 object seen by a camera (a synthetic 512 x 512 image), its contour cut into
 segments of Galton and Meathrel's seven curvature types, and the canonical string read clockwise
-from the arrow. The string in the title is the one :func:`~qualgrasp.qualitative.outline.outline_image`
+from the arrow. The string in the title is the one :func:`~qualgrasp.qualitative.vision.outline.outline_image`
 computes, not a caption typed in.
 """
 
@@ -13,7 +13,7 @@ import matplotlib.pyplot as plt
 from qualgrasp.experiments.figures import fig3_outline
 from qualgrasp.experiments.style import RC
 from qualgrasp.qualitative.objects import render
-from qualgrasp.qualitative.outline import outline_image
+from qualgrasp.qualitative.vision.outline import outline_image
 
 image = render("figure3")
 outline = outline_image(image)

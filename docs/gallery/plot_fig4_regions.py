@@ -13,8 +13,8 @@ import matplotlib.pyplot as plt
 from qualgrasp.experiments.figures import fig4_regions
 from qualgrasp.experiments.style import RC
 from qualgrasp.qualitative.objects import render
-from qualgrasp.qualitative.outline import outline_image
-from qualgrasp.qualitative.regions import feasible_regions
+from qualgrasp.qualitative.vision.outline import outline_image
+from qualgrasp.qualitative.synthesis.regions import feasible_regions
 
 for name in ("polygon", "nut", "disc"):
     regions = feasible_regions(outline_image(render(name)))

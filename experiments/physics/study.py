@@ -6,11 +6,11 @@ built-in names, silhouettes, images) and writes its tables.
 Grasps, per object
 ------------------
 * **qualitative**: every registered procedure's grasps
-  (:func:`qualgrasp.qualitative.synthesis.synthesize`, certified, with their certified tolerance),
+  (:func:`qualgrasp.qualitative.synthesis.pipeline.synthesize`, certified, with their certified tolerance),
   the ``per_route`` of largest certified epsilon;
 * **baseline**: :func:`qualgrasp.experiments.baseline.baseline` with the same fingers and contact
   model, its ``per_route`` best, with their certified tolerance where one exists
-  (:func:`qualgrasp.qualitative.independent.independent_grasp` on the feasible regions of the
+  (:func:`qualgrasp.qualitative.synthesis.independent.independent_grasp` on the feasible regions of the
   default scale, as the comparison study's :func:`~qualgrasp.experiments.study.best_tolerance`);
 * **random**: ``random`` grasps per procedure of uniformly random distinct contacts on the boundary
   the image shows (:func:`qualgrasp.experiments.baseline.boundary`), with its normals.
@@ -69,9 +69,9 @@ from ...certify import Contact, Grasp, certify_grasp
 from ...certify.errors import GraspError
 from ...certify.regions import Boundary as ArcBoundary
 from ...qualitative.errors import QualitativeError
-from ...qualitative.independent import independent_grasp, outline_boundary, planned_regions
-from ...qualitative.outline import outline_image
-from ...qualitative.synthesis import synthesize
+from ...qualitative.synthesis.independent import independent_grasp, outline_boundary, planned_regions
+from ...qualitative.vision.outline import outline_image
+from ...qualitative.synthesis.pipeline import synthesize
 from ..baseline import Boundary, Budget, baseline, boundary, boundary_of_polygon, screen_grasps
 from ..design import QUICK, Route, Subject, routes
 from ..study import execute, subjects

@@ -1,5 +1,5 @@
 """``forcegrasp2``: ForceGrasp with two fingers (paper 5.1.3-5.1.4, Nguyen's condition), point
-contacts with friction; see :func:`qualgrasp.qualitative.forcegrasp.pair_grasps`."""
+contacts with friction; see :func:`qualgrasp.qualitative.synthesis.forcegrasp.pair_grasps`."""
 
 from __future__ import annotations
 

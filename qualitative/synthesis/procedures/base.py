@@ -2,11 +2,11 @@
 
 A synthesis procedure turns candidate contacts on an object's feasible grasp regions into grasps.
 Each is a :class:`Procedure` registered by name with :func:`register`; synthesis
-(:func:`qualgrasp.qualitative.synthesis.synthesize`), the command line, the study's routes, plot
+(:func:`qualgrasp.qualitative.synthesis.pipeline.synthesize`), the command line, the study's routes, plot
 labels and colours and the demo are generated from the registry, never from finger counts.
 
 A new procedure is one module in this package declaring its search and registering it, plus its
-import in :mod:`qualgrasp.qualitative.procedures`.
+import in :mod:`qualgrasp.qualitative.synthesis.procedures`.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """An image file's size in pixels, read from its header without decoding the pixels.
 
-:func:`qualgrasp.qualitative.vision.read_image` checks this size against its limit *before* it
+:func:`qualgrasp.qualitative.vision.contour.read_image` checks this size against its limit *before* it
 lets OpenCV decode the file, so that a small file claiming a huge image (a Radiance HDR header of
 20,000 x 20,000 pixels is a few dozen bytes) is refused at once instead of making the decoder
 allocate gigabytes and run for minutes.
@@ -35,7 +35,7 @@ from pathlib import Path
 
 from PIL import Image
 
-from .errors import ImageError
+from ..errors import ImageError
 
 __all__ = ["HEADER_BYTES", "header_size"]
 

@@ -17,8 +17,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.path import Path as MplPath
 
-from .outline import NAMES, Outline
-from .regions import Region
+from ..vision.outline import NAMES, Outline
+from ..synthesis.regions import Region
 
 __all__ = ["STYLE", "draw_frame", "plot_outline", "plot_regions", "outline_figure", "curvature_handles"]
 
@@ -135,7 +135,7 @@ def plot_regions(ax: Axes, outline: Outline, regions: Sequence[Region], image: n
     outline : Outline
         The outline the regions belong to.
     regions : sequence of Region
-        Feasible regions (:func:`qualgrasp.qualitative.regions.feasible_regions`).
+        Feasible regions (:func:`qualgrasp.qualitative.synthesis.regions.feasible_regions`).
     image : numpy.ndarray, optional
         Image drawn faintly underneath (pixel frame).
     normals : int

@@ -48,8 +48,8 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from .errors import ContourError
-from .vision import ImageSource, gaussian_blur, read_image
+from ..errors import ContourError
+from .contour import ImageSource, gaussian_blur, read_image
 
 __all__ = ["EDGE_BLUR", "EDGE_REACH", "RING", "WEAK_EDGE", "SHARPNESS", "edge_contrast", "edge_strength",
            "edge_evidence", "weak_edge"]
@@ -77,7 +77,7 @@ def edge_contrast(image: ImageSource | np.ndarray, contour: np.ndarray) -> float
     Parameters
     ----------
     image : str, pathlib.Path or numpy.ndarray
-        The image (see :func:`qualgrasp.qualitative.vision.read_image`).
+        The image (see :func:`qualgrasp.qualitative.vision.contour.read_image`).
     contour : numpy.ndarray
         ``(m, 2)`` closed contour (x, y) of the object, pixels (as extracted from ``image``).
 
@@ -98,7 +98,7 @@ def edge_contrast(image: ImageSource | np.ndarray, contour: np.ndarray) -> float
     Examples
     --------
     >>> from qualgrasp.qualitative.objects import render
-    >>> from qualgrasp.qualitative.vision import extract_contour
+    >>> from qualgrasp.qualitative.vision.contour import extract_contour
     >>> image = render("disc")
     >>> edge_contrast(image, extract_contour(image))
     -200.0
@@ -124,7 +124,7 @@ def edge_strength(image: ImageSource | np.ndarray, points, normals, contrast: fl
     Parameters
     ----------
     image : str, pathlib.Path or numpy.ndarray
-        The image (see :func:`qualgrasp.qualitative.vision.read_image`).
+        The image (see :func:`qualgrasp.qualitative.vision.contour.read_image`).
     points : array_like
         ``(n, 2)`` contact points (x, y), pixels, on the object's contour.
     normals : array_like
@@ -202,7 +202,7 @@ def edge_evidence(image: ImageSource | np.ndarray, contour, contour_normals, poi
     Parameters
     ----------
     image : str, pathlib.Path or numpy.ndarray
-        The image (see :func:`qualgrasp.qualitative.vision.read_image`).
+        The image (see :func:`qualgrasp.qualitative.vision.contour.read_image`).
     contour, contour_normals : array_like
         ``(m, 2)`` the object's contour as segmented (pixels) and its inward normals.
     points, normals : array_like
@@ -217,7 +217,7 @@ def edge_evidence(image: ImageSource | np.ndarray, contour, contour_normals, poi
     --------
     >>> import numpy as np
     >>> from qualgrasp.qualitative.objects import render
-    >>> from qualgrasp.qualitative.outline import outline_image
+    >>> from qualgrasp.qualitative.vision.outline import outline_image
     >>> o = outline_image(render("square"))
     >>> bool(edge_evidence(render("square"), o.contour, o.normals(), o.contour[:5], o.normals()[:5]).min() > WEAK_EDGE)
     True

@@ -28,8 +28,8 @@ from typing import Sequence
 
 import numpy as np
 
-from .errors import SynthesisError
-from .outline import Outline
+from ..errors import SynthesisError
+from ..vision.outline import Outline
 from .regions import Region
 
 __all__ = ["STEP", "INSET", "PER_REGION", "GAP", "ERROR", "Candidates", "candidates", "object_frame",
@@ -101,7 +101,7 @@ def candidates(outline: Outline, regions: Sequence[Region], step: float = STEP,
     outline : Outline
         The outline the regions belong to (gives the object's size and the sample spacing).
     regions : sequence of Region
-        Feasible regions (:func:`qualgrasp.qualitative.regions.feasible_regions`).
+        Feasible regions (:func:`qualgrasp.qualitative.synthesis.regions.feasible_regions`).
     step : float
         Spacing of the candidates along a region, fraction of the object's size.
     inset : float

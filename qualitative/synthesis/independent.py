@@ -45,17 +45,17 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..certify.errors import CertifyError, GraspError
-from ..certify.core import Grasp, grasp_from_dict
-from ..certify.files import atomic_output, check_output
-from ..certify.regions.boundary import SEARCH_BUDGET, IndependentRegions, bisection_tol, independent_regions
-from ..certify.regions import tuple_to_dict
-from ..certify.files import json_lines
-from ..certify.core.validation import id_problem, number, show
-from .errors import QualitativeError
-from .outline import DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_contour, planning_scale
+from ...certify.errors import CertifyError, GraspError
+from ...certify.core import Grasp, grasp_from_dict
+from ...certify.files import atomic_output, check_output
+from ...certify.regions.boundary import SEARCH_BUDGET, IndependentRegions, bisection_tol, independent_regions
+from ...certify.regions import tuple_to_dict
+from ...certify.files import json_lines
+from ...certify.core.validation import id_problem, number, show
+from ..errors import QualitativeError
+from ..vision.outline import DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_contour, planning_scale
 from .regions import ALPHA, ALPHA_MAX, FINGER_WIDTH, MARGIN, Region, feasible_regions, planning_regions
-from .vision import ImageSource, extract_contour
+from ..vision.contour import ImageSource, extract_contour
 
 __all__ = ["ON_OUTLINE", "outline_boundary", "contact_limits", "planned_regions", "independent_grasp",
            "independent_file", "IndependentSummary"]
@@ -79,7 +79,7 @@ def outline_boundary(outline: Outline) -> tuple[np.ndarray, np.ndarray]:
     Examples
     --------
     >>> import numpy as np
-    >>> from qualgrasp.qualitative.outline import outline_contour
+    >>> from qualgrasp.qualitative.vision.outline import outline_contour
     >>> square = np.array([[0, 0], [100, 0], [100, 100], [0, 100]], float)
     >>> P, N = outline_boundary(outline_contour(square))
     >>> P.shape, bool(np.allclose(np.hypot(*N.T), 1))
@@ -142,11 +142,11 @@ def planned_regions(image: ImageSource, grasp: Grasp, *, alpha: float | None = N
                     cache: dict | None = None, scale: float | None = None) -> list[Region]:
     """The feasible regions a grasp was planned on: those of the image's outline at the scale
     ``scale`` when given, else the grasp's field ``scale``, else the finger's
-    (:func:`qualgrasp.qualitative.outline.planning_scale` of ``finger_width``, the default of every
+    (:func:`qualgrasp.qualitative.vision.outline.planning_scale` of ``finger_width``, the default of every
     qualitative command), with the curvature threshold ``alpha`` when given, else the grasp's field
-    ``alpha``, else :data:`~qualgrasp.qualitative.regions.ALPHA` (as
-    :func:`qualgrasp.qualitative.synthesis.synthesize` records them), found by
-    :func:`qualgrasp.qualitative.regions.planning_regions` as synthesis finds them.
+    ``alpha``, else :data:`~qualgrasp.qualitative.synthesis.regions.ALPHA` (as
+    :func:`qualgrasp.qualitative.synthesis.pipeline.synthesize` records them), found by
+    :func:`qualgrasp.qualitative.synthesis.regions.planning_regions` as synthesis finds them.
 
     Parameters
     ----------
@@ -155,14 +155,14 @@ def planned_regions(image: ImageSource, grasp: Grasp, *, alpha: float | None = N
     grasp : Grasp
         A grasp on that object.
     alpha, finger_width, margin
-        Feasible regions' parameters (:func:`~qualgrasp.qualitative.regions.feasible_regions`).
+        Feasible regions' parameters (:func:`~qualgrasp.qualitative.synthesis.regions.feasible_regions`).
     threshold, largest
-        As for :func:`~qualgrasp.qualitative.outline.outline_image`.
+        As for :func:`~qualgrasp.qualitative.vision.outline.outline_image`.
     outline : Outline, optional
         The image's outline at the default scale (the fine one regions take their normals from).
     contour : numpy.ndarray, optional
         The object's contour as extracted from the image
-        (:func:`qualgrasp.qualitative.vision.extract_contour`): outlines are computed from it, and
+        (:func:`qualgrasp.qualitative.vision.contour.extract_contour`): outlines are computed from it, and
         the image is not segmented again.
     cache : dict, optional
         Regions already found, by ``(scale, alpha)``, and the outline of each scale, by ``scale``
@@ -214,7 +214,7 @@ def independent_grasp(outline: Outline, grasp: Grasp, *, regions: list[Region] |
     grasp : Grasp
         Planar, contacts on the outline (within :data:`ON_OUTLINE` of its size).
     regions : list of Region, optional
-        Feasible regions (default :func:`~qualgrasp.qualitative.regions.feasible_regions` with
+        Feasible regions (default :func:`~qualgrasp.qualitative.synthesis.regions.feasible_regions` with
         its defaults).
     symmetric, tol, budget, normal_tol
         As for :func:`qualgrasp.certify.regions.independent_regions` (``tol`` in pixels,
@@ -232,8 +232,8 @@ def independent_grasp(outline: Outline, grasp: Grasp, *, regions: list[Region] |
     Examples
     --------
     >>> from qualgrasp.qualitative.objects import render
-    >>> from qualgrasp.qualitative.outline import outline_image
-    >>> from qualgrasp.qualitative.synthesis import synthesize
+    >>> from qualgrasp.qualitative.vision.outline import outline_image
+    >>> from qualgrasp.qualitative.synthesis.pipeline import synthesize
     >>> image = render("square")
     >>> g = synthesize(image, fingers=2).grasps[0]
     >>> r = independent_grasp(outline_image(image), g)
@@ -293,7 +293,7 @@ def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str 
     Parameters
     ----------
     image : str, pathlib.Path or numpy.ndarray
-        The object's image (:func:`qualgrasp.qualitative.vision.read_image`).
+        The object's image (:func:`qualgrasp.qualitative.vision.contour.read_image`).
     grasps_path : path
         Grasp set in certify's format (JSON Lines).
     out_path : path
@@ -301,14 +301,14 @@ def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str 
     symmetric, tol, budget, normal_tol
         As for :func:`independent_grasp`.
     alpha, finger_width, margin
-        Feasible regions' parameters (:func:`~qualgrasp.qualitative.regions.feasible_regions`);
+        Feasible regions' parameters (:func:`~qualgrasp.qualitative.synthesis.regions.feasible_regions`);
         each grasp's regions are those it was planned on (:func:`planned_regions`: its fields
         ``scale`` and ``alpha``, ``alpha`` given overriding the latter).
     scale : float, optional
         The outline's scale of every grasp's regions, overriding its field ``scale`` (default:
         the field, else the finger's scale, :func:`planned_regions`).
     threshold, largest, method, mask, rect
-        Segmentation (:func:`qualgrasp.qualitative.vision.extract_contour`); the contour is
+        Segmentation (:func:`qualgrasp.qualitative.vision.contour.extract_contour`); the contour is
         extracted once, and every scale's outline computed from it.
     progress : callable, optional
         Called with 1 after each grasp line.

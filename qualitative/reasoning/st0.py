@@ -2,7 +2,7 @@
 
 A *trace* is a sequence of frames, one per instant (instants 0, 1, ..., n - 1). A frame maps an
 ordered pair of region names ``(x, y)`` (a tuple) to the name of the RCC-8 base relation that
-holds between x and y at that instant (see :mod:`qualgrasp.qualitative.rcc8`). A pair missing from a frame
+holds between x and y at that instant (see :mod:`qualgrasp.qualitative.reasoning.rcc8`). A pair missing from a frame
 is read as the converse of the reversed pair; a pair missing both ways is an error. A region is
 always ``EQ`` to itself.
 
@@ -45,8 +45,8 @@ Semantics (finite traces of length n; theory notes, section 9)
 - ``F p = true U p``, ``G p = !F!p``, ``O p = true S p``, ``H p = !O!p``.
 
 Every operator is evaluated on the whole trace at once in O(n) with numpy (prefix and suffix
-scans), so a formula costs O(n * size). :func:`evaluate_reference` is a deliberately naive
-per-instant evaluator of the same semantics, kept as the reference route for tests.
+scans), so a formula costs O(n * size). The tests check it against a deliberately naive
+per-instant evaluator of the same semantics (``tests/st0_reference.py``).
 """
 
 from __future__ import annotations
@@ -60,7 +60,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import FormulaError, TraceError
+from ..errors import FormulaError, TraceError
 from .rcc8 import RELATIONS, path_consistency
 
 #: Longest formula accepted, in characters.
@@ -83,7 +83,7 @@ MAX_EVALUATION_WORK = 400_000_000
 __all__ = [
     "Formula", "Const", "Atom", "Not", "And", "Or", "Implies",
     "Next", "Sometime", "Always", "Until", "Previous", "Once", "Historically", "Since",
-    "parse", "read_trace", "write_trace", "evaluate_file", "evaluate_reference",
+    "parse", "read_trace", "write_trace", "evaluate_file",
     "MAX_FORMULA", "MAX_DEPTH", "MAX_TRACE_BYTES", "MAX_ARRANGEMENT_WORK", "MAX_EVALUATION_WORK",
 ]
 
@@ -619,74 +619,6 @@ def evaluate_file(formula: str | Formula, path: str | Path) -> np.ndarray:
     if not trace:
         raise TraceError(f"trace file {path} is empty: it holds no frame to evaluate the formula on")
     return formula.evaluate(trace)
-
-
-# ------------------------------------------------------------------------ reference route
-
-def evaluate_reference(formula: Formula, trace: Sequence[Frame]) -> np.ndarray:
-    """Per-instant evaluation written directly from the semantics (quadratic; for tests).
-
-    Shares nothing with the fast route but the formula tree: atoms look the relation up in each
-    frame, and each temporal operator scans the trace from every instant.
-    """
-    n = len(trace)
-
-    def rel(t, x, y):
-        frame = trace[t]
-        if x == y:
-            return "EQ"
-        if (x, y) in frame:
-            return frame[(x, y)]
-        if (y, x) in frame:
-            back = frame[(y, x)]
-            return {"TPP": "TPPi", "TPPi": "TPP", "NTPP": "NTPPi", "NTPPi": "NTPP"}.get(back, back)
-        raise TraceError(f"frame {t} gives no relation for the pair {(x, y)}")
-
-    def values(f):
-        if isinstance(f, Const):
-            return [bool(f.value)] * n
-        if isinstance(f, Atom):
-            return [rel(t, f.x, f.y) in f.relations for t in range(n)]
-        if isinstance(f, (And, Or)):
-            vs = [values(a) for a in f.args]
-            combine = all if isinstance(f, And) else any
-            return [combine(v[t] for v in vs) for t in range(n)]
-        if isinstance(f, Implies):
-            p, q = values(f.left), values(f.right)
-            return [(not p[t]) or q[t] for t in range(n)]
-        if isinstance(f, Not):
-            return [not v for v in values(f.arg)]
-        if isinstance(f, (Until, Since)):
-            p, q = values(f.left), values(f.right)
-            step = 1 if isinstance(f, Until) else -1
-            out = []
-            for i in range(n):
-                j, result = i, False
-                while 0 <= j < n:  # walk away from i until q holds or p fails
-                    if q[j]:
-                        result = True
-                        break
-                    if not p[j]:
-                        break
-                    j += step
-                out.append(result)
-            return out
-        p = values(f.arg)
-        if isinstance(f, Next):
-            return [i + 1 < n and p[i + 1] for i in range(n)]
-        if isinstance(f, Previous):
-            return [i >= 1 and p[i - 1] for i in range(n)]
-        if isinstance(f, Sometime):
-            return [any(p[j] for j in range(i, n)) for i in range(n)]
-        if isinstance(f, Always):
-            return [all(p[j] for j in range(i, n)) for i in range(n)]
-        if isinstance(f, Once):
-            return [any(p[j] for j in range(0, i + 1)) for i in range(n)]
-        if isinstance(f, Historically):
-            return [all(p[j] for j in range(0, i + 1)) for i in range(n)]
-        raise TypeError(f"not an ST0 formula: {f!r}")
-
-    return np.array(values(formula), dtype=bool).reshape(n)
 
 
 # ---------------------------------------------------------------------------------- parser

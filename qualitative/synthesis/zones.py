@@ -76,9 +76,9 @@ import shapely
 from shapely.geometry import MultiPoint
 from shapely.geometry.base import BaseGeometry
 
-from ..certify.core.wrench import cross, wrench
+from ...certify.core.wrench import cross, wrench
 
-from .errors import ZoneError
+from ..errors import ZoneError
 
 __all__ = ["TOL", "Zone", "Translations", "Zones", "zones", "grasp_zones", "free_depth",
            "twist_constraints", "centre_of"]

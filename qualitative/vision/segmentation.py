@@ -1,10 +1,10 @@
 """Segmentation methods other than a global threshold, for backgrounds that defeat one.
 
-:func:`qualgrasp.qualitative.vision.segment` chooses among these by name (its ``method``); the
+:func:`qualgrasp.qualitative.vision.contour.segment` chooses among these by name (its ``method``); the
 default there stays Otsu's global threshold. The functions here work on a grey image already
 slightly blurred (``smooth``, float64, any units) and return the object's pixels as a boolean
 mask; the choice of one object, the contour and its sub-pixel refinement are
-:mod:`qualgrasp.qualitative.vision`'s.
+:mod:`qualgrasp.qualitative.vision.contour`'s.
 
 ``"multiotsu"`` (a soft shadow)
     Otsu's method with three classes (:func:`skimage.filters.threshold_multiotsu`): the object is
@@ -50,7 +50,7 @@ import numpy as np
 from scipy import ndimage
 from skimage.filters import threshold_multiotsu, threshold_otsu
 
-from .errors import SegmentationError
+from ..errors import SegmentationError
 
 __all__ = ["METHODS", "multiotsu_mask", "ADAPTIVE_BLOCK", "GRABCUT_MARGIN", "GRABCUT_ITERATIONS", "GRABCUT_SEED",
            "border_pixels", "adaptive_mask", "grabcut_rect", "grabcut_mask"]

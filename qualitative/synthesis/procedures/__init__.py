@@ -1,5 +1,5 @@
 """Synthesis procedures as objects, registered by name (see
-:mod:`qualgrasp.qualitative.procedures.base`).
+:mod:`qualgrasp.qualitative.synthesis.procedures.base`).
 
 Built in, in order: ``forcegrasp2``, ``forcegrasp3``, ``formgrasp``, ``pairgrasp3`` (three
 fingers beyond the paper's condition: an opposed pair and a third finger). A new procedure is one
@@ -7,7 +7,7 @@ module here declaring its search and registering a :class:`Procedure`, plus its 
 
 Examples
 --------
->>> from qualgrasp.qualitative import procedures
+>>> from qualgrasp.qualitative.synthesis import procedures
 >>> procedures.names()
 ('forcegrasp2', 'forcegrasp3', 'formgrasp', 'pairgrasp3')
 >>> procedures.for_fingers(4).title

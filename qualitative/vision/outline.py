@@ -122,8 +122,8 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from .errors import ContourError, OutlineError
-from .vision import ImageSource, extract_contour, signed_area
+from ..errors import ContourError, OutlineError
+from .contour import ImageSource, extract_contour, signed_area
 
 __all__ = [
     "SYMBOLS",
@@ -979,7 +979,7 @@ def outline_image(src: ImageSource, *, scale: float = DEFAULT_SCALE, threshold: 
     Parameters
     ----------
     src : str, pathlib.Path or numpy.ndarray
-        Image file or array (see :func:`qualgrasp.qualitative.vision.read_image`).
+        Image file or array (see :func:`qualgrasp.qualitative.vision.contour.read_image`).
     scale : float
         Standard deviation of the Gaussian smoothing, fraction of the perimeter, in
         ``(0, SCALE_MAX]`` (default :data:`DEFAULT_SCALE`, 0.004; see :func:`outline_contour`).
@@ -990,9 +990,9 @@ def outline_image(src: ImageSource, *, scale: float = DEFAULT_SCALE, threshold: 
     subpixel : bool
         Refine the contour to sub-pixel accuracy.
     method : str
-        Segmentation method (:data:`qualgrasp.qualitative.vision.METHODS`): ``"otsu"`` (default),
+        Segmentation method (:data:`qualgrasp.qualitative.vision.contour.METHODS`): ``"otsu"`` (default),
         ``"multiotsu"`` (a soft shadow), ``"adaptive"`` (uneven lighting), ``"grabcut"`` (a
-        textured background); see :func:`qualgrasp.qualitative.vision.segment`.
+        textured background); see :func:`qualgrasp.qualitative.vision.contour.segment`.
     mask : str, pathlib.Path or numpy.ndarray, optional
         A user's mask of the object (non-zero pixels), instead of a method.
     rect : (int, int, int, int), optional
@@ -1061,7 +1061,7 @@ def finger_scale(outline: Outline | np.ndarray, finger_width: float, *, samples:
     than about three quarters of a pad are then smoothed away, wider ones remain (measured on the
     built-in square: a semicircular bump is gone up to 0.8 pad, kept from 0.85). With
     ``W = finger_width * D`` (``D`` the object's size, the diameter of its minimum enclosing
-    circle, as in :mod:`qualgrasp.qualitative.regions`) and ``P`` the perimeter, the scale is
+    circle, as in :mod:`qualgrasp.qualitative.synthesis.regions`) and ``P`` the perimeter, the scale is
     ``finger_width * D / (4 * P)``.
 
     Parameters
@@ -1071,7 +1071,7 @@ def finger_scale(outline: Outline | np.ndarray, finger_width: float, *, samples:
         ``(m, 2)`` closed contour in pixels (resampled like :func:`outline_contour` does).
     finger_width : float
         Pad width, fraction of the object's size (the project's default is
-        :data:`qualgrasp.qualitative.regions.FINGER_WIDTH`, 0.08).
+        :data:`qualgrasp.qualitative.synthesis.regions.FINGER_WIDTH`, 0.08).
     samples : int
         Resampling of a contour given as an array.
 
@@ -1257,7 +1257,7 @@ def outline_scales(src: ImageSource, *, threshold: float | None = None, largest:
     Parameters
     ----------
     src : str, pathlib.Path or numpy.ndarray
-        Image file or array (see :func:`qualgrasp.qualitative.vision.read_image`).
+        Image file or array (see :func:`qualgrasp.qualitative.vision.contour.read_image`).
     threshold : float, optional
         Grey level separating object and background, in the input's units; default Otsu's.
     largest : bool

@@ -2,7 +2,7 @@
 
 Our reading of the procedure, with the choices the paper leaves open:
 
-1. ``S`` is the set of candidate contacts on feasible regions (:mod:`qualgrasp.qualitative.candidates`).
+1. ``S`` is the set of candidate contacts on feasible regions (:mod:`qualgrasp.qualitative.synthesis.candidates`).
 2. For each start point ``s`` in ``S``:
 
    a. place the first contact at ``s``;
@@ -16,7 +16,7 @@ Our reading of the procedure, with the choices the paper leaves open:
       than four would be needed. No two or three frictionless contacts immobilise a planar
       object, so "shrinking" is judged on the zone left at the end: the three contacts added are
       those that, with ``s``, leave the **deepest empty** zone (most negative depth,
-      :func:`qualgrasp.qualitative.zones.free_depth`: the zone is cancelled "to the maximum extent", with the
+      :func:`qualgrasp.qualitative.synthesis.zones.free_depth`: the zone is cancelled "to the maximum extent", with the
       largest angular margin). Every completion is examined (a set of four is evaluated once, in
       closed form: four unit constraints ``a_i`` close the zone iff the origin lies inside their
       tetrahedron, and the depth is minus the origin's distance to its nearest face), so the
@@ -46,10 +46,10 @@ from functools import cache
 
 import numpy as np
 
-from ..certify.core import cross
+from ...certify.core import cross
 
 from .candidates import ERROR, GAP, Candidates, separated
-from .errors import SynthesisError
+from ..errors import SynthesisError
 from .zones import Zones, free_depth, unit_wrenches, zones
 
 __all__ = ["ERROR", "FormGrasp", "form_grasps", "deepest_closure", "closure_depth4", "line_of_action_exit", "ray_edges",
@@ -192,7 +192,7 @@ def deepest_closure(cands: Candidates, center: np.ndarray, length: float, size: 
     the same way) leaves rotations one way free:
 
     >>> import numpy as np
-    >>> from qualgrasp.qualitative.candidates import Candidates
+    >>> from qualgrasp.qualitative.synthesis.candidates import Candidates
     >>> n = np.array([[0, 1], [-1, 0], [0, -1], [1, 0]], float)
     >>> def square(offsets):
     ...     a, b, c, d = offsets
@@ -225,7 +225,7 @@ def closure_depth4(a: np.ndarray) -> np.ndarray:
     numpy.ndarray
         ``(B,)``: minus the distance from the origin to the nearest face of the tetrahedron of the
         four ``a_i`` when the origin lies strictly inside it (the zone is empty; equal to
-        :func:`qualgrasp.qualitative.zones.free_depth`), ``+inf`` otherwise (the zone is not empty).
+        :func:`qualgrasp.qualitative.synthesis.zones.free_depth`), ``+inf`` otherwise (the zone is not empty).
     """
     a0, a1, a2, a3 = (a[:, i] for i in range(4))
     # barycentric weights of the origin: sum_i C_i a_i = 0

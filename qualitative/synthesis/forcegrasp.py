@@ -11,7 +11,7 @@ Two fingers (Nguyen 1988; paper definitions 14-15)
     ``theta_2 = angle(n_2, F_1 - F_2) < theta_min``. A **feasible region pair** holds such a pair,
     one point on each region (the same region twice is allowed: two points of a disc's single
     curve). For each pair of regions we choose, among the candidate points
-    (:mod:`qualgrasp.qualitative.candidates`), the pair **farthest from the cone boundaries**: largest margin
+    (:mod:`qualgrasp.qualitative.synthesis.candidates`), the pair **farthest from the cone boundaries**: largest margin
     ``theta_min - max(theta_1, theta_2)``; among pairs within 1 % of ``theta_min`` of the best, the
     one farthest from the regions' ends. One grasp per region pair.
 
@@ -50,7 +50,7 @@ from shapely.geometry import Polygon
 from shapely.geometry.base import BaseGeometry
 
 from .candidates import GAP, Candidates, separated
-from .errors import SynthesisError
+from ..errors import SynthesisError
 
 __all__ = ["MARGIN", "GAP", "ForceGrasp", "friction", "angle_between", "nguyen_angles", "span_margin",
            "positively_spans", "pair_grasps", "best_pair_angle", "triplet_grasps", "best_triplet_margins",
@@ -308,7 +308,7 @@ def best_triplet_margins(cands: Candidates, contour: np.ndarray, theta_min: floa
     The three normals of an equilateral triangle span the plane with a margin of 30 degrees:
 
     >>> import numpy as np
-    >>> from qualgrasp.qualitative.candidates import Candidates
+    >>> from qualgrasp.qualitative.synthesis.candidates import Candidates
     >>> a = np.radians([90, 210, 330])
     >>> n = -np.c_[np.cos(a), np.sin(a)]
     >>> c = Candidates(-50 * n, n, np.arange(3), np.full(3, 10.0))

@@ -1,10 +1,10 @@
 """A figure to inspect a segmentation: the object's contour over the whole image, at full contrast.
 
-The grasp figures (:mod:`qualgrasp.qualitative.grasp_plot`) draw the image faintly and zoom on
+The grasp figures (:mod:`qualgrasp.qualitative.plots.grasp`) draw the image faintly and zoom on
 the object; to see *what was segmented* -- a shadow taken in, a texture followed, an object cut
 by the frame -- the user needs the whole image with the contour on it, and the contacts coloured
-by their edge evidence (:mod:`qualgrasp.qualitative.edges`). Built with the object-oriented API
-on the Agg canvas, like :mod:`qualgrasp.qualitative.plot`: no pyplot state, no display needed.
+by their edge evidence (:mod:`qualgrasp.qualitative.vision.edges`). Built with the object-oriented API
+on the Agg canvas, like :mod:`qualgrasp.qualitative.plots.outline`: no pyplot state, no display needed.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from .edges import WEAK_EDGE
+from ..vision.edges import WEAK_EDGE
 
 __all__ = ["plot_segmentation", "segmentation_figure"]
 
@@ -26,7 +26,7 @@ WEAK = "tab:red"
 
 def plot_segmentation(ax: Axes, image: np.ndarray, contour: np.ndarray, points=None, strengths=None) -> Axes:
     """Draw the image at full contrast, the contour over it and, if given, contacts coloured by
-    their edge strength (green at least :data:`~qualgrasp.qualitative.edges.WEAK_EDGE`, red
+    their edge strength (green at least :data:`~qualgrasp.qualitative.vision.edges.WEAK_EDGE`, red
     below: a weak edge).
 
     Parameters
@@ -40,7 +40,7 @@ def plot_segmentation(ax: Axes, image: np.ndarray, contour: np.ndarray, points=N
     points : array_like, optional
         ``(n, 2)`` contact points, pixels.
     strengths : array_like, optional
-        ``(n,)`` their edge strengths (:func:`qualgrasp.qualitative.edges.edge_strength`).
+        ``(n,)`` their edge strengths (:func:`qualgrasp.qualitative.vision.edges.edge_strength`).
 
     Returns
     -------
@@ -51,7 +51,7 @@ def plot_segmentation(ax: Axes, image: np.ndarray, contour: np.ndarray, points=N
     --------
     >>> from matplotlib.figure import Figure
     >>> from qualgrasp.qualitative.objects import render
-    >>> from qualgrasp.qualitative.vision import extract_contour
+    >>> from qualgrasp.qualitative.vision.contour import extract_contour
     >>> image = render("disc")
     >>> ax = plot_segmentation(Figure().subplots(), image, extract_contour(image))
     >>> len(ax.lines), [float(v) for v in ax.get_xlim()]  # the whole image
@@ -97,7 +97,7 @@ def segmentation_figure(image: np.ndarray, contour: np.ndarray, points=None, str
     Examples
     --------
     >>> from qualgrasp.qualitative.objects import render
-    >>> from qualgrasp.qualitative.vision import extract_contour
+    >>> from qualgrasp.qualitative.vision.contour import extract_contour
     >>> image = render("square")
     >>> fig = segmentation_figure(image, extract_contour(image), [[180, 256]], [0.9], title="square")
     >>> len(fig.axes), fig.legends[0].get_texts()[1].get_text()

@@ -1,12 +1,12 @@
 """Grasp synthesis from an image: outline, feasible regions, a synthesis procedure, certification.
 
 :func:`synthesize` is the public function behind ``qualgrasp synthesize``. The procedure is a
-registered object (:mod:`qualgrasp.qualitative.procedures`), chosen by name or by finger count:
+registered object (:mod:`qualgrasp.qualitative.synthesis.procedures`), chosen by name or by finger count:
 
-* ``formgrasp`` (4 fingers): FormGrasp (:mod:`qualgrasp.qualitative.formgrasp`), frictionless
+* ``formgrasp`` (4 fingers): FormGrasp (:mod:`qualgrasp.qualitative.synthesis.formgrasp`), frictionless
   contacts;
 * ``forcegrasp2`` and ``forcegrasp3`` (2 and 3 fingers): ForceGrasp
-  (:mod:`qualgrasp.qualitative.forcegrasp`), ``point`` contacts with Coulomb friction ``mu``
+  (:mod:`qualgrasp.qualitative.synthesis.forcegrasp`), ``point`` contacts with Coulomb friction ``mu``
   (from ``mu``, or ``mu = tan(theta_min)``).
 
 Every grasp found is converted to a :class:`qualgrasp.certify.Grasp` -- contacts in pixels of the input image
@@ -22,20 +22,20 @@ a synthesised grasp that does not certify is a bug of the synthesis, and is repo
 The finger's scale
 ------------------
 A finger cannot feel a bump smaller than its pad, so feasible regions and the procedures work on
-the outline at the **finger's scale** (:func:`qualgrasp.qualitative.outline.finger_scale` of the
+the outline at the **finger's scale** (:func:`qualgrasp.qualitative.vision.outline.finger_scale` of the
 pad width ``finger_width``, a fraction of the object's size; never finer than the default scale
 0.004), while contacts stay on the one contour the image gives (the same samples at every scale)
 and curved regions carry the normals of the outline at the default (fine) scale, so that the
 procedure's reasoning and the certification see the same contacts and normals; a straight region
 keeps the normal of its fitted line, its points those of the contour. When the procedure finds nothing there, the next coarser
-scales of the outline's hierarchy (:func:`qualgrasp.qualitative.outline.outline_scales`) are
+scales of the outline's hierarchy (:func:`qualgrasp.qualitative.vision.outline.outline_scales`) are
 tried, at most :data:`FALLBACK_SCALES` of them, and last the default scale (details finer than
 the finger; the scale reported says so) (:func:`search_scales`). ``scale`` fixes one scale (no
 fallback). :attr:`Synthesis.scale` is the scale the grasps come from, and
 :attr:`Synthesis.reason` says why nothing was found.
 
 **Curvature threshold.** Curves are feasible first where their bounding circle under the pad is
-wider than :data:`qualgrasp.qualitative.regions.ALPHA` of the object's size (flat ones, as the
+wider than :data:`qualgrasp.qualitative.synthesis.regions.ALPHA` of the object's size (flat ones, as the
 paper prefers). When no scale gives a grasp, the same scales are tried again with the threshold
 relaxed to the finger's own width: a curve is then feasible wherever the pad fits on it (its
 circle at least as wide as the pad), such as the rounded tip of a wing or of a cell's protrusion,
@@ -46,7 +46,7 @@ from; ``alpha`` given fixes it.
 **Contacts whose normal the image pins down.** Every attempt is first searched with the
 candidates whose normal spread is at most :data:`SPREAD` (10 degrees: the contour's own normal
 stays that close within ``error`` pixels of arc either side;
-:mod:`qualgrasp.qualitative.candidates`), and only when no attempt gives a grasp again with every
+:mod:`qualgrasp.qualitative.synthesis.candidates`), and only when no attempt gives a grasp again with every
 candidate. On a lumpy outline (a cell's membrane, bumps of a pixel) a contact placed a pixel or
 two off meets a normal tens of degrees away, and a frictionless finger's force turns with it.
 :attr:`Synthesis.smooth` says which pass the grasps come from; ``normal_spread=None`` searches
@@ -55,7 +55,7 @@ every candidate at once.
 Certified tolerance
 -------------------
 With ``tolerance`` (the default), every certified grasp also gets its **independent contact
-regions** (:func:`qualgrasp.qualitative.independent.independent_grasp`): a stretch of the outline
+regions** (:func:`qualgrasp.qualitative.synthesis.independent.independent_grasp`): a stretch of the outline
 around every contact, within the contact's feasible region, over which each finger may land
 anywhere and the grasp is still certified in force closure. The grasp's fields (so they reach the
 grasp file) state what is certified: ``extents`` (per finger ``[before, after]``, pixels of arc
@@ -88,9 +88,9 @@ Edge evidence
 A segmentation can follow a shadow's soft boundary or a textured background instead of the
 object's edge; a grasp certified on such a contour grasps the shadow. Each grasp records in its
 field ``edge_strength`` the image's edge evidence at each contact
-(:func:`qualgrasp.qualitative.edges.edge_evidence`: the gradient across the contour at the
+(:func:`qualgrasp.qualitative.vision.edges.edge_evidence`: the gradient across the contour at the
 contact relative to the contrast and sharpness of the object's edges elsewhere); a contact below
-:data:`qualgrasp.qualitative.edges.WEAK_EDGE` is on a **weak edge** (:func:`on_weak_edge`).
+:data:`qualgrasp.qualitative.vision.edges.WEAK_EDGE` is on a **weak edge** (:func:`on_weak_edge`).
 
 One rule for every route. :func:`unresolved_reasons` gives the reasons a certified grasp is not
 counted as found, from its own fields and its certified epsilon, whoever planned it:
@@ -111,21 +111,21 @@ from typing import Any, Iterator, Sequence
 
 import numpy as np
 
-from ..certify import Contact, Grasp, Report, certify_grasp
-from ..certify.errors import GraspError
-from ..certify.quality import epsilon
-from ..certify.regions import IndependentRegions
+from ...certify import Contact, Grasp, Report, certify_grasp
+from ...certify.errors import GraspError
+from ...certify.quality import epsilon
+from ...certify.regions import IndependentRegions
 from . import procedures as registry
 from .candidates import ERROR, INSET, PER_REGION, STEP, Candidates, candidates, object_frame
-from .errors import SynthesisError
+from ..errors import SynthesisError
 from .forcegrasp import MARGIN, friction
 from .independent import independent_grasp
-from .outline import (DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_contour, outline_contour_scales,
-                      planning_scale)
+from ..vision.outline import (DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_contour, outline_contour_scales,
+                              planning_scale)
 from .procedures import Procedure, SearchInput
 from .regions import ALPHA, FINGER_WIDTH, MARGIN as REGION_MARGIN, Region, feasible_regions, on_fine_outline
-from .edges import WEAK_EDGE, edge_evidence, weak_edge
-from .vision import ImageSource, extract_contour
+from ..vision.edges import WEAK_EDGE, edge_evidence, weak_edge
+from ..vision.contour import ImageSource, extract_contour
 
 __all__ = ["MU", "POSITION", "NORMAL", "SPREAD", "FALLBACK_SCALES", "FALLBACK_STEP", "NOT_COUNTED", "NotCounted",
            "Synthesis", "synthesize", "to_grasp", "choose", "resolution", "normal_span", "below_resolution",
@@ -148,7 +148,7 @@ three times that of a clean edge or curve in an image (the built-in objects' can
 
 FALLBACK_SCALES = 4
 """Coarser scales of the outline's hierarchy tried, one after the other, when a procedure finds
-nothing at the finger's scale (up to :data:`qualgrasp.qualitative.outline.SCALE_MAX`)."""
+nothing at the finger's scale (up to :data:`qualgrasp.qualitative.vision.outline.SCALE_MAX`)."""
 
 FALLBACK_STEP = 1.4
 """Smallest ratio between consecutive scales tried: the starts of the hierarchy's intervals are
@@ -195,7 +195,7 @@ class NotCounted:
 
 def on_weak_edge(grasp: Grasp, eps_l1: float) -> bool:
     """Whether a contact of the grasp lies where the image shows no clear edge of the object (its
-    field ``edge_strength`` has a value below :data:`qualgrasp.qualitative.edges.WEAK_EDGE`;
+    field ``edge_strength`` has a value below :data:`qualgrasp.qualitative.vision.edges.WEAK_EDGE`;
     module notes): a shadow's or a texture's boundary. False without the field. ``eps_l1`` is
     not used (the signature of :class:`NotCounted`).
 
@@ -261,7 +261,7 @@ class Synthesis:
     fingers : int
         Number of contacts of the procedure's grasps.
     procedure : Procedure
-        The registered procedure (:mod:`qualgrasp.qualitative.procedures`).
+        The registered procedure (:mod:`qualgrasp.qualitative.synthesis.procedures`).
     mu, theta_min : float or None
         Friction coefficient and cone half-angle (radians) of procedures with friction; None for
         frictionless ones.
@@ -276,8 +276,8 @@ class Synthesis:
     length : float
         Object's radius about ``center``, pixels.
     found : tuple
-        The procedure's results (:class:`~qualgrasp.qualitative.formgrasp.FormGrasp` or
-        :class:`~qualgrasp.qualitative.forcegrasp.ForceGrasp`), parallel to ``grasps``.
+        The procedure's results (:class:`~qualgrasp.qualitative.synthesis.formgrasp.FormGrasp` or
+        :class:`~qualgrasp.qualitative.synthesis.forcegrasp.ForceGrasp`), parallel to ``grasps``.
     grasps : tuple of certify.Grasp
         The grasps in certify's format.
     reports : tuple of certify.Report
@@ -455,7 +455,7 @@ def normal_span(outline: Outline) -> float:
     Examples
     --------
     >>> import numpy as np
-    >>> from qualgrasp.qualitative.outline import outline_contour
+    >>> from qualgrasp.qualitative.vision.outline import outline_contour
     >>> square = np.array([[0, 0], [100, 0], [100, 100], [0, 100]], float)
     >>> round(normal_span(outline_contour(square)), 3)  # 4 x 0.004 x 400 px
     6.4
@@ -466,8 +466,8 @@ def normal_span(outline: Outline) -> float:
 def _spans(outline: Outline, regions, found, fine: Outline) -> list[float]:
     """Length over which each contact's normal is estimated (pixels): the fitted line of a
     straight edge (its element, or its region when the edge runs on into its corners' windows,
-    :mod:`qualgrasp.qualitative.regions`), four smoothing standard deviations of the fine outline on a curve (the
-    normals curved regions carry; :func:`qualgrasp.qualitative.regions.on_fine_outline`)."""
+    :mod:`qualgrasp.qualitative.synthesis.regions`), four smoothing standard deviations of the fine outline on a curve (the
+    normals curved regions carry; :func:`qualgrasp.qualitative.synthesis.regions.on_fine_outline`)."""
     out = []
     for r in found.regions:
         seg = outline.segments[regions[r].segment]
@@ -508,7 +508,7 @@ def choose(fingers: int | None = None, procedure: str | None = None) -> Procedur
 
 def set_edge_strength(grasps: Sequence[Grasp], image: ImageSource, contour, normals) -> None:
     """Record in each grasp's field ``edge_strength`` the image's edge evidence at its contacts
-    (:func:`qualgrasp.qualitative.edges.edge_evidence` against the object's ``contour`` and its
+    (:func:`qualgrasp.qualitative.vision.edges.edge_evidence` against the object's ``contour`` and its
     inward ``normals``, pixels; module notes), for every route that plans on an image."""
     if not grasps:
         return
@@ -544,7 +544,7 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     Parameters
     ----------
     image : str, pathlib.Path or numpy.ndarray
-        Image file or array (see :func:`qualgrasp.qualitative.vision.read_image`).
+        Image file or array (see :func:`qualgrasp.qualitative.vision.contour.read_image`).
     fingers : int, optional
         Finger count: the first registered procedure with that many fingers (2: ForceGrasp,
         3: ForceGrasp, 4: FormGrasp); default 2 when ``procedure`` is not given either.
@@ -555,11 +555,11 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
         Friction cone half-angle, **radians** (``mu = tan(theta_min)``); instead of ``mu``.
     alpha : float, optional
         Curvature threshold of feasible regions, fraction of the object's size
-        (:func:`qualgrasp.qualitative.regions.feasible_regions`); default
-        :data:`~qualgrasp.qualitative.regions.ALPHA`, relaxed to ``finger_width`` when nothing is
+        (:func:`qualgrasp.qualitative.synthesis.regions.feasible_regions`); default
+        :data:`~qualgrasp.qualitative.synthesis.regions.ALPHA`, relaxed to ``finger_width`` when nothing is
         found (module notes). Given, it is the only one tried.
     procedure : str, optional
-        A registered procedure by name (:mod:`qualgrasp.qualitative.procedures`):
+        A registered procedure by name (:mod:`qualgrasp.qualitative.synthesis.procedures`):
         ``forcegrasp2``, ``forcegrasp3``, ``formgrasp``.
     name : str, optional
         Name used in grasp ids (default: the file's stem, or ``image`` for an array).
@@ -569,14 +569,14 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
         With ``certify``, compute both epsilons (L1 and L-infinity); otherwise only the L1
         epsilon, which tells resolved grasps (module notes).
     threshold, largest, method, mask, rect
-        Segmentation (:func:`qualgrasp.qualitative.vision.extract_contour`): a grey level, the
+        Segmentation (:func:`qualgrasp.qualitative.vision.contour.extract_contour`): a grey level, the
         largest of several objects, the method (``"otsu"``, ``"multiotsu"``, ``"adaptive"``,
         ``"grabcut"``), a user's mask of the object, GrabCut's rectangle ``(x, y, w, h)``. The
         contour is extracted once; every scale's outline is computed from it.
     finger_width, region_margin
-        Feasible regions (:func:`qualgrasp.qualitative.regions.feasible_regions`), fractions of the size.
+        Feasible regions (:func:`qualgrasp.qualitative.synthesis.regions.feasible_regions`), fractions of the size.
     step, inset, per_region
-        Candidate contacts (:func:`qualgrasp.qualitative.candidates.candidates`).
+        Candidate contacts (:func:`qualgrasp.qualitative.synthesis.candidates.candidates`).
     error : float
         Position error (pixels) the grasps must survive: FormGrasp's zone depth, and the window
         of the candidates' normal spread.
@@ -606,12 +606,12 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
         Bad parameters (unknown procedure or finger count, friction given to a frictionless
         procedure, both ``mu`` and ``theta_min``).
     ImageError, SegmentationError, ContourError
-        Unusable image (see :func:`qualgrasp.qualitative.outline.outline_image`).
+        Unusable image (see :func:`qualgrasp.qualitative.vision.outline.outline_image`).
 
     Examples
     --------
     >>> from qualgrasp.qualitative.objects import render
-    >>> from qualgrasp.qualitative.synthesis import synthesize
+    >>> from qualgrasp.qualitative.synthesis.pipeline import synthesize
     >>> s = synthesize(render("polygon"), procedure="formgrasp", quality=False)
     >>> s.procedure.title, s.fingers, len(s.grasps) > 0, all(s.certified)
     ('FormGrasp', 4, True, True)
@@ -688,7 +688,7 @@ def search_scales(contour: np.ndarray, fine: Outline, finger_width: float, scale
     """The outline scales synthesis tries, in order (module notes): ``scale`` alone when given;
     else the finger's scale (never finer than the default), then up to :data:`FALLBACK_SCALES`
     coarser scales of the hierarchy of the object's ``contour`` (as extracted from the image,
-    :func:`qualgrasp.qualitative.vision.extract_contour`; ``fine`` is its outline at the default
+    :func:`qualgrasp.qualitative.vision.contour.extract_contour`; ``fine`` is its outline at the default
     scale), each the start of an interval with another string and at least :data:`FALLBACK_STEP`
     times the previous scale, and last the default (fine) scale. A generator: the hierarchy is
     computed only when the first scale is not enough."""
@@ -709,7 +709,7 @@ def search_scales(contour: np.ndarray, fine: Outline, finger_width: float, scale
 
 def search_alphas(alpha: float | None, finger_width: float) -> tuple[float, ...]:
     """The curvature thresholds synthesis tries, in order (module notes): ``alpha`` alone when
-    given; else :data:`qualgrasp.qualitative.regions.ALPHA`, then the finger's own width (a curve
+    given; else :data:`qualgrasp.qualitative.synthesis.regions.ALPHA`, then the finger's own width (a curve
     is feasible where its bounding circle under the pad is at least as wide as the pad) when that
     is lower.
 

@@ -12,17 +12,17 @@ Reading (qualitative, on the feasible regions):
 
 * **An opposed pair.** Two fingers on feasible regions meeting Nguyen's two-finger condition with
   the angular margin, as ``forcegrasp2`` chooses them (one pair per region pair,
-  :func:`qualgrasp.qualitative.forcegrasp.pair_grasps`): the grasp line strictly inside both
+  :func:`qualgrasp.qualitative.synthesis.forcegrasp.pair_grasps`): the grasp line strictly inside both
   friction cones, ``max(theta_1, theta_2) <= (1 - margin) theta_min``.
 * **A third finger anywhere feasible.** A candidate contact on any feasible region at least
-  :data:`qualgrasp.qualitative.candidates.GAP` of the object's size from both (a pad's room).
+  :data:`qualgrasp.qualitative.synthesis.candidates.GAP` of the object's size from both (a pad's room).
   Adding a contact to a grasp in force closure keeps it in force closure: the three contacts'
   wrench cone contains the pair's, which is already the whole wrench space. The pair's margin is
   the grasp's margin (``cone_margin``).
 * **Where the third finger adds most.** On a straight region when one has room: its normal is
   pinned down by the whole edge's fitted line, so it adds the least image uncertainty (synthesis
   counts a grasp only when its certified epsilon exceeds the wrench change a pixel of error at
-  any of its contacts can cause, :func:`qualgrasp.qualitative.synthesis.resolution`). There, the
+  any of its contacts can cause, :func:`qualgrasp.qualitative.synthesis.pipeline.resolution`). There, the
   pair holds forces across its grasp line only by friction, so the third finger goes where its
   normal is closest to perpendicular to the grasp line (largest ``|sin|`` of the angle between
   them; field ``third_angle``: that angle in radians); among candidates within 1 % of the best,
@@ -63,7 +63,7 @@ def third_finger(cands: Candidates, pair: ForceGrasp, size: float, *, gap: float
     on a side whose normal is perpendicular to the grasp line, as far from it as the side allows.
 
     >>> import numpy as np
-    >>> from qualgrasp.qualitative.candidates import Candidates
+    >>> from qualgrasp.qualitative.synthesis.candidates import Candidates
     >>> P = np.array([[0., 50], [100, 50], [50, 0], [20, 100], [50, 100]])
     >>> N = np.array([[1., 0], [-1, 0], [0, 1], [0, -1], [0, -1]])
     >>> c = Candidates(P, N, np.arange(5), np.full(5, 10.0))
@@ -97,7 +97,7 @@ def _straight(cands: Candidates, region: int) -> bool:
 def pair_and_third(cands: Candidates, theta_min: float, size: float, *, margin: float,
                    gap: float = GAP) -> list[ForceGrasp]:
     """Three-finger grasps: every opposed pair of
-    :func:`qualgrasp.qualitative.forcegrasp.pair_grasps` with its third finger
+    :func:`qualgrasp.qualitative.synthesis.forcegrasp.pair_grasps` with its third finger
     (:func:`third_finger`); a pair with no room for a third finger gives none. The contacts are
     the pair's two, then the third; ``angles`` are the pair's angles to the grasp line and 0 for
     the third finger (it pushes along its normal); ``margin`` is the pair's; ``point`` is None."""

@@ -1,5 +1,5 @@
 """``formgrasp``: FormGrasp (paper 5.1.1-5.1.2), four frictionless fingers placed by Reuleaux's
-zones of freedom; see :func:`qualgrasp.qualitative.formgrasp.form_grasps`."""
+zones of freedom; see :func:`qualgrasp.qualitative.synthesis.formgrasp.form_grasps`."""
 
 from __future__ import annotations
 

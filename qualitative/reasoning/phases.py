@@ -1,6 +1,6 @@
 """Grasp phases and finger placement order as ST0 formulas, and a kinematic trace generator.
 
-The regions are those of :mod:`qualgrasp.qualitative.scene`: the object ``O``, the approach zone ``A``
+The regions are those of :mod:`qualgrasp.qualitative.reasoning.scene`: the object ``O``, the approach zone ``A``
 (the object dilated by a margin) and the fingers ``F1..Fk``. With ``k`` fingers the phases are
 state formulas (no temporal operator), mutually exclusive on any real scene:
 
@@ -18,7 +18,7 @@ placing       ``in_zone & {DC,EC}(F1,O) & ... & (EC(F1,O) | ...) & !(EC(F1,O) & 
 grasp         ``EC(F1,O) & ... & EC(Fk,O)``: every finger touches the object
 ============  ===================================================================================
 
-Temporal formulas (``G``: always, ``U``: until, ``O``: once; see :mod:`qualgrasp.qualitative.st0`):
+Temporal formulas (``G``: always, ``U``: until, ``O``: once; see :mod:`qualgrasp.qualitative.reasoning.st0`):
 
 - :func:`phase_sequence`: ``idle & (idle U (approach & (approach U (pregrasp & (pregrasp U
   (placing U G grasp))))))``: the trace starts idle, and leaves each phase only for the next
@@ -43,7 +43,7 @@ from collections.abc import Sequence
 import numpy as np
 from shapely.geometry import Polygon
 
-from .errors import FormulaError, RegionError
+from ..errors import FormulaError, RegionError
 from .scene import grasp_scene
 from .st0 import Formula, parse
 
@@ -138,7 +138,7 @@ def grasp_trace(obj: Polygon, contacts: np.ndarray, normals: np.ndarray, radius:
        the contact for ``depth_i = 0``, pressed ``depth_i`` pixels into the object otherwise.
 
     Each move takes ``steps`` frames; frame 0 is the start. Every frame is
-    :func:`qualgrasp.qualitative.scene.grasp_scene` of the current discs at tolerance ``tol``.
+    :func:`qualgrasp.qualitative.reasoning.scene.grasp_scene` of the current discs at tolerance ``tol``.
 
     Parameters
     ----------
@@ -156,7 +156,7 @@ def grasp_trace(obj: Polygon, contacts: np.ndarray, normals: np.ndarray, radius:
     depth : float or sequence of float
         Penetration of each finger past its contact (pixels), default 0.
     regions, region_width
-        Feasible grasp regions ``R1..`` as in :func:`qualgrasp.qualitative.scene.scene_regions`.
+        Feasible grasp regions ``R1..`` as in :func:`qualgrasp.qualitative.reasoning.scene.scene_regions`.
     tol : float, optional
         RCC-8 tolerance (pixels); default ``radius / 100``, above the disc polygon's error.
 

@@ -37,7 +37,7 @@ import numpy as np
 import shapely
 from shapely.geometry.base import BaseGeometry
 
-from .errors import NetworkError, RegionError
+from ..errors import NetworkError, RegionError
 
 __all__ = [
     "RELATIONS",
@@ -299,7 +299,7 @@ def relations_among(regions: Mapping[str, BaseGeometry],
     Each unordered pair is computed once with :func:`relation`; the reversed pair gets the
     converse, so the result is always a consistent scenario. The result is a network in the
     format of :func:`path_consistency` (a name counts as a one-element set) and a frame of an ST0
-    trace (:mod:`qualgrasp.qualitative.st0`).
+    trace (:mod:`qualgrasp.qualitative.reasoning.st0`).
     """
     names = list(regions)
     for name in names:

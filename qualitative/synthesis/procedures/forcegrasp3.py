@@ -1,6 +1,6 @@
 """``forcegrasp3``: ForceGrasp with three fingers (paper 5.1.3-5.1.4, Ponce and Faverjon's
 friction zone), point contacts with friction; see
-:func:`qualgrasp.qualitative.forcegrasp.triplet_grasps`."""
+:func:`qualgrasp.qualitative.synthesis.forcegrasp.triplet_grasps`."""
 
 from __future__ import annotations
 

@@ -52,8 +52,8 @@ from typing import Any, Sequence
 import numpy as np
 from scipy import ndimage
 
-from .outline import Outline, outline_contour, planning_scale, tls_line
-from .vision import ImageSource, extract_contour
+from ..vision.outline import Outline, outline_contour, planning_scale, tls_line
+from ..vision.contour import ImageSource, extract_contour
 
 __all__ = ["ALPHA", "ALPHA_MAX", "FINGER_WIDTH", "MARGIN", "GRASPABLE", "ON_LINE", "Region", "feasible_regions",
            "on_fine_outline", "planning_regions", "regions_image", "regions_to_dict"]
@@ -146,7 +146,7 @@ def feasible_regions(outline: Outline, alpha: float = ALPHA, finger_width: float
     Parameters
     ----------
     outline : Outline
-        A qualitative outline (:func:`qualgrasp.qualitative.outline.outline_image`).
+        A qualitative outline (:func:`qualgrasp.qualitative.vision.outline.outline_image`).
     alpha : float
         Threshold on the bounding-circle diameter ``rho`` of curves, fraction of the object's size
         ``outline.size``; a curve point is feasible when ``rho > alpha * size``.
@@ -276,10 +276,10 @@ def planning_regions(contour: np.ndarray, *, scale: float | None = None, alpha: 
     ----------
     contour : numpy.ndarray
         ``(m, 2)`` closed contour as extracted from the image
-        (:func:`qualgrasp.qualitative.vision.extract_contour`), pixels.
+        (:func:`qualgrasp.qualitative.vision.contour.extract_contour`), pixels.
     scale : float, optional
         Outline scale, fraction of the perimeter; default
-        :func:`qualgrasp.qualitative.outline.planning_scale` of ``finger_width`` (the finger's).
+        :func:`qualgrasp.qualitative.vision.outline.planning_scale` of ``finger_width`` (the finger's).
     alpha, finger_width, margin : float
         As for :func:`feasible_regions`.
     fine : Outline, optional
@@ -315,13 +315,13 @@ def regions_image(src: ImageSource, *, alpha: float = ALPHA, finger_width: float
     Parameters
     ----------
     src : str, pathlib.Path or numpy.ndarray
-        Image file or array (see :func:`qualgrasp.qualitative.vision.read_image`).
+        Image file or array (see :func:`qualgrasp.qualitative.vision.contour.read_image`).
     alpha, finger_width, margin : float
         See :func:`feasible_regions` (fractions of the object's size).
     scale : float, optional
         Outline scale (default the finger's, :func:`planning_regions`).
     threshold, largest, **options
-        Segmentation (:func:`qualgrasp.qualitative.vision.extract_contour`).
+        Segmentation (:func:`qualgrasp.qualitative.vision.contour.extract_contour`).
 
     Returns
     -------

@@ -1,6 +1,6 @@
 """Grasp scenes as RCC-8 networks: object, approach zone, finger discs and feasible grasp regions.
 
-Region names, used by :mod:`qualgrasp.qualitative.phases` and in ST0 formulas:
+Region names, used by :mod:`qualgrasp.qualitative.reasoning.phases` and in ST0 formulas:
 
 ========  ===============================================================================
 ``O``     the object (a polygon, pixel coordinates)
@@ -19,7 +19,7 @@ tangent to the object can miss it by up to ``radius * (1 - cos(pi / (4 * quad_se
 (0.0012 ``radius`` for the default 16); use a tolerance ``tol`` larger than this (and than the
 noise of vision polygons) for tangent fingers to read as ``EC``. The tolerance must stay below
 ``region_width`` and the finger diameter, which it cannot resolve (see
-:func:`qualgrasp.qualitative.rcc8.relation`).
+:func:`qualgrasp.qualitative.reasoning.rcc8.relation`).
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ import shapely
 from shapely.geometry import LineString, Point, Polygon
 from shapely.geometry.base import BaseGeometry
 
-from .errors import RegionError
+from ..errors import RegionError
 from .rcc8 import relations_among
 
 __all__ = ["finger_disc", "approach_zone", "grasp_region", "scene_regions", "grasp_scene"]
@@ -126,9 +126,9 @@ def grasp_scene(obj: Polygon, centres: np.ndarray, radius: float, *, margin: flo
     -------
     dict
         Every ordered pair of distinct names ``(x, y)`` mapped to the base relation name with
-        ``r(x, y)`` (computed with :func:`qualgrasp.qualitative.rcc8.relation` at tolerance ``tol``,
+        ``r(x, y)`` (computed with :func:`qualgrasp.qualitative.reasoning.rcc8.relation` at tolerance ``tol``,
         pixels). It is a consistent RCC-8 network (accepted as is by
-        :func:`qualgrasp.qualitative.rcc8.path_consistency`) and a frame of an ST0 trace.
+        :func:`qualgrasp.qualitative.reasoning.rcc8.path_consistency`) and a frame of an ST0 trace.
     """
     return relations_among(scene_regions(obj, centres, radius, margin=margin, regions=regions,
                                          region_width=region_width, quad_segs=quad_segs), tol)

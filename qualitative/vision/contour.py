@@ -1,7 +1,7 @@
 """From an image to the object's outer contour.
 
 Pipeline: read the image (file or array) as a grey image (a file's size is checked from its
-header before it is decoded: :mod:`qualgrasp.qualitative.headers`), blur it slightly (1 pixel)
+header before it is decoded: :mod:`qualgrasp.qualitative.vision.headers`), blur it slightly (1 pixel)
 and segment it, keep exactly one connected object (8-connected; specks below 1 % of the largest
 component are noise), take its outer contour with :func:`cv2.findContours` (``RETR_EXTERNAL``,
 ``CHAIN_APPROX_NONE``) and refine every contour point to sub-pixel accuracy along the contour's
@@ -10,7 +10,7 @@ normal (:func:`refine_contour`; on the built-in anti-aliased images the median e
 
 Segmentation (:func:`segment`): by default Otsu's global threshold, the object's side decided
 from the pixels on the image border (the background). Backgrounds that defeat one global
-threshold have their methods (:data:`METHODS`, :mod:`qualgrasp.qualitative.segmentation`):
+threshold have their methods (:data:`METHODS`, :mod:`qualgrasp.qualitative.vision.segmentation`):
 ``"multiotsu"`` (three grey classes: an object with its soft shadow), ``"adaptive"`` (against
 the local mean: uneven lighting), ``"grabcut"`` (from a rectangle: a textured background); or the
 user gives the object's mask (:func:`read_mask`). When no object lies inside the frame, the
@@ -47,7 +47,7 @@ import numpy as np
 from scipy import ndimage
 from skimage.filters import threshold_otsu
 
-from .errors import ContourError, ImageError, SegmentationError
+from ..errors import ContourError, ImageError, SegmentationError
 from .headers import header_size
 from .segmentation import METHODS, adaptive_mask, border_pixels, grabcut_mask, grabcut_rect, multiotsu_mask
 
@@ -296,12 +296,12 @@ def segment(src: ImageSource, threshold: float | None = None, blur: float = 1.0,
         One of :data:`METHODS`: ``"otsu"`` (the default: one global threshold), ``"multiotsu"``
         (three grey classes: a soft shadow), ``"adaptive"`` (against the local mean: uneven
         lighting) or ``"grabcut"`` (from a rectangle: textured backgrounds); see
-        :mod:`qualgrasp.qualitative.segmentation`.
+        :mod:`qualgrasp.qualitative.vision.segmentation`.
     mask : str, pathlib.Path or numpy.ndarray, optional
         A user's mask of the object instead of a method (:func:`read_mask`).
     rect : (int, int, int, int), optional
         GrabCut's rectangle ``(x, y, width, height)``, pixels, holding the object; default
-        :func:`qualgrasp.qualitative.segmentation.grabcut_rect` around Otsu's object.
+        :func:`qualgrasp.qualitative.vision.segmentation.grabcut_rect` around Otsu's object.
 
     Returns
     -------

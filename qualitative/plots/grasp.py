@@ -10,7 +10,7 @@
   (figure 8).
 
 Functions draw on a given :class:`matplotlib.axes.Axes` in the image's pixel frame (x = column,
-y = row, y axis pointing down, equal aspect), like :mod:`qualgrasp.qualitative.plot`; the figure builders use
+y = row, y axis pointing down, equal aspect), like :mod:`qualgrasp.qualitative.plots.outline`; the figure builders use
 the object-oriented API and the Agg canvas (no pyplot, no display).
 """
 
@@ -27,12 +27,12 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon as PolygonPatch, Wedge
 from shapely.geometry.base import BaseGeometry
 
-from .edges import WEAK_EDGE
-from .forcegrasp import ForceGrasp, friction_cone, friction_zone
-from .formgrasp import FormGrasp, line_of_action_exit, zone_steps
-from .plot import STYLE, draw_frame
-from .synthesis import Synthesis
-from .zones import Zones
+from ..vision.edges import WEAK_EDGE
+from ..synthesis.forcegrasp import ForceGrasp, friction_cone, friction_zone
+from ..synthesis.formgrasp import FormGrasp, line_of_action_exit, zone_steps
+from .outline import STYLE, draw_frame
+from ..synthesis.pipeline import Synthesis
+from ..synthesis.zones import Zones
 
 __all__ = ["plot_zones", "plot_contacts", "plot_grasp", "plot_form_step", "synthesis_figure"]
 
@@ -79,7 +79,7 @@ def plot_zones(ax: Axes, zones: Zones, bounds: tuple[float, float, float, float]
     ax : matplotlib.axes.Axes
         Where to draw (pixel frame).
     zones : Zones
-        Zones of freedom (:func:`qualgrasp.qualitative.zones.zones`).
+        Zones of freedom (:func:`qualgrasp.qualitative.synthesis.zones.zones`).
     bounds : (xmin, ymin, xmax, ymax)
         Box the unbounded zones are clipped to, pixels.
     size : float
@@ -286,7 +286,7 @@ def synthesis_figure(synth: Synthesis, image: np.ndarray | None = None, count: i
     Parameters
     ----------
     synth : Synthesis
-        Result of :func:`qualgrasp.qualitative.synthesis.synthesize`.
+        Result of :func:`qualgrasp.qualitative.synthesis.pipeline.synthesize`.
     image : numpy.ndarray, optional
         The image, drawn faintly underneath.
     count : int
