@@ -59,6 +59,32 @@ def test_fast_evaluator_agrees_with_the_naive_per_instant_one(f, trace):
     assert np.array_equal(f.evaluate(trace), evaluate_reference(f, trace))
 
 
+# p = EC(A,B) holds at instants 0, 2, 3 of five; q = DC(A,B) at 1 and 4
+_HAND_TRACE = [{("A", "B"): r} for r in ("EC", "DC", "EC", "EC", "DC")]
+_P, _Q = Atom(frozenset({"EC"}), "A", "B"), Atom(frozenset({"DC"}), "A", "B")
+
+
+@pytest.mark.parametrize("formula, expected", [
+    (_P, [1, 0, 1, 1, 0]),
+    (Next(_P), [0, 1, 1, 0, 0]),            # false at the last instant
+    (Previous(_P), [0, 1, 0, 1, 1]),        # false at instant 0
+    (Sometime(_Q), [1, 1, 1, 1, 1]),
+    (Always(_P), [0, 0, 0, 0, 0]),
+    (Once(_Q), [0, 1, 1, 1, 1]),
+    (Historically(_P), [1, 0, 0, 0, 0]),
+    (Until(_P, _Q), [1, 1, 1, 1, 1]),       # p holds up to each next q
+    (Until(_Q, _P), [1, 1, 1, 1, 0]),       # no p from instant 4 on
+    (Since(_P, _Q), [0, 1, 1, 1, 1]),       # no q at or before instant 0
+    (Since(_Q, _P), [1, 1, 1, 1, 1]),
+    (Implies(_P, Next(_P)), [0, 1, 1, 0, 1]),
+])
+def test_each_operator_on_a_trace_worked_by_hand(formula, expected):
+    """Both evaluators against values worked out by hand (the property test above would accept
+    a fault the two shared)."""
+    assert formula.evaluate(_HAND_TRACE).astype(int).tolist() == expected
+    assert np.asarray(evaluate_reference(formula, _HAND_TRACE)).astype(int).tolist() == expected
+
+
 @given(formulas, traces())
 def test_sometime_always_and_their_past_duals(p, trace):
     ev = lambda f: f.evaluate(trace)
