@@ -9,6 +9,7 @@ import cv2
 import pytest
 from typer.testing import CliRunner
 
+from qualgrasp.certify.cli.options import FOLDER_MARKER
 from qualgrasp.certify.regions.boundary import TOL_FLOOR
 from qualgrasp.cli import app
 from qualgrasp.qualitative.objects import render
@@ -117,10 +118,37 @@ def test_synthesize_and_plots_never_write_over_the_image(scene, tmp_path):
 
 
 def test_figures_refuses_a_file_in_the_way_and_keeps_it(tmp_path):
-    """An --out folder holding a user's FIFO under a figure's name: refused, the FIFO kept."""
+    """An --out folder holding a user's FIFO under a figure's name: refused, the FIFO kept; also
+    in a folder qualgrasp wrote before (its marker), where each output is checked by itself."""
     out = tmp_path / "figs"
     out.mkdir()
     os.mkfifo(out / "fig3_outline.pdf")
     result = run("figures", "--out", out)
+    assert result.exit_code == 2 and "did not write" in result.output
+    assert (out / "fig3_outline.pdf").is_fifo()
+    (out / FOLDER_MARKER).touch()
+    result = run("figures", "--out", out)
     assert result.exit_code == 2 and "FIFO" in result.output
     assert (out / "fig3_outline.pdf").is_fifo()
+
+
+@pytest.mark.parametrize("command, name", [(["figures"], "fig3_outline.png"),
+                                           (["compare", "--builtins"], "overall.csv"),
+                                           (["silhouettes", "--n", "1", "--no-horse"], "cell-000.png")])
+def test_folder_commands_never_replace_a_users_file(tmp_path, command, name):
+    """A folder the command did not make, holding a user's file under one of the outputs' names
+    (found by a hostile run: figures and compare replaced it): refused before any work, kept."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / name).write_text("mine")
+    result = run(*command, "--out", out)
+    assert result.exit_code == 2 and "did not write" in result.output, result.output
+    assert (out / name).read_text() == "mine" and sorted(p.name for p in out.iterdir()) == [name]
+
+
+def test_a_folder_qualgrasp_wrote_can_be_written_again(tmp_path):
+    out = tmp_path / "sil"
+    for _ in range(2):
+        result = run("silhouettes", "--out", out, "--n", "1", "--no-horse")
+        assert result.exit_code == 0, result.output
+    assert (out / FOLDER_MARKER).exists() and any(p.suffix == ".png" for p in out.iterdir())

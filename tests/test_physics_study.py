@@ -104,6 +104,21 @@ def test_output_folder_that_is_a_file_exits_2(tmp_path):
     assert result.exit_code == 2 and "is not a folder" in result.output
 
 
+def test_the_output_folder_is_never_the_input_folder(tmp_path):
+    """Found by a hostile run: validate wrote its figures into its image folder, replacing an
+    input image of the same name."""
+    folder = tmp_path / "images"
+    folder.mkdir()
+    cv2.imwrite(str(folder / "physics-filmstrip.png"), render("nut"))
+    before = (folder / "physics-filmstrip.png").read_bytes()
+    for out in (folder, tmp_path / "link"):
+        if out != folder:
+            out.symlink_to(folder)
+        result = CliRunner().invoke(_app(), ["validate", str(folder), "--quick", "--out", str(out)])
+        assert result.exit_code == 2 and "input of this run" in result.output, result.output
+    assert (folder / "physics-filmstrip.png").read_bytes() == before
+
+
 def test_validate_on_a_folder_of_images(tmp_path):
     """An image without known geometry: the grasps are executed on the contour it shows."""
     folder = tmp_path / "images"

@@ -40,7 +40,7 @@ from ..core import arguments
 from ..errors import OptionError
 from ..files.outputs import check_name_length, check_output, file_kind, inside, same_file, writable_folder
 
-__all__ = ["OptionError", "FIGURE_SUFFIXES", "output_file", "output_folder", "input_file", "number_in",
+__all__ = ["OptionError", "FIGURE_SUFFIXES", "FOLDER_MARKER", "output_file", "output_folder", "input_file", "number_in",
            "count_in", "optional_number_in", "printable", "fail"]
 
 #: Suffixes a figure may be saved with (matplotlib's writers).
@@ -92,13 +92,20 @@ def output_file(path: str | Path, flag: str, *, suffixes: Iterable[str] | None =
     return check_output(path, flag, reads=reads)
 
 
+#: The file that marks a folder as written by qualgrasp (:func:`output_folder`): a later run may
+#: replace the files in it.
+FOLDER_MARKER = ".qualgrasp-output"
+
+
 def output_folder(path: str | Path, flag: str, *, reads: Iterable[str | Path] = ()) -> Path:
-    """Check (and create) an output folder; return it.
+    """Check (and create) an output folder, mark it as qualgrasp's (:data:`FOLDER_MARKER`);
+    return it.
 
     Refused: an existing path that is not a folder (a file, a FIFO, a device; symbolic links
     followed), a folder that is one of ``reads`` (an input folder or file of the run), holds one
-    of them, or cannot be created or written. Write each file in it with
-    :func:`qualgrasp.certify.files.outputs.atomic_output`.
+    of them, or cannot be created or written, and an existing folder holding anything without the
+    marker (a run writes its files by name, and would replace a user's file of the same name).
+    Write each file in it with :func:`qualgrasp.certify.files.outputs.atomic_output`.
 
     Raises
     ------
@@ -120,7 +127,14 @@ def output_folder(path: str | Path, flag: str, *, reads: Iterable[str | Path] = 
         if same_file(path, other) or inside(other, path):
             raise OptionError(f"{flag}: {path} is (or holds) an input of this run ({other}); give another folder")
     check_name_length(path, flag)
+    if path.is_dir() and not (path / FOLDER_MARKER).exists() and any(path.iterdir()):
+        raise OptionError(f"{flag}: {path} already holds files qualgrasp did not write (no {FOLDER_MARKER} "
+                          "in it); give a new or empty folder")
     writable_folder(path, flag)
+    try:
+        (path / FOLDER_MARKER).touch()
+    except OSError as err:
+        raise OptionError(f"{flag}: cannot write into {path} ({err.strerror or err})") from None
     return path
 
 

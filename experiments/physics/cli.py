@@ -65,7 +65,7 @@ def validate_command(
         count_in(silhouettes, "--silhouettes", 0, available_silhouettes() - 1, what="(the bundled cell outlines)")
         count_in(wings, "--wings", 0, available_wings(), what="(the bundled wing outlines)")
         count_in(workers, "--workers", 1, 256, what="processes")
-        output_folder(out, "--out")
+        output_folder(out, "--out", reads=[folder] if folder else [])
     except OptionError as err:
         _fail(str(err))
     images: list = sorted(p for p in folder.iterdir() if p.suffix.lower() in _IMAGE_SUFFIXES) if folder else []
