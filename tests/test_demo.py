@@ -1,7 +1,9 @@
 """``qualgrasp demo`` end to end: what it writes is complete, consistent and re-checkable."""
 
 import json
+import os
 import re
+from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
@@ -12,13 +14,19 @@ from qualgrasp.experiments.study import BUILTINS
 
 runner = CliRunner()
 
-# The whole job (figures, synthesis, certification, the quick study): `.ci/run` also runs it as the
-# README's demo command before the tests.
+# The whole job (figures, synthesis, certification, the quick study): `.ci/run` runs it as the
+# README's demo command before the tests, and these tests read that run's output.
 pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module")
 def demo(tmp_path_factory):
+    """The demo's output folder and what it printed: with QUALGRASP_DEMO_OUTPUT and
+    QUALGRASP_DEMO_LOG (set by ``.ci/run``), those of the README's demo command it has just run;
+    else a run of its own."""
+    given, log = os.environ.get("QUALGRASP_DEMO_OUTPUT"), os.environ.get("QUALGRASP_DEMO_LOG")
+    if given and log:
+        return Path(given), Path(log).read_text()
     out = tmp_path_factory.mktemp("demo") / "out"
     result = runner.invoke(app, ["demo", "--out", str(out)])
     assert result.exit_code == 0, result.output
