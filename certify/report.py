@@ -21,6 +21,7 @@ from .errors import CertificateError
 from .core.closure import Verdict, form_closure, force_closure
 from .quality.evidence import verify_epsilon
 from .core.grasp import Grasp
+from .core.validation import show_repr
 from .solvers import Method
 from .quality.bounds import Epsilon, epsilons
 from .files.results import NAMES, result_row
@@ -136,14 +137,6 @@ def _number(value: Any) -> float | None:
     return x if math.isfinite(x) else None
 
 
-def _show(value: Any) -> str:
-    try:
-        text = repr(value)
-    except RecursionError:
-        return "(deeply nested value)"
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
 def verify_row(grasp: Grasp, row: dict[str, Any], tol: Tolerances = Tolerances()) -> Check:
     """Re-check every claim of a results row (not an error row) against its grasp, without a
     solver.
@@ -170,7 +163,7 @@ def verify_row(grasp: Grasp, row: dict[str, Any], tol: Tolerances = Tolerances()
         return Check(False, "malformed row (too deeply nested)")
     except (TypeError, ValueError, KeyError, AttributeError, IndexError, OverflowError,
             ZeroDivisionError) as err:
-        return Check(False, f"malformed row ({type(err).__name__}: {_show(str(err))})")
+        return Check(False, f"malformed row ({type(err).__name__}: {show_repr(str(err))})")
 
 
 def _verify_row(grasp: Grasp, row: Any, tol: Tolerances) -> Check:
@@ -181,23 +174,23 @@ def _verify_row(grasp: Grasp, row: Any, tol: Tolerances) -> Check:
         return Check(False, f"column{'s' if len(missing) > 1 else ''} {', '.join(missing)} "
                             f"{'are' if len(missing) > 1 else 'is'} missing")
     if row["verified"] is not True:
-        return Check(False, f"verified must be true on a certified row, got {_show(row['verified'])}")
+        return Check(False, f"verified must be true on a certified row, got {show_repr(row['verified'])}")
     if row["error"] is not None:
-        return Check(False, f"error must be null on a certified row, got {_show(row['error'])}")
+        return Check(False, f"error must be null on a certified row, got {show_repr(row['error'])}")
     for key, expected in (("dim", grasp.dim), ("n_contacts", len(grasp.contacts))):
         value = row[key]
         if isinstance(value, bool) or not isinstance(value, int) or value != expected:
-            return Check(False, f"{key} {_show(value)} does not match the grasp's {expected}")
+            return Check(False, f"{key} {show_repr(value)} does not match the grasp's {expected}")
     center = row["center"]
     if not isinstance(center, (list, tuple)) or len(center) != grasp.dim:
-        return Check(False, f"center must hold {grasp.dim} numbers, got {_show(center)}")
+        return Check(False, f"center must hold {grasp.dim} numbers, got {show_repr(center)}")
     for a, b in zip(center, grasp.center):
         x = _number(a)
         if x is None or abs(x - b) > GEOMETRY_TOL * max(1.0, abs(b)):
-            return Check(False, f"center {_show(center)} does not match the grasp's {list(grasp.center)}")
+            return Check(False, f"center {show_repr(center)} does not match the grasp's {list(grasp.center)}")
     x = _number(row["length"])
     if x is None or abs(x - grasp.length) > GEOMETRY_TOL * max(1.0, grasp.length):
-        return Check(False, f"length {_show(row['length'])} does not match the grasp's {grasp.length!r}")
+        return Check(False, f"length {show_repr(row['length'])} does not match the grasp's {grasp.length!r}")
     if not isinstance(row["certificate"], dict):
         return Check(False, "certificate must be an object with force and form")
     flags = {"closure": True, "no_closure": False, "degenerate": None}
@@ -207,12 +200,12 @@ def _verify_row(grasp: Grasp, row: Any, tol: Tolerances) -> Check:
     ):
         status = row[status_key]
         if not isinstance(status, str) or status not in flags:
-            return Check(False, f"{status_key} must be closure, no_closure or degenerate, got {_show(status)}")
+            return Check(False, f"{status_key} must be closure, no_closure or degenerate, got {show_repr(status)}")
         if row[flag_key] is not flags[status]:
-            return Check(False, f"{flag_key} {_show(row[flag_key])} does not match {status_key} {status!r}")
+            return Check(False, f"{flag_key} {show_repr(row[flag_key])} does not match {status_key} {status!r}")
         margin = _number(row[margin_key])
         if margin is None:
-            return Check(False, f"{margin_key} must be a finite number, got {_show(row[margin_key])}")
+            return Check(False, f"{margin_key} must be a finite number, got {show_repr(row[margin_key])}")
         if status != "closure" and margin != 0:
             return Check(False, f"{margin_key} must be 0 when not in closure")
         try:

@@ -37,6 +37,7 @@ from ..report import certify_grasp, verify_row
 from ..files.results import NAMES, carried_clash, carried_name, error_row
 from ..solvers import METHODS, Method, make_solver
 from ..core.arguments import choice, count_in, number_in, require
+from ..core.validation import show_repr
 from ..files.reader import Chunk, chunk_values, column_problem, table_to_rows
 
 __all__ = ["Options", "Quality", "certify_rows", "certify_values", "certify_chunk_results", "certify_arrow",
@@ -239,9 +240,9 @@ def _failure(cols: GraspColumns, i: int, line: int, row: Any, tol: Tolerances, g
         return gid, f"column{'s' if len(missing) > 1 else ''} {', '.join(missing)} missing"
     stated_line = row["line"]
     if isinstance(stated_line, bool) or not isinstance(stated_line, int) or stated_line != line:
-        return gid, f"line {_show(stated_line)} does not match the grasp's line {line}"
+        return gid, f"line {show_repr(stated_line)} does not match the grasp's line {line}"
     if not _same_id(row["id"], gid):
-        return gid, f"id {_show(row['id'])} does not match the grasp's id {_show(gid)} (line {line})"
+        return gid, f"id {show_repr(row['id'])} does not match the grasp's id {show_repr(gid)} (line {line})"
     # a grasp whose extra fields cannot be carried is an error row, as certify_rows writes it
     message = cols.message(i) or _carried(cols.meta[i] if cols.meta else None)[1]
     if row["status"] == "error":
@@ -250,20 +251,12 @@ def _failure(cols: GraspColumns, i: int, line: int, row: Any, tol: Tolerances, g
         expected = error_row(f"line {line}: {message}", id=row["id"], line=line)
         for name in NAMES:
             if row[name] != expected[name] or type(row[name]) is not type(expected[name]):
-                return gid, f"{name} of an error row must be {_show(expected[name])}, got {_show(row[name])}"
+                return gid, f"{name} of an error row must be {show_repr(expected[name])}, got {show_repr(row[name])}"
         return None
     if message is not None:
-        return gid, f"status {_show(row['status'])} but the grasp is invalid (the row must be an error row): {message}"
+        return gid, f"status {show_repr(row['status'])} but the grasp is invalid (the row must be an error row): {message}"
     check = verify_row(cols.grasps([i])[0], row, tol)
     return None if check else (gid, check.reason)
-
-
-def _show(value: Any) -> str:
-    try:
-        text = repr(value)
-    except RecursionError:
-        return "(deeply nested value)"
-    return text if len(text) <= 60 else text[:57] + "..."
 
 
 @dataclass

@@ -47,7 +47,7 @@ from .. import models as registry
 from ..models import MAX_LENGTH, MIN_LENGTH
 
 __all__ = ["MAX_CONTACTS", "MIN_NORMAL", "ABSENT", "UNKNOWN", "ContactData", "GraspData",
-           "Checked", "show", "number", "numbers", "contact_data", "grasp_data",
+           "Checked", "show", "show_repr", "number", "numbers", "contact_data", "grasp_data",
            "check_contacts", "check_grasps", "grasp_rules", "CheckedGrasps", "param_names", "TOP_LEVEL",
            "id_problem"]
 
@@ -65,6 +65,21 @@ def show(value: Any, limit: int = 60) -> str:
         text = json.dumps(value, allow_nan=True)
     except (TypeError, ValueError, RecursionError):
         text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def show_repr(value: Any, limit: int = 60) -> str:
+    """A short ``repr`` of a value for messages (a row's own Python value, as it was read).
+
+    Examples
+    --------
+    >>> show_repr("abc"), len(show_repr(list(range(100))))
+    ("'abc'", 60)
+    """
+    try:
+        text = repr(value)
+    except RecursionError:
+        return "(deeply nested value)"
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
