@@ -17,11 +17,14 @@ repeated here: ``MARGIN`` (:data:`.regions.MARGIN`, :data:`.forcegrasp.MARGIN`),
 
 Examples
 --------
->>> from qualgrasp.qualitative.objects import render
->>> from qualgrasp.qualitative.synthesis import synthesize
->>> s = synthesize(render("polygon"), procedure="formgrasp")
->>> s.procedure.name, len(s.grasps) > 0
-('formgrasp', True)
+The regions a square's grasps are planned on (:func:`.pipeline.synthesize` has the whole
+pipeline's example):
+
+>>> import numpy as np
+>>> from qualgrasp.qualitative.synthesis import planning_regions
+>>> outline, regions = planning_regions(np.array([[0, 0], [100, 0], [100, 100], [0, 100]], float))
+>>> outline.string, len(regions)
+('/>/>/>/>', 4)
 """
 
 from .pipeline import (FALLBACK_SCALES, FALLBACK_STEP, MU, NORMAL, NOT_COUNTED, POSITION, SPREAD, NotCounted,
