@@ -52,6 +52,22 @@ __all__ = ["made_up_meshes", "real_meshes", "independent_travel", "edge8_forces"
            "real_study", "main"]
 
 
+def _certify_hold(report: dict, outcome, args, props):
+    """The soft-contact grasp of ``outcome``, its least grip force against gravity ``-z`` and that
+    bound's exact re-check, timed into ``report["t_certify"]`` and counted (certified, unverified,
+    noted, withdrawn); returns ``(grasp, bound, check)``."""
+    grasp = grasp_of(outcome, args.mu, "soft", props)
+    t0 = time.perf_counter()
+    b = least_grip(grasp, props.mass, props.com, (0, 0, -1))
+    ok = check_bound(grasp, props.mass, props.com, b)
+    report["t_certify"].append(time.perf_counter() - t0)
+    report["certified"] += 1
+    report["unverified"] += int(not ok)
+    report["noted"] += int(bool(b.note))
+    report["withdrawn"] += int(b.slip is None or (b.forces is None and not np.isinf(b.lo)))
+    return grasp, b, ok
+
+
 def _tally_edge8(report: dict, grasp, props, verdict: str, hold: float) -> None:
     """Count in ``report`` a grasp whose 8-edge linearised verdict (Dex-Net's cones) differs from
     the exact ``verdict`` at grip force ``hold``, and whether its optimistic forces leave the exact
@@ -262,15 +278,7 @@ def real_study(args) -> dict:
                 report["messages"].append(f"{name}: {o.message}")
                 continue
             mine["contacts"] += 1
-            grasp = grasp_of(o, args.mu, "soft", props)
-            t0 = time.perf_counter()
-            b = least_grip(grasp, props.mass, props.com, (0, 0, -1))
-            ok = check_bound(grasp, props.mass, props.com, b)
-            report["t_certify"].append(time.perf_counter() - t0)
-            report["certified"] += 1
-            report["unverified"] += int(not ok)
-            report["noted"] += int(bool(b.note))
-            report["withdrawn"] += int(b.slip is None or (b.forces is None and not np.isinf(b.lo)))
+            grasp, b, _ = _certify_hold(report, o, args, props)
             if b.note:
                 report["notes"].append(f"{name}: {b.note}")
             verdict = hold_verdict(b.lo, b.hi, args.hold)
@@ -352,16 +360,8 @@ def main(argv: list[str] | None = None) -> dict:
             if certified >= args.certify:
                 continue
             certified += 1
-            grasp = grasp_of(o, args.mu, "soft", props)
-            t0 = time.perf_counter()
-            b = least_grip(grasp, props.mass, props.com, (0, 0, -1))
-            ok = check_bound(grasp, props.mass, props.com, b)
-            report["t_certify"].append(time.perf_counter() - t0)
-            report["certified"] += 1
+            grasp, b, ok = _certify_hold(report, o, args, props)
             report["verified"] += int(bool(ok))
-            report["unverified"] += int(not ok)
-            report["noted"] += int(bool(b.note))
-            report["withdrawn"] += int(b.slip is None or (b.forces is None and not np.isinf(b.lo)))
             verdict = hold_verdict(b.lo, b.hi, args.hold)
             report["holds"] += int(verdict == "holds")
             if verdict == "undecided":
