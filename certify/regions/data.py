@@ -118,8 +118,32 @@ def _params_of(prefix: str, d: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+class _ModelParams:
+    """The contact model's parameters of a region, read from ``params``."""
+
+    params: tuple[tuple[str, float], ...]
+
+    @property
+    def mu(self) -> float:
+        """Friction coefficient (0 when frictionless)."""
+        return float(dict(self.params).get("mu", 0.0))
+
+    @property
+    def width(self) -> float:
+        """Pad width (0 unless a pad)."""
+        return float(dict(self.params).get("width", 0.0))
+
+
+def _set_model(region: Any, checked) -> None:
+    """Store a region's checked model: its registered name and its parameters in the model's order."""
+    name = registry.get(int(checked.model[0])).name
+    object.__setattr__(region, "model", name)
+    object.__setattr__(region, "params", tuple((p, float(checked.params[p][0]))
+                                               for p in registry.get(name).param_names))
+
+
 @dataclass(frozen=True, init=False)
-class StraightRegion:
+class StraightRegion(_ModelParams):
     """A straight contact region: the finger anywhere on the segment ``[a, b]``, inward normal ``n``.
 
     Parameters
@@ -165,23 +189,10 @@ class StraightRegion:
                  {"p": list(b), "n": list(nv), "model": model, "mu": mu, "width": width}]
         checked = _check_model(_prefix, items, {(0, "p"): "a", (1, "p"): "b"})
         stored = tuple(float(v) for v in checked.n[0, :2])
-        name = registry.get(int(checked.model[0])).name
         object.__setattr__(self, "a", a)
         object.__setattr__(self, "b", b)
         object.__setattr__(self, "n", stored)
-        object.__setattr__(self, "model", name)
-        object.__setattr__(self, "params", tuple((p, float(checked.params[p][0]))
-                                                 for p in registry.get(name).param_names))
-
-    @property
-    def mu(self) -> float:
-        """Friction coefficient (0 when frictionless)."""
-        return float(dict(self.params).get("mu", 0.0))
-
-    @property
-    def width(self) -> float:
-        """Pad width (0 unless a pad)."""
-        return float(dict(self.params).get("width", 0.0))
+        _set_model(self, checked)
 
     @property
     def length(self) -> float:
@@ -199,7 +210,7 @@ class StraightRegion:
 
 
 @dataclass(frozen=True, init=False)
-class CurvedRegion:
+class CurvedRegion(_ModelParams):
     """A curved contact region: a polyline of boundary points with their inward normals.
 
     The finger is anywhere on the curve from the first point to the last; between two
@@ -257,26 +268,13 @@ class CurvedRegion:
             names[(j, "p")], names[(j, " p")] = f"points[{j}]", f"points[{j}]"
             names[(j, "n")] = f"normals[{j}]"
         checked = _check_model(_prefix, items, names)
-        name = registry.get(int(checked.model[0])).name
         P = np.array(pts, dtype=float).reshape(-1, 2)
         N = np.ascontiguousarray(checked.n[:, :2], dtype=float)
         P.setflags(write=False)
         N.setflags(write=False)
         object.__setattr__(self, "points", P)
         object.__setattr__(self, "normals", N)
-        object.__setattr__(self, "model", name)
-        object.__setattr__(self, "params", tuple((p, float(checked.params[p][0]))
-                                                 for p in registry.get(name).param_names))
-
-    @property
-    def mu(self) -> float:
-        """Friction coefficient (0 when frictionless)."""
-        return float(dict(self.params).get("mu", 0.0))
-
-    @property
-    def width(self) -> float:
-        """Pad width (0 unless a pad)."""
-        return float(dict(self.params).get("width", 0.0))
+        _set_model(self, checked)
 
     @property
     def length(self) -> float:
