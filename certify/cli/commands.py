@@ -78,12 +78,7 @@ def certify_command(
         except CertifyError as err:
             fail(str(err))
     if not quiet:
-        table = Table(title=f"{summary.rows} grasps -> {output}")
-        table.add_column("status")
-        table.add_column("rows", justify="right")
-        for status, count in sorted(summary.statuses.items()):
-            table.add_row(status, str(count))
-        table.add_row("unverified", str(summary.unverified))
+        table = _status_table(f"{summary.rows} grasps -> {output}", summary)
         if summary.resumed_chunks:
             table.add_row("chunks kept from the interrupted run", str(summary.resumed_chunks))
         console.print(table)
@@ -154,12 +149,7 @@ def certify_regions_command(
         except CertifyError as err:
             fail(str(err))
     if not quiet:
-        table = Table(title=f"{summary.rows} region tuples -> {output}")
-        table.add_column("status")
-        table.add_column("rows", justify="right")
-        for status, count in sorted(summary.statuses.items()):
-            table.add_row(status, str(count))
-        table.add_row("unverified", str(summary.unverified))
+        table = _status_table(f"{summary.rows} region tuples -> {output}", summary)
         console.print(table)
         console.print(f"{summary.seconds:.1f} s")
     if summary.errors or summary.unverified:
@@ -191,6 +181,17 @@ def sample_command(
     except CertifyError as err:
         fail(str(err))
     console.print(f"wrote {count} grasps to {output}")
+
+
+def _status_table(title: str, summary) -> Table:
+    """Rows per status and the unverified rows of a run's summary."""
+    table = Table(title=title)
+    table.add_column("status")
+    table.add_column("rows", justify="right")
+    for status, count in sorted(summary.statuses.items()):
+        table.add_row(status, str(count))
+    table.add_row("unverified", str(summary.unverified))
+    return table
 
 
 def register(app: typer.Typer) -> None:
