@@ -196,7 +196,8 @@ def cli_lines(command, name: str, parent=None, depth: int = 0) -> list[str]:
         lines.append("")
     if hasattr(command, "list_commands"):
         for sub in command.list_commands(ctx):
-            child = command.get_command(ctx, sub)
+            # the lazy application's get_command gives summaries only; load_command the command
+            child = getattr(command, "load_command", command.get_command)(ctx, sub)
             if child is None or getattr(child, "hidden", False):
                 continue
             lines += cli_lines(child, sub, ctx, depth + 1)
