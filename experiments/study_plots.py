@@ -17,8 +17,8 @@ Every plot is written as PNG and PDF with :func:`qualgrasp.experiments.style.sav
   fraction of the object's size; 0 when none is certified), per route, one panel per finger
   count, beside the route's sampled robustness (pooled fraction held, in the tick labels).
 
-Panels, labels and colours come from the procedure registry (:mod:`qualgrasp.qualitative.synthesis.procedures`):
-one panel (or row) per registered procedure, with its baseline; colours tell the procedure, line
+Panels and labels come from the procedure registry (:mod:`qualgrasp.qualitative.synthesis.procedures`):
+one panel (or row) per registered procedure, with its baseline; colours tell the procedure (:func:`~qualgrasp.experiments.style.procedure_colour`), line
 style and marker the method (solid and circles: qualitative; dashed and triangles: baseline).
 """
 
@@ -31,7 +31,7 @@ from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from ..qualitative.synthesis import procedures
 from .design import KINDS, UNITS, compared_procedure
-from .style import context, new_figure, save
+from .style import context, new_figure, procedure_colour, save
 
 __all__ = ["plot_epsilon", "plot_quality_time", "plot_robustness", "plot_tolerance", "plot_all"]
 
@@ -70,7 +70,7 @@ def plot_epsilon(out: Path, object_rows: list[dict], grasp_rows: list[dict]) -> 
                         and r["method"] == method and r["eps_best"] is not None and r["counted"]]
                 dropped = sum(g["certified"] and not g["counted"] for g in grasp_rows
                               if g["procedure"] == name and g["method"] == method)
-                color = p.colour
+                color = procedure_colour(p)
                 if eps:
                     ax.boxplot([eps], positions=[x], widths=0.5, showfliers=False,
                                medianprops={"color": color, "linewidth": 1.6},
@@ -100,8 +100,8 @@ def plot_quality_time(out: Path, object_rows: list[dict]) -> list[Path]:
                 rows = [r for r in object_rows if r["procedure"] == p.name and r["method"] == method
                         and r["seconds"] is not None]
                 ax.scatter([r["seconds"] for r in rows], [r["eps_best"] or 0.0 for r in rows],
-                           s=16, marker=marker, color=p.colour,
-                           facecolors=p.colour if method == "baseline" else "none",
+                           s=16, marker=marker, color=procedure_colour(p),
+                           facecolors=procedure_colour(p) if method == "baseline" else "none",
                            linewidths=0.9, label=f"{name}, {_short(p, _mu(object_rows, p.name))}",
                            alpha=0.85)
         ax.set_xscale("log")
@@ -141,7 +141,7 @@ def plot_robustness(out: Path, robust: list[dict], mu: dict | None = None) -> li
                         x, y = _curve(robust, route, kind)
                         style, marker, name = _METHOD[method]
                         ax.plot(x, y, linestyle=style, marker=marker, markersize=3.5,
-                                color=p.colour, label=name,
+                                color=procedure_colour(p), label=name,
                                 linewidth=2.2 if method == "qualitative" else 1.2,
                                 alpha=0.55 if method == "qualitative" else 1.0)
                 ax.set_ylim(-0.05, 1.05)
@@ -180,10 +180,10 @@ def plot_tolerance(out: Path, object_rows: list[dict], robust: list[dict]) -> li
                          and r["method"] == method and r.get("slide_best") is not None]
                 if delta:
                     ax.boxplot([delta], positions=[x], widths=0.5, showfliers=False,
-                               medianprops={"color": p.colour, "linewidth": 1.6},
+                               medianprops={"color": procedure_colour(p), "linewidth": 1.6},
                                boxprops={"color": "0.4"}, whiskerprops={"color": "0.4"},
                                capprops={"color": "0.4"})
-                ax.scatter(_jitter(len(delta), x, rng), delta, s=9, color=p.colour, alpha=0.8,
+                ax.scatter(_jitter(len(delta), x, rng), delta, s=9, color=procedure_colour(p), alpha=0.8,
                            marker=_METHOD[method][1], zorder=3, linewidths=0)
                 held = _held(robust, name, method)
                 positive = sum(d > 0 for d in delta)

@@ -26,9 +26,10 @@ from qualgrasp.certify.files import atomic_output
 from qualgrasp.qualitative.plots.grasp import CONE, TCOLOR, ZMINUS, ZPLUS
 from qualgrasp.qualitative.objects import BACKGROUND, FOREGROUND
 from qualgrasp.qualitative.plots.outline import STYLE as CURVATURE
+from qualgrasp.qualitative.synthesis import procedures
 
 __all__ = ["RC", "DPI", "CURVATURE", "ZPLUS", "ZMINUS", "TCOLOR", "CONE", "GOOD", "BAD", "GRASP_LINE",
-           "ZONE", "MEET", "OBJECT", "context", "new_figure", "show_image", "clean", "check_formats", "save"]
+           "ZONE", "MEET", "OBJECT", "PROCEDURE_COLOURS", "procedure_colour", "context", "new_figure", "show_image", "clean", "check_formats", "save"]
 
 DPI = 200
 GOOD = "tab:green"  # a verdict that holds: closure, positive spanning
@@ -37,6 +38,9 @@ GRASP_LINE = "tab:red"  # the two-finger grasp line, as drawn by qualitative.plo
 ZONE = {"facecolor": "tab:green", "edgecolor": "darkgreen", "alpha": 0.45}  # friction zone, idem
 MEET = "darkgreen"  # where the three forces meet, idem
 OBJECT = 0.84  # grey level of the object as shown (1 = white background)
+#: Colours of the synthesis procedures (and of their baselines), in the registry's order.
+PROCEDURE_COLOURS = ("tab:blue", "tab:orange", "tab:purple", "tab:green", "tab:brown", "tab:pink", "tab:olive",
+                     "tab:cyan")
 
 RC = {
     "font.family": "DejaVu Sans",
@@ -56,6 +60,19 @@ RC = {
     "pdf.fonttype": 42,  # embed TrueType, so the text stays text (editable, searchable)
     "ps.fonttype": 42,
 }
+
+
+def procedure_colour(procedure: procedures.Procedure) -> str:
+    """The colour of ``procedure`` in every plot: :data:`PROCEDURE_COLOURS` in the order procedures
+    are registered (cycling after eight), so a new procedure needs no plotting code.
+
+    Examples
+    --------
+    >>> procedure_colour(procedures.get("forcegrasp2"))
+    'tab:blue'
+    """
+    index = procedures.names().index(procedure.name)
+    return PROCEDURE_COLOURS[index % len(PROCEDURE_COLOURS)]
 
 
 @contextmanager

@@ -71,8 +71,6 @@ class Procedure:
         with friction take ``mu`` (or ``theta_min``).
     tag : str
         Short tag in grasp ids (``<image>-<tag>-0007``).
-    colour : str
-        Matplotlib colour of the procedure (and of its baseline) in plots.
     search : callable
         ``search(SearchInput) -> list`` of found grasps (objects with ``points``, ``normals``,
         ``regions``).
@@ -95,7 +93,6 @@ class Procedure:
     fingers: int
     model: str
     tag: str
-    colour: str
     search: Callable[[SearchInput], Sequence[Any]]
     score: Callable[[Any], float]
     meta: Callable[[Any], dict]

@@ -34,7 +34,7 @@ def _diagnose(s: SearchInput) -> str:
 
 
 FORCEGRASP2 = register(Procedure(
-    name="forcegrasp2", title="ForceGrasp", fingers=2, model="point", tag="force2", colour="tab:blue",
+    name="forcegrasp2", title="ForceGrasp", fingers=2, model="point", tag="force2",
     search=_search, score=lambda g: g.margin, meta=force_meta, diagnose=_diagnose,
     description="two fingers with friction: the grasp line inside both friction cones (Nguyen)",
     failure="no pair of candidate contacts has its grasp line inside both friction "

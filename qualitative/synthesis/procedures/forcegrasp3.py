@@ -38,7 +38,7 @@ def _diagnose(s: SearchInput) -> str:
 
 
 FORCEGRASP3 = register(Procedure(
-    name="forcegrasp3", title="ForceGrasp", fingers=3, model="point", tag="force3", colour="tab:orange",
+    name="forcegrasp3", title="ForceGrasp", fingers=3, model="point", tag="force3",
     search=_search, score=lambda g: g.margin, meta=force_meta, diagnose=_diagnose,
     description="three fingers with friction: a common point of the friction cones, normals "
                 "spanning the plane (Ponce and Faverjon)",

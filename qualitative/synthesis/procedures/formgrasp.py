@@ -34,7 +34,7 @@ def _diagnose(s: SearchInput) -> str:
 
 
 FORMGRASP = register(Procedure(
-    name="formgrasp", title="FormGrasp", fingers=4, model="frictionless", tag="form", colour="tab:purple",
+    name="formgrasp", title="FormGrasp", fingers=4, model="frictionless", tag="form",
     search=_search, score=lambda g: -g.depth, meta=lambda g: {"zone_depth": g.depth}, diagnose=_diagnose,
     description="four frictionless fingers until the zone of freedom is empty (Reuleaux, Nielsen)",
     failure="the zones of freedom of no candidate tuple close within four "

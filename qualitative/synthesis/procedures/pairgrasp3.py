@@ -143,7 +143,7 @@ def _diagnose(s: SearchInput) -> str:
 
 
 PAIRGRASP3 = register(Procedure(
-    name="pairgrasp3", title="PairGrasp", fingers=3, model="point", tag="pair3", colour="tab:green",
+    name="pairgrasp3", title="PairGrasp", fingers=3, model="point", tag="pair3",
     search=_search, score=lambda g: g.margin, meta=_meta, diagnose=_diagnose,
     description="three fingers with friction: an opposed pair in force closure (Nguyen) and a third "
                 "finger where it adds most, beyond the paper's condition",
