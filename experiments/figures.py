@@ -56,7 +56,8 @@ from qualgrasp.qualitative.synthesis.forcegrasp import GAP, ForceGrasp, friction
 from qualgrasp.qualitative.synthesis.formgrasp import zone_steps
 from qualgrasp.qualitative.plots.grasp import plot_contacts, plot_form_step, plot_grasp
 from qualgrasp.qualitative.objects import render
-from qualgrasp.qualitative.vision.outline import NAMES, Outline, outline_image
+from qualgrasp.qualitative.vision.outline import Outline, outline_image
+from qualgrasp.qualitative.vision.grammar import NAMES
 from qualgrasp.qualitative.plots.outline import curvature_handles, draw_frame, plot_outline, plot_regions
 from qualgrasp.qualitative.synthesis.regions import ALPHA, feasible_regions
 from qualgrasp.qualitative.synthesis.pipeline import MU, Synthesis, synthesize

@@ -18,7 +18,8 @@ from .synthesis import procedures
 from .errors import FormulaError, QualitativeError, TraceError
 from .plots.grasp import synthesis_figure
 from .synthesis.independent import independent_file
-from .vision.outline import SCALE_MAX, SCALE_MIN, outline_contour, outline_scales, outline_to_dict, planning_scale
+from .vision.outline import SCALE_MAX, SCALE_MIN, outline_contour, outline_to_dict
+from .vision.scales import outline_scales, planning_scale
 from .plots.outline import outline_figure
 from .synthesis.regions import ALPHA_MAX, FINGER_WIDTH, MARGIN, planning_regions, regions_to_dict
 from .reasoning.st0 import evaluate_file

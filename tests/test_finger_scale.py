@@ -23,7 +23,8 @@ from qualgrasp.qualitative.errors import SynthesisError
 from qualgrasp.qualitative.synthesis.forcegrasp import best_triplet_margins, triplet_grasps
 from qualgrasp.qualitative.synthesis.formgrasp import deepest_closure
 from qualgrasp.qualitative.objects import render, render_polygon, shape
-from qualgrasp.qualitative.vision.outline import DEFAULT_SCALE, finger_scale, outline_image
+from qualgrasp.qualitative.vision.outline import DEFAULT_SCALE, outline_image
+from qualgrasp.qualitative.vision.scales import finger_scale
 from qualgrasp.qualitative.synthesis.procedures import SearchInput
 from qualgrasp.qualitative.synthesis.regions import ALPHA, FINGER_WIDTH, feasible_regions
 from qualgrasp.qualitative.synthesis.pipeline import FALLBACK_STEP, synthesize

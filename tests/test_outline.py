@@ -12,8 +12,8 @@ from skimage.transform import rescale, rotate
 
 from qualgrasp.qualitative.errors import ContourError, OutlineError
 from qualgrasp.qualitative.objects import NAMES, RADIUS, render, shape
-from qualgrasp.qualitative.vision.outline import (SYMBOLS, Outline, canonical, is_well_formed, outline_contour,
-                                                  outline_image, validate)
+from qualgrasp.qualitative.vision.outline import Outline, outline_contour, outline_image
+from qualgrasp.qualitative.vision.grammar import SYMBOLS, canonical, is_well_formed, validate
 from qualgrasp.qualitative.vision.contour import signed_area
 
 ORDER = "/)(><}{"  # the documented canonical symbol order

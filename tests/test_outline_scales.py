@@ -15,9 +15,9 @@ from typer.testing import CliRunner
 from qualgrasp.cli import app
 from qualgrasp.qualitative.errors import QualitativeError
 from qualgrasp.qualitative.objects import NAMES, render, render_polygon, shape
-from qualgrasp.qualitative.vision.outline import (DEFAULT_SCALE, POINT_LIKE, SCALE_MAX, Outline, ScaleInterval, finger_scale,
-                                                  outline_contour, outline_contour_scales, outline_image, outline_scales,
-                                                  validate)
+from qualgrasp.qualitative.vision.outline import DEFAULT_SCALE, SCALE_MAX, Outline, outline_contour, outline_image
+from qualgrasp.qualitative.vision.grammar import POINT_LIKE, validate
+from qualgrasp.qualitative.vision.scales import ScaleInterval, finger_scale, outline_contour_scales, outline_scales
 from qualgrasp.qualitative.synthesis.regions import FINGER_WIDTH
 from qualgrasp.qualitative.vision.contour import extract_contour
 from test_outline import EXPECTED, least_rotation

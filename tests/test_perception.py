@@ -13,7 +13,8 @@ from skimage import data
 from qualgrasp.qualitative.vision.edges import WEAK_EDGE, edge_contrast, edge_strength
 from qualgrasp.qualitative.errors import ContourError, ImageError, SegmentationError
 from qualgrasp.qualitative.objects import NAMES, render, shape
-from qualgrasp.qualitative.vision.outline import outline_image, outline_scales
+from qualgrasp.qualitative.vision.outline import outline_image
+from qualgrasp.qualitative.vision.scales import outline_scales
 from qualgrasp.qualitative.vision.segmentation import METHODS, grabcut_rect
 from qualgrasp.qualitative.plots.segmentation import segmentation_figure
 from qualgrasp.qualitative.synthesis.pipeline import synthesize

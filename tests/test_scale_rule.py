@@ -14,7 +14,8 @@ from typer.testing import CliRunner
 
 from qualgrasp.cli import app
 from qualgrasp.qualitative.objects import render, render_polygon, shape
-from qualgrasp.qualitative.vision.outline import DEFAULT_SCALE, outline_image, planning_scale
+from qualgrasp.qualitative.vision.outline import DEFAULT_SCALE, outline_image
+from qualgrasp.qualitative.vision.scales import planning_scale
 from qualgrasp.qualitative.synthesis.regions import FINGER_WIDTH, regions_image
 from qualgrasp.qualitative.synthesis.pipeline import synthesize
 

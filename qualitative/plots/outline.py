@@ -17,7 +17,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.path import Path as MplPath
 
-from ..vision.outline import NAMES, Outline
+from ..vision.outline import Outline
+from ..vision.grammar import NAMES
 from ..synthesis.regions import Region
 
 __all__ = ["STYLE", "draw_frame", "plot_outline", "plot_regions", "outline_figure", "curvature_handles"]

@@ -53,7 +53,8 @@ from ...certify.regions import tuple_to_dict
 from ...certify.files import json_lines
 from ...certify.core.validation import id_problem, number, show
 from ..errors import QualitativeError
-from ..vision.outline import DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_contour, planning_scale
+from ..vision.outline import DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_contour
+from ..vision.scales import planning_scale
 from .regions import ALPHA, ALPHA_MAX, FINGER_WIDTH, MARGIN, Region, feasible_regions, planning_regions
 from ..vision.contour import ImageSource, extract_contour
 
@@ -142,7 +143,7 @@ def planned_regions(image: ImageSource, grasp: Grasp, *, alpha: float | None = N
                     cache: dict | None = None, scale: float | None = None) -> list[Region]:
     """The feasible regions a grasp was planned on: those of the image's outline at the scale
     ``scale`` when given, else the grasp's field ``scale``, else the finger's
-    (:func:`qualgrasp.qualitative.vision.outline.planning_scale` of ``finger_width``, the default of every
+    (:func:`qualgrasp.qualitative.vision.scales.planning_scale` of ``finger_width``, the default of every
     qualitative command), with the curvature threshold ``alpha`` when given, else the grasp's field
     ``alpha``, else :data:`~qualgrasp.qualitative.synthesis.regions.ALPHA` (as
     :func:`qualgrasp.qualitative.synthesis.pipeline.synthesize` records them), found by

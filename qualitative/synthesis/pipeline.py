@@ -22,13 +22,13 @@ a synthesised grasp that does not certify is a bug of the synthesis, and is repo
 The finger's scale
 ------------------
 A finger cannot feel a bump smaller than its pad, so feasible regions and the procedures work on
-the outline at the **finger's scale** (:func:`qualgrasp.qualitative.vision.outline.finger_scale` of the
+the outline at the **finger's scale** (:func:`qualgrasp.qualitative.vision.scales.finger_scale` of the
 pad width ``finger_width``, a fraction of the object's size; never finer than the default scale
 0.004), while contacts stay on the one contour the image gives (the same samples at every scale)
 and curved regions carry the normals of the outline at the default (fine) scale, so that the
 procedure's reasoning and the certification see the same contacts and normals; a straight region
 keeps the normal of its fitted line, its points those of the contour. When the procedure finds nothing there, the next coarser
-scales of the outline's hierarchy (:func:`qualgrasp.qualitative.vision.outline.outline_scales`) are
+scales of the outline's hierarchy (:func:`qualgrasp.qualitative.vision.scales.outline_scales`) are
 tried, at most :data:`FALLBACK_SCALES` of them, and last the default scale (details finer than
 the finger; the scale reported says so) (:func:`search_scales`). ``scale`` fixes one scale (no
 fallback). :attr:`Synthesis.scale` is the scale the grasps come from, and
@@ -120,8 +120,8 @@ from .candidates import ERROR, INSET, PER_REGION, STEP, Candidates, candidates, 
 from ..errors import SynthesisError
 from .forcegrasp import MARGIN, friction
 from .independent import independent_grasp
-from ..vision.outline import (DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_contour, outline_contour_scales,
-                              planning_scale)
+from ..vision.outline import DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, Outline, outline_contour
+from ..vision.scales import outline_contour_scales, planning_scale
 from .procedures import Procedure, SearchInput
 from .regions import ALPHA, FINGER_WIDTH, MARGIN as REGION_MARGIN, Region, feasible_regions, on_fine_outline
 from ..vision.edges import WEAK_EDGE, edge_evidence, weak_edge

@@ -52,7 +52,8 @@ from typing import Any, Sequence
 import numpy as np
 from scipy import ndimage
 
-from ..vision.outline import Outline, outline_contour, planning_scale, tls_line
+from ..vision.outline import Outline, outline_contour, tls_line
+from ..vision.scales import planning_scale
 from ..vision.contour import ImageSource, extract_contour
 
 __all__ = ["ALPHA", "ALPHA_MAX", "FINGER_WIDTH", "MARGIN", "GRASPABLE", "ON_LINE", "Region", "feasible_regions",
@@ -279,7 +280,7 @@ def planning_regions(contour: np.ndarray, *, scale: float | None = None, alpha: 
         (:func:`qualgrasp.qualitative.vision.contour.extract_contour`), pixels.
     scale : float, optional
         Outline scale, fraction of the perimeter; default
-        :func:`qualgrasp.qualitative.vision.outline.planning_scale` of ``finger_width`` (the finger's).
+        :func:`qualgrasp.qualitative.vision.scales.planning_scale` of ``finger_width`` (the finger's).
     alpha, finger_width, margin : float
         As for :func:`feasible_regions`.
     fine : Outline, optional

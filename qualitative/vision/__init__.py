@@ -8,8 +8,10 @@ The modules, in pipeline order:
 * :mod:`.contour`: reading an image, segmenting it and extracting the object's outer contour at
   sub-pixel accuracy;
 * :mod:`.edges`: edge evidence at a contact (does the image show the object's edge there?);
-* :mod:`.outline`: qualitative outlines (Galton & Meathrel): grammar, extraction from a contour,
-  and scale space.
+* :mod:`.grammar`: the grammar of qualitative outline strings (Galton & Meathrel): alphabet,
+  canonical rotation, well-formedness;
+* :mod:`.outline`: qualitative outlines extracted from a contour at one scale;
+* :mod:`.scales`: the finger's scale, the planning scale and the hierarchy of strings over scales.
 
 This package imports nothing of :mod:`qualgrasp.qualitative.reasoning`,
 :mod:`~qualgrasp.qualitative.synthesis` or :mod:`~qualgrasp.qualitative.plots`.
@@ -29,10 +31,11 @@ from .segmentation import (ADAPTIVE_BLOCK, GRABCUT_ITERATIONS, GRABCUT_MARGIN, G
                            border_pixels, grabcut_mask, grabcut_rect, multiotsu_mask)
 from .edges import (EDGE_BLUR, EDGE_REACH, RING, SHARPNESS, WEAK_EDGE, edge_contrast, edge_evidence, edge_strength,
                     weak_edge)
-from .outline import (DEFAULT_SCALE, LINE_LIKE, NAMES, POINT_LIKE, SCALE_MAX, SCALE_MIN, SYMBOLS, WINDOW, Outline,
-                      ScaleInterval, Segment, canonical, finger_scale, is_well_formed, outline_contour,
-                      outline_contour_scales, outline_image, outline_scales, outline_to_dict, planning_scale, resample,
-                      tls_line, validate)
+from .grammar import (CONVEX_POINTS, CURVE_SET, CURVES, LINE_LIKE, LINE_SET, NAMES, POINT_LIKE, POINT_SET, SYMBOLS,
+                      canonical, check_turnings, is_well_formed, least_rotation, turning_range, validate)
+from .outline import (DEFAULT_SCALE, SCALE_MAX, SCALE_MIN, WINDOW, Outline, Segment, canonical_at, check_scale,
+                      outline_contour, outline_image, outline_to_dict, prepare_contour, resample, tls_line)
+from .scales import ScaleInterval, finger_scale, outline_contour_scales, outline_scales, planning_scale
 
 __all__ = [
     "MIN_AREA", "MAX_PIXELS", "MAX_CONTOUR", "METHODS", "Segmentation", "read_image", "read_mask", "gaussian_blur",
@@ -42,8 +45,9 @@ __all__ = [
     "adaptive_mask", "grabcut_rect", "grabcut_mask",
     "EDGE_BLUR", "EDGE_REACH", "RING", "WEAK_EDGE", "SHARPNESS", "edge_contrast", "edge_strength", "edge_evidence",
     "weak_edge",
-    "SYMBOLS", "NAMES", "LINE_LIKE", "POINT_LIKE", "DEFAULT_SCALE", "WINDOW", "SCALE_MAX", "SCALE_MIN", "Segment",
-    "Outline", "canonical", "validate", "is_well_formed", "resample", "outline_contour", "outline_image",
-    "ScaleInterval", "finger_scale", "planning_scale", "tls_line", "outline_contour_scales", "outline_scales",
-    "outline_to_dict",
+    "SYMBOLS", "NAMES", "LINE_LIKE", "POINT_LIKE", "CURVES", "CONVEX_POINTS", "LINE_SET", "POINT_SET", "CURVE_SET",
+    "canonical", "least_rotation", "turning_range", "validate", "check_turnings", "is_well_formed",
+    "DEFAULT_SCALE", "WINDOW", "SCALE_MAX", "SCALE_MIN", "Segment", "Outline", "resample", "check_scale",
+    "prepare_contour", "outline_contour", "outline_image", "canonical_at", "tls_line", "outline_to_dict",
+    "ScaleInterval", "finger_scale", "planning_scale", "outline_contour_scales", "outline_scales",
 ]

@@ -1,18 +1,6 @@
-"""Qualitative outlines (Galton & Meathrel 1999): a contour as a cyclic string of curvature types.
-
-Alphabet (the project's ASCII rendering of the seven curvature types), in canonical order:
-
-======  ===========================================  ==========
-symbol  curvature type                               kind
-======  ===========================================  ==========
-``/``   straight line segment                        line-like
-``)``   convex curve segment                         line-like
-``(``   concave curve segment                        line-like
-``>``   outward-pointing angle (convex corner)       point-like
-``<``   inward-pointing angle (concave corner)       point-like
-``}``   outward-pointing cusp                        point-like
-``{``   inward-pointing cusp                         point-like
-======  ===========================================  ==========
+"""Qualitative outlines (Galton & Meathrel 1999) extracted from a contour: the contour as a cyclic
+string of curvature types (the grammar of the strings: :mod:`.grammar`) with its segments, at one
+scale (the hierarchy of scales: :mod:`.scales`).
 
 Conventions
 -----------
@@ -21,22 +9,9 @@ Conventions
   turned by +90 degrees, so the inward unit normal is ``(-t_y, t_x)``. Turning in the positive
   sense along this traversal is convex. On screen (y down) this traversal is clockwise, the
   direction in which the paper reads its figure 3.
-* **Canonical rotation.** Any rotation of the cyclic string describes the same outline; the
-  canonical string is the lexicographically least rotation under the symbol order ``/)(><}{``
-  (straight first). A square is ``/>/>/>/>``, a disc ``)``. :attr:`Outline.segments` start at the
-  segment where the canonical string starts (for periodic strings, the first such segment along
-  the contour).
-* **Well-formedness** (paper section 4.1, project notes section 4): (1) the string contains ``)`` or
-  at least three convex points (``>`` or ``}``); (2) no two cyclically consecutive identical symbols
-  (a single symbol, such as a disc's ``)``, has no neighbour and is allowed); (3) no two cyclically
-  consecutive point-like symbols; (4) every cusp (``}`` or ``{``) is adjacent on at least one side to
-  a curve (``)`` or ``(``) -- the notes' reading of a garbled sentence of the paper; geometry
-  says more (an outward cusp's sides meet tangentially with the object between them, so one of
-  them must be concave; likewise an inward cusp needs a convex side), but only the notes' rule is
-  enforced; (5) the total turning is 2 pi: for a string, some choice of turning angles in the
-  ranges of its symbols (``/`` 0, ``)`` positive, ``(`` negative, ``>`` in (0, pi), ``<`` in
-  (-pi, 0), ``}`` pi, ``{`` -pi) must add up to 2 pi; for an extracted outline the measured
-  turnings must add up to 2 pi and each must have its symbol's sign.
+* **Canonical start.** :attr:`Outline.segments` start at the segment where the canonical string
+  (:func:`~qualgrasp.qualitative.vision.grammar.canonical`) starts (for periodic strings, the first
+  such segment along the contour).
 
 Scale
 -----
@@ -49,21 +24,6 @@ of the extraction are tied to the scale: the corner window is ``WINDOW * s * P``
 merge), so at coarser scales small features (notches, bumps) are smoothed away rather than read as
 corners. Angles and the straightness threshold do not change with the scale. Scales run up to
 :data:`SCALE_MAX` (0.032).
-
-A finger pad of width ``W`` feels the outline at the scale ``W / (4 P)`` (a Gaussian whose
-+-2 sigma span is the pad, :func:`finger_scale`); for the project's pad of 0.08 of the object's
-size ``D``, that is ``0.02 D / P``: 0.0064 for a disc, less for objects whose perimeter is long
-for their size (0.004 to 0.009 for the study's silhouettes), never more than 0.01 (``P >= 2 D``).
-
-:func:`outline_scales` (an image) and :func:`outline_contour_scales` (a contour) give the
-**hierarchy** (curvature scale space, Mokhtarian and Mackworth 1992): the intervals of scale over
-which the string stays the same (:class:`ScaleInterval`), from the default scale 0.004 (fine) to
-:data:`SCALE_MAX` (coarse: there 21 of the 24 study cells have no concave symbol left, while deep
-concavities such as the polygon's notch, figure 3's slot or the horse's legs remain), found on a
-geometric grid (4 scales per octave) and located by bisection to 1 %. The image is segmented and
-the contour resampled once; only the smoothing and the classification are repeated per scale.
-Real silhouettes give many short intervals at fine scales, where wiggles hover around the angle
-thresholds.
 
 Extraction (curvature scale space style; every threshold is an angle or a fraction of the
 perimeter ``P``, so the string does not depend on position, rotation or scale):
@@ -116,7 +76,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Union
 
 import cv2
 import numpy as np
@@ -124,51 +83,11 @@ from scipy import ndimage
 
 from ..errors import ContourError, OutlineError
 from .contour import ImageSource, extract_contour, signed_area
+from .grammar import (CONVEX_POINTS, CURVE_SET, LINE_SET, NAMES, POINT_SET, canonical, check_turnings,
+                      least_rotation, turning_range, validate)
 
-__all__ = [
-    "SYMBOLS",
-    "NAMES",
-    "LINE_LIKE",
-    "POINT_LIKE",
-    "DEFAULT_SCALE",
-    "WINDOW",
-    "SCALE_MAX",
-    "SCALE_MIN",
-    "Segment",
-    "Outline",
-    "canonical",
-    "validate",
-    "is_well_formed",
-    "resample",
-    "outline_contour",
-    "outline_image",
-    "ScaleInterval",
-    "finger_scale",
-    "planning_scale",
-    "tls_line",
-    "outline_contour_scales",
-    "outline_scales",
-    "outline_to_dict",
-]
-
-SYMBOLS = "/)(><}{"
-NAMES = {
-    "/": "straight line",
-    ")": "convex curve",
-    "(": "concave curve",
-    ">": "outward angle",
-    "<": "inward angle",
-    "}": "outward cusp",
-    "{": "inward cusp",
-}
-LINE_LIKE = "/)("
-POINT_LIKE = "><}{"
-CURVES = ")("
-CONVEX_POINTS = ">}"
-# Sets for membership tests ("" is a substring of every str, so `"" in POINT_LIKE` would be True).
-_LINES, _POINTS, _CURVES = frozenset(LINE_LIKE), frozenset(POINT_LIKE), frozenset(CURVES)
-_RANK = {s: i for i, s in enumerate(SYMBOLS)}
-_TURNING_TOLERANCE = 1e-6
+__all__ = ["DEFAULT_SCALE", "WINDOW", "SCALE_MAX", "SCALE_MIN", "Segment", "Outline", "resample", "check_scale",
+           "prepare_contour", "outline_contour", "outline_image", "canonical_at", "tls_line", "outline_to_dict"]
 
 DEFAULT_SCALE = 0.004
 """Default scale: Gaussian standard deviation of the smoothing, fraction of the perimeter."""
@@ -189,151 +108,6 @@ would cover most of the contour and the description degenerates.
 
 
 # --------------------------------------------------------------------------------------------------
-# Strings: canonical form and well-formedness
-
-
-def _check_alphabet(string: str) -> None:
-    if not isinstance(string, str) or not string:
-        raise OutlineError(f"an outline string must be a non-empty str, got {string!r}")
-    bad = sorted(set(string) - set(SYMBOLS))
-    if bad:
-        raise OutlineError(f"unknown symbol(s) {''.join(bad)!r} in {string!r}; the alphabet is {SYMBOLS!r}")
-
-
-def _least_rotation(string: str) -> int:
-    """Index where the lexicographically least rotation (in symbol order) starts; first if tied."""
-    ranks = [_RANK[s] for s in string]
-    n = len(ranks)
-    return min(range(n), key=lambda i: ranks[i:] + ranks[:i])
-
-
-def canonical(string: str) -> str:
-    """The canonical rotation of a cyclic outline string.
-
-    Parameters
-    ----------
-    string : str
-        Symbols from :data:`SYMBOLS`, read along the positively oriented contour.
-
-    Returns
-    -------
-    str
-        The lexicographically least rotation under the symbol order ``/)(><}{``.
-
-    Raises
-    ------
-    OutlineError
-        Empty string or unknown symbol.
-    """
-    _check_alphabet(string)
-    i = _least_rotation(string)
-    return string[i:] + string[:i]
-
-
-def _turning_range(string: str) -> tuple[float, bool, float, bool]:
-    """Infimum and supremum of the total turning a string allows, with whether each is attained."""
-    lo, lo_closed, hi, hi_closed = 0.0, True, 0.0, True
-    for s in string:
-        if s == "/":
-            continue
-        if s == "}" or s == "{":
-            v = math.pi if s == "}" else -math.pi
-            lo, hi = lo + v, hi + v
-        elif s == ")":
-            lo_closed, hi = False, math.inf
-        elif s == "(":
-            hi_closed, lo = False, -math.inf
-        elif s == ">":
-            lo_closed, hi_closed, hi = False, False, hi + math.pi
-        elif s == "<":
-            lo_closed, hi_closed, lo = False, False, lo - math.pi
-    return lo, lo_closed, hi, hi_closed
-
-
-def _check_rules(string: str) -> None:
-    n = len(string)
-    convex_points = sum(string.count(s) for s in CONVEX_POINTS)
-    if ")" not in string and convex_points < 3:
-        raise OutlineError(
-            f"rule 1 (bounded): {string!r} has no convex curve ')' and only {convex_points} convex "
-            "point(s) ('>' or '}'); at least three are needed")
-    if n > 1:
-        for i in range(n):
-            a, b = string[i], string[(i + 1) % n]
-            if a == b:
-                raise OutlineError(
-                    f"rule 2 (no repeated symbol): {string!r} has {a!r} twice in a row at positions "
-                    f"{i} and {(i + 1) % n} (cyclically)")
-            if a in _POINTS and b in _POINTS:
-                raise OutlineError(
-                    f"rule 3 (no consecutive points): {string!r} has point-like {a!r}{b!r} at positions "
-                    f"{i} and {(i + 1) % n} (cyclically)")
-    for i, s in enumerate(string):
-        if s in "}{" and string[i - 1] not in _CURVES and string[(i + 1) % n] not in _CURVES:
-            raise OutlineError(
-                f"rule 4 (cusp next to a curve): the cusp {s!r} at position {i} of {string!r} has no "
-                "curve ')' or '(' on either side")
-
-
-def _check_string_turning(string: str) -> None:
-    lo, lo_closed, hi, hi_closed = _turning_range(string)
-    target = 2 * math.pi
-    above = target > lo or (lo_closed and math.isclose(target, lo))
-    below = target < hi or (hi_closed and math.isclose(target, hi))
-    if not (above and below):
-        raise OutlineError(
-            f"turning (total 2 pi): the symbols of {string!r} allow a total turning between "
-            f"{lo / math.pi:g} pi and {hi / math.pi:g} pi, which excludes 2 pi")
-
-
-def _check_turnings(symbols: str, turnings) -> None:
-    """Measured turnings (radians) of the elements ``symbols``: 2 pi in total, each of its symbol's sign."""
-    total = sum(turnings)
-    if abs(total - 2 * math.pi) > _TURNING_TOLERANCE:
-        raise OutlineError(f"turning (total 2 pi): the segments turn by {total / math.pi:.6g} pi in total")
-    for symbol, turning in zip(symbols, turnings):
-        sign = {"/": 0, ")": 1, "(": -1, ">": 1, "<": -1, "}": 1, "{": -1}[symbol]
-        if sign and np.sign(turning) != sign:
-            raise OutlineError(
-                f"turning (sign): segment {symbol!r} ({NAMES[symbol]}) turns by "
-                f"{math.degrees(turning):.3g} degrees, of the wrong sign")
-
-
-def validate(outline: Union[str, "Outline"]) -> None:
-    """Check that an outline string (or an extracted :class:`Outline`) is well formed.
-
-    Parameters
-    ----------
-    outline : str or Outline
-        A cyclic string over :data:`SYMBOLS`, or an extracted outline (its string and its measured
-        segment turnings are checked).
-
-    Raises
-    ------
-    OutlineError
-        Naming the first rule broken: ``rule 1 (bounded)``, ``rule 2 (no repeated symbol)``,
-        ``rule 3 (no consecutive points)``, ``rule 4 (cusp next to a curve)``,
-        ``turning (total 2 pi)`` or ``turning (sign)``; or an unknown symbol.
-    """
-    string = outline if isinstance(outline, str) else outline.raw_string
-    _check_alphabet(string)
-    _check_rules(string)
-    if isinstance(outline, str):
-        _check_string_turning(string)
-    else:
-        _check_turnings(string, [seg.turning for seg in outline.segments])
-
-
-def is_well_formed(outline: Union[str, "Outline"]) -> bool:
-    """True when :func:`validate` accepts the outline."""
-    try:
-        validate(outline)
-    except OutlineError:
-        return False
-    return True
-
-
-# --------------------------------------------------------------------------------------------------
 # Outline data
 
 
@@ -350,7 +124,7 @@ class Segment:
     Attributes
     ----------
     symbol : str
-        Curvature type, one of :data:`SYMBOLS`.
+        Curvature type, one of :data:`~qualgrasp.qualitative.vision.grammar.SYMBOLS`.
     start, stop : int
         Span ``[start, stop)`` of samples of :attr:`Outline.contour`; ``0 <= start < n`` and
         ``start < stop <= start + n``: indices past ``n`` wrap around. Point-like elements span the
@@ -387,7 +161,7 @@ class Segment:
     @property
     def is_point(self) -> bool:
         """True for point-like elements (angles and cusps)."""
-        return self.symbol in _POINTS
+        return self.symbol in POINT_SET
 
     @property
     def length(self) -> float:
@@ -654,22 +428,22 @@ def _repair(items: list[list], phi: np.ndarray, corner_angle: float, cusp_angle:
     while len(items) > 1:
         for i, a in enumerate(items):
             prev, b = items[i - 1], items[(i + 1) % len(items)]
-            if a[0] in _LINES and a[0] == b[0]:
+            if a[0] in LINE_SET and a[0] == b[0]:
                 merge(i, a[0])
-            elif a[0] in _POINTS and b[0] in _POINTS and (a[3] > 0) == (b[3] > 0):
+            elif a[0] in POINT_SET and b[0] in POINT_SET and (a[3] > 0) == (b[3] > 0):
                 merge(i, _point_symbol(a[3] + b[3], corner_angle, cusp_angle))
-            elif a[0] in _POINTS and b[0] in _POINTS:
+            elif a[0] in POINT_SET and b[0] in POINT_SET:
                 # Opposite turnings closer than a window (a step): keep both, with a link between;
                 # summing them would erase the feature.
                 link(i)
             elif a[0] == "":  # a corner too weak to count: its span joins the preceding element
                 turning = prev[3] + a[3]
-                if prev[0] in _POINTS or prev[0] == "":
+                if prev[0] in POINT_SET or prev[0] == "":
                     symbol = _point_symbol(turning, corner_angle, cusp_angle)
                 else:
                     symbol = _line_symbol(turning, flat_angle)
                 merge((i - 1) % len(items), symbol)
-            elif a[0] in "}{" and prev[0] not in _CURVES and b[0] not in _CURVES:
+            elif a[0] in "}{" and prev[0] not in CURVE_SET and b[0] not in CURVE_SET:
                 # Two straight lines cannot meet in a cusp: at this resolution it is a sharp angle.
                 a[0] = ">" if a[0] == "}" else "<"
             else:
@@ -683,7 +457,7 @@ def _repair(items: list[list], phi: np.ndarray, corner_angle: float, cusp_angle:
     if ")" not in symbols and sum(s in CONVEX_POINTS for s in symbols) < 3:
         # Bounded outlines need a convex curve or three convex points; the turning must then be
         # carried by some line-like element that was judged straight or concave.
-        best = max((item for item in items if item[0] in _LINES), key=lambda it: it[3], default=None)
+        best = max((item for item in items if item[0] in LINE_SET), key=lambda it: it[3], default=None)
         if best is not None and best[3] > 0:
             best[0] = ")"
             return _repair(items, phi, corner_angle, cusp_angle, flat_angle)
@@ -719,7 +493,7 @@ def _close_up(items: list[list]) -> None:
     """
     target = 2 * math.pi
     while True:
-        lo, lo_closed, hi, hi_closed = _turning_range("".join(item[0] for item in items))
+        lo, lo_closed, hi, hi_closed = turning_range("".join(item[0] for item in items))
         if not (target < hi or (hi_closed and math.isclose(target, hi))):
             cusp, angle = "{", "<"  # too little turning allowed
         elif not (target > lo or (lo_closed and math.isclose(target, lo))):
@@ -777,7 +551,7 @@ def _segment(item: list, points: np.ndarray, phi: np.ndarray, half: int, spacing
     start, stop = start % n, start % n + (stop - start)
     span = points[np.arange(start, stop) % n]
     position = endpoints = None
-    if symbol in _POINTS:
+    if symbol in POINT_SET:
         position = _frozen(_apex(points, phi, [symbol, start, stop], half, spacing))
     elif symbol == "/":
         mean, direction = tls_line(span)
@@ -787,8 +561,8 @@ def _segment(item: list, points: np.ndarray, phi: np.ndarray, half: int, spacing
                    _frozen(span), position, endpoints)
 
 
-def _check_scale(scale: float, name: str = "scale") -> float:
-    """``scale`` as a float in ``(0, SCALE_MAX]``, or ValueError naming it and its units."""
+def check_scale(scale: float, name: str = "scale") -> float:
+    """``scale`` as a float in ``(0, SCALE_MAX]``, or ValueError naming it (``name``) and its units."""
     try:
         value = float(scale)
     except (TypeError, ValueError):
@@ -798,7 +572,7 @@ def _check_scale(scale: float, name: str = "scale") -> float:
     return value
 
 
-def _prepare(contour: np.ndarray, samples: int) -> tuple[np.ndarray, float, float]:
+def prepare_contour(contour: np.ndarray, samples: int) -> tuple[np.ndarray, float, float]:
     """Checked, positively oriented contour resampled by arc length: points, perimeter, size (pixels)."""
     contour = np.asarray(contour, dtype=np.float64)
     if contour.ndim != 2 or contour.shape[1] != 2 or len(contour) < 3:
@@ -864,7 +638,7 @@ def outline_contour(contour: np.ndarray, *, scale: float = DEFAULT_SCALE, sample
         Standard deviation of the Gaussian smoothing, as a fraction of the perimeter, in
         ``(0, SCALE_MAX]`` (default :data:`DEFAULT_SCALE`, 0.004). Features narrower than about
         two scales are smoothed away; the corner window follows it (see ``corner_window``).
-        :func:`finger_scale` converts a finger pad's width into a scale.
+        :func:`~qualgrasp.qualitative.vision.scales.finger_scale` converts a finger pad's width into a scale.
     samples : int
         Number of samples after resampling by arc length.
     corner_window : float, optional
@@ -884,7 +658,7 @@ def outline_contour(contour: np.ndarray, *, scale: float = DEFAULT_SCALE, sample
     Returns
     -------
     Outline
-        Well formed (checked with :func:`validate`), segments in canonical order, with the
+        Well formed (checked with :func:`~qualgrasp.qualitative.vision.grammar.validate`), segments in canonical order, with the
         ``scale`` it was computed at.
 
     Raises
@@ -903,12 +677,12 @@ def outline_contour(contour: np.ndarray, *, scale: float = DEFAULT_SCALE, sample
     >>> outline_contour(square, scale=0.01).scale
     0.01
     """
-    scale = _check_scale(scale)
-    points, perimeter, size = _prepare(contour, samples)
+    scale = check_scale(scale)
+    points, perimeter, size = prepare_contour(contour, samples)
     p = _params(scale, samples, corner_window, corner_angle, cusp_angle, straight, flat_angle)
     smoothed, phi, items = _describe(points, p)
     string = "".join(item[0] for item in items)
-    r = _least_rotation(string)
+    r = least_rotation(string)
     items = items[r:] + items[:r]
     spacing = perimeter / samples
     segments = tuple(_segment(item, points, phi, p.half, spacing) for item in items)
@@ -1011,137 +785,16 @@ def outline_image(src: ImageSource, *, scale: float = DEFAULT_SCALE, threshold: 
     >>> outline_image(render("figure3")).string
     '/}(</{)>'
     """
-    scale = _check_scale(scale)
+    scale = check_scale(scale)
     contour = extract_contour(src, threshold=threshold, largest=largest, subpixel=subpixel, method=method,
                               mask=mask, rect=rect)
     return outline_contour(contour, scale=scale, **options)
 
 
-# --------------------------------------------------------------------------------------------------
-# Scales
-
-
-@dataclass(frozen=True)
-class ScaleInterval:
-    """A range of scales over which an object's outline string does not change.
-
-    Attributes
-    ----------
-    lo, hi : float
-        Bounds of the range, scales (Gaussian standard deviations as fractions of the perimeter).
-        Inner bounds are located to a relative tolerance (see :func:`outline_contour_scales`).
-    string : str
-        The canonical outline string over the range.
-    corners : int
-        Number of point-like symbols (angles and cusps) in the string.
-    """
-
-    lo: float
-    hi: float
-    string: str
-    corners: int
-
-    @property
-    def middle(self) -> float:
-        """Geometric middle of the range, ``sqrt(lo * hi)`` (the grid is geometric)."""
-        return math.sqrt(self.lo * self.hi)
-
-    @property
-    def convex(self) -> bool:
-        """True when the string has no concave symbol (``(``, ``<`` or ``{``)."""
-        return not any(s in "(<{" for s in self.string)
-
-
-def finger_scale(outline: Outline | np.ndarray, finger_width: float, *, samples: int = 1024) -> float:
-    """The scale at which a finger pad of a given width feels the object's outline.
-
-    A pad of width ``W`` pressed on the contour averages it over ``W``; the Gaussian that does the
-    same has its +-2 sigma span equal to the pad, ``sigma = W / 4`` (close to the standard
-    deviation ``W / sqrt(12) = 0.29 W`` of the pad's own box average). Bumps and dents narrower
-    than about three quarters of a pad are then smoothed away, wider ones remain (measured on the
-    built-in square: a semicircular bump is gone up to 0.8 pad, kept from 0.85). With
-    ``W = finger_width * D`` (``D`` the object's size, the diameter of its minimum enclosing
-    circle, as in :mod:`qualgrasp.qualitative.synthesis.regions`) and ``P`` the perimeter, the scale is
-    ``finger_width * D / (4 * P)``.
-
-    Parameters
-    ----------
-    outline : Outline or numpy.ndarray
-        An extracted outline (its :attr:`~Outline.size` and :attr:`~Outline.perimeter`), or an
-        ``(m, 2)`` closed contour in pixels (resampled like :func:`outline_contour` does).
-    finger_width : float
-        Pad width, fraction of the object's size (the project's default is
-        :data:`qualgrasp.qualitative.synthesis.regions.FINGER_WIDTH`, 0.08).
-    samples : int
-        Resampling of a contour given as an array.
-
-    Returns
-    -------
-    float
-        Scale, fraction of the perimeter (pass it as ``scale`` to :func:`outline_contour`); for a
-        disc and the default pad, ``0.08 / (4 pi) = 0.0064``.
-
-    Raises
-    ------
-    ValueError
-        ``finger_width`` not positive and finite.
-    ContourError
-        Unusable contour.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> square = np.array([[0, 0], [100, 0], [100, 100], [0, 100]], float)
-    >>> round(finger_scale(square, 0.08), 5)  # 0.08 * 100 sqrt(2) / (4 * 400)
-    0.00707
-    """
-    width = float(finger_width)
-    if not (math.isfinite(width) and width > 0):
-        raise ValueError(
-            f"finger_width must be a positive fraction of the object's size, got {finger_width!r}")
-    if isinstance(outline, Outline):
-        size, perimeter = outline.size, outline.perimeter
-    else:
-        _, perimeter, size = _prepare(outline, samples)
-    return width * size / (4.0 * perimeter)
-
-
-def planning_scale(outline: Outline | np.ndarray, finger_width: float, *, samples: int = 1024) -> float:
-    """The scale every qualitative command reads an object's outline at by default: the finger's
-    (:func:`finger_scale`), never finer than :data:`DEFAULT_SCALE` nor coarser than
-    :data:`SCALE_MAX`.
-
-    ``qualgrasp outline``, ``regions``, ``synthesize``, ``independent-regions``, ``compare`` and the
-    figures all start from it, so the string shown and the regions the grasps are planned on are
-    those of one outline. The built-in objects keep their strings there (figure 3's ``/}(</{)>``
-    among them): their features are several pads wide.
-
-    Parameters
-    ----------
-    outline : Outline or numpy.ndarray
-        As for :func:`finger_scale`.
-    finger_width : float
-        Pad width, fraction of the object's size.
-    samples : int
-        Resampling of a contour given as an array.
-
-    Returns
-    -------
-    float
-        Scale, fraction of the perimeter.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> square = np.array([[0, 0], [100, 0], [100, 100], [0, 100]], float)
-    >>> round(planning_scale(square, 0.08), 5), planning_scale(square, 0.01), planning_scale(square, 1.0)
-    (0.00707, 0.004, 0.032)
-    """
-    return min(SCALE_MAX, max(DEFAULT_SCALE, finger_scale(outline, finger_width, samples=samples)))
-
-
-def _string_at(points: np.ndarray, scale: float, options: dict) -> str:
-    """Canonical string at one scale, checked well formed (string and measured turnings)."""
+def canonical_at(points: np.ndarray, scale: float, options: dict) -> str:
+    """The canonical string of a prepared contour (:func:`prepare_contour`) at one scale, checked
+    well formed (string and measured turnings); ``options`` are the extraction's angles and
+    thresholds, as for :func:`outline_contour`."""
     p = _params(scale, len(points), None, **options)
     try:
         items = _describe(points, p)[2]
@@ -1150,139 +803,10 @@ def _string_at(points: np.ndarray, scale: float, options: dict) -> str:
     raw = "".join(item[0] for item in items)
     try:
         validate(raw)
-        _check_turnings(raw, [item[3] for item in items])
+        check_turnings(raw, [item[3] for item in items])
     except OutlineError as err:  # a bug of the extraction: the repair must prevent it
         raise OutlineError(f"at scale {scale:.6g}: {err}") from None
     return canonical(raw)
-
-
-def outline_contour_scales(contour: np.ndarray, *, fine: float = DEFAULT_SCALE, coarse: float = SCALE_MAX,
-                           per_octave: int = 4, tolerance: float = 0.01, samples: int = 1024,
-                           corner_angle: float = math.radians(30), cusp_angle: float = math.radians(125),
-                           straight: float = 0.25,
-                           flat_angle: float = math.radians(10)) -> tuple[ScaleInterval, ...]:
-    """The scale hierarchy of a contour's outline (curvature scale space), from fine to coarse.
-
-    The contour is resampled once; at each scale only the smoothing and the classification of
-    :func:`outline_contour` are repeated. The string is computed on a geometric grid of
-    ``per_octave`` scales per doubling from ``fine`` to ``coarse`` (both included); where two
-    neighbouring scales differ, the change is located by bisection (geometric middles) until the
-    bracket is narrower than a factor ``1 + tolerance``, and a boundary is put at the bracket's
-    geometric middle. Strings seen inside a bracket become intervals of their own. A change that
-    reverts within one grid step is not seen.
-
-    Parameters
-    ----------
-    contour : numpy.ndarray
-        ``(m, 2)`` closed contour (x, y), pixels, either orientation.
-    fine, coarse : float
-        Scale range covered, fractions of the perimeter, ``0 < fine < coarse <= SCALE_MAX``. Default
-        from :data:`DEFAULT_SCALE` (0.004, the fine end: the first interval's string is the default
-        outline) to :data:`SCALE_MAX` (0.032, where the built-in objects and most real cells have
-        become convex blobs: no concave symbol).
-    per_octave : int
-        Grid scales per doubling of the scale (4: neighbours about 19 % apart).
-    tolerance : float
-        Relative accuracy of the inner bounds: each lies within a factor ``sqrt(1 + tolerance)`` of
-        the true change (for the extraction's own, deterministic string).
-    samples : int
-        Number of samples after resampling by arc length.
-    corner_angle, cusp_angle, straight, flat_angle : float
-        As for :func:`outline_contour` (the corner window is ``WINDOW`` scales at every scale).
-
-    Returns
-    -------
-    tuple of ScaleInterval
-        Contiguous (``hi`` of one is ``lo`` of the next), increasing, from ``fine`` to ``coarse``;
-        consecutive strings differ; every string is well formed.
-
-    Raises
-    ------
-    ContourError
-        Unusable contour, or no well-formed description at some scale (naming it).
-    ValueError
-        Bad range, grid or tolerance.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> square = np.array([[0, 0], [100, 0], [100, 100], [0, 100]], float)
-    >>> [(round(i.lo, 4), round(i.hi, 4), i.string) for i in outline_contour_scales(square)]
-    [(0.004, 0.032, '/>/>/>/>')]
-    """
-    fine, coarse = _check_scale(fine, "fine"), _check_scale(coarse, "coarse")
-    if not fine < coarse:
-        raise ValueError(f"fine ({fine:g}) must be smaller than coarse ({coarse:g})")
-    if int(per_octave) != per_octave or per_octave < 1:
-        raise ValueError(f"per_octave must be a positive integer, got {per_octave!r}")
-    if not 0 < tolerance < 1:
-        raise ValueError(f"tolerance must be in (0, 1), got {tolerance!r}")
-    options = {"corner_angle": corner_angle, "cusp_angle": cusp_angle, "straight": straight,
-               "flat_angle": flat_angle}
-    points = _prepare(contour, samples)[0]
-    steps = max(1, math.ceil(per_octave * math.log2(coarse / fine) - 1e-9))
-    grid = fine * (coarse / fine) ** (np.arange(steps + 1) / steps)
-    grid[-1] = coarse
-    seen = [(float(s), _string_at(points, float(s), options)) for s in grid]
-
-    def refine(lo: float, a: str, hi: float, b: str) -> list[tuple[float, str]]:
-        # Scales strictly between lo and hi, with their strings, until every change is bracketed.
-        if a == b or hi / lo <= 1 + tolerance:
-            return []
-        mid = math.sqrt(lo * hi)
-        m = _string_at(points, mid, options)
-        return refine(lo, a, mid, m) + [(mid, m)] + refine(mid, m, hi, b)
-
-    sampled = [seen[0]]
-    for (lo, a), (hi, b) in zip(seen, seen[1:]):
-        sampled += refine(lo, a, hi, b) + [(hi, b)]
-    intervals: list[ScaleInterval] = []
-    lo = fine
-    for (s, a), (t, b) in zip(sampled, sampled[1:] + [(coarse, None)]):
-        if a != b:
-            hi = coarse if b is None else math.sqrt(s * t)
-            intervals.append(ScaleInterval(lo, hi, a, sum(c in _POINTS for c in a)))
-            lo = hi
-    return tuple(intervals)
-
-
-def outline_scales(src: ImageSource, *, threshold: float | None = None, largest: bool = False,
-                   subpixel: bool = True, method: str = "otsu", mask: ImageSource | None = None,
-                   rect: tuple[int, int, int, int] | None = None, **options) -> tuple[ScaleInterval, ...]:
-    """The scale hierarchy of the outline of the object in an image, from fine to coarse.
-
-    The image is segmented and its contour extracted once (see :func:`outline_image`); the
-    hierarchy is that of :func:`outline_contour_scales`.
-
-    Parameters
-    ----------
-    src : str, pathlib.Path or numpy.ndarray
-        Image file or array (see :func:`qualgrasp.qualitative.vision.contour.read_image`).
-    threshold : float, optional
-        Grey level separating object and background, in the input's units; default Otsu's.
-    largest : bool
-        With several objects, describe the largest instead of raising.
-    subpixel : bool
-        Refine the contour to sub-pixel accuracy.
-    method, mask, rect
-        Segmentation, as for :func:`outline_image`.
-    **options
-        Range, grid and extraction parameters of :func:`outline_contour_scales`.
-
-    Returns
-    -------
-    tuple of ScaleInterval
-        From ``fine`` (default 0.004) to ``coarse`` (default :data:`SCALE_MAX`, 0.032).
-
-    Examples
-    --------
-    >>> from qualgrasp.qualitative.objects import render
-    >>> outline_scales(render("disc"))[0].string
-    ')'
-    """
-    contour = extract_contour(src, threshold=threshold, largest=largest, subpixel=subpixel, method=method,
-                              mask=mask, rect=rect)
-    return outline_contour_scales(contour, **options)
 
 
 def outline_to_dict(outline: Outline) -> dict:
