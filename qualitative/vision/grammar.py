@@ -32,7 +32,8 @@ Rules
   (-pi, 0), ``}`` pi, ``{`` -pi) must add up to 2 pi; for an extracted outline the measured
   turnings must add up to 2 pi and each must have its symbol's sign (:func:`check_turnings`).
 
-These rules are about strings; :mod:`.outline` extracts the strings from contours.
+These rules are about strings; :mod:`~qualgrasp.qualitative.vision.outline` extracts the strings
+from contours.
 """
 
 from __future__ import annotations

@@ -1,6 +1,7 @@
 """Qualitative outlines (Galton & Meathrel 1999) extracted from a contour: the contour as a cyclic
-string of curvature types (the grammar of the strings: :mod:`.grammar`) with its segments, at one
-scale (the hierarchy of scales: :mod:`.scales`).
+string of curvature types (the grammar of the strings: :mod:`~qualgrasp.qualitative.vision.grammar`)
+with its segments, at one scale (the hierarchy of scales:
+:mod:`~qualgrasp.qualitative.vision.scales`).
 
 Conventions
 -----------
