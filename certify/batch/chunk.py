@@ -40,7 +40,7 @@ from ..core.arguments import choice, count_in, number_in, require
 from ..core.validation import show_repr
 from ..files.reader import Chunk, chunk_values, column_problem, table_to_rows
 
-__all__ = ["Options", "Quality", "certify_rows", "certify_values", "certify_chunk_results", "certify_arrow",
+__all__ = ["Options", "RowFailure", "Quality", "certify_rows", "certify_values", "certify_chunk_results", "certify_arrow",
            "verify_rows", "verify_chunk", "status_counts", "STATUSES"]
 
 
@@ -49,13 +49,20 @@ class Options:
     """What is computed for every grasp (recorded in a run's manifest; part of a chunk's
     identity): the solver ``method``, whether to compute epsilon (``quality``), the spatial
     epsilon's relative gap and budget, and the per-grasp time limit of quality in seconds
-    (``eps_time``, None for none; see :func:`qualgrasp.certify.certify_grasp`)."""
+    (``eps_time``, None for none; see :func:`qualgrasp.certify.certify_grasp`).
+
+    ``source``, when given, turns each chunk of the input into grasps first: a frozen dataclass
+    (recorded in the manifest) whose ``grasp_values(chunk)`` gives, for each row in order, a grasp
+    in the JSON schema or a :class:`RowFailure`, and whose ``inputs()`` names the files it reads
+    (which the output must not be), such as
+    :class:`qualgrasp.certify.meshes.source.PoseSource` (poses closed on a mesh)."""
 
     method: Method = "fast"
     quality: bool = True
     eps_gap: float = 0.01
     eps_budget: int = 200_000
     eps_time: float | None = 10.0
+    source: Any = None
 
     def __post_init__(self) -> None:
         choice(self.method, "method", METHODS)
@@ -63,6 +70,23 @@ class Options:
         count_in(self.eps_budget, "eps_budget", 1, what="direction")
         if self.eps_time is not None:
             number_in(self.eps_time, "eps_time", 0, math.inf, unit="seconds")
+        if self.source is not None and not all(callable(getattr(self.source, m, None))
+                                               for m in ("grasp_values", "inputs")):
+            raise TypeError("source must have grasp_values(chunk) and inputs() methods, got "
+                            f"{type(self.source).__name__}")
+
+
+@dataclass(frozen=True)
+class RowFailure:
+    """An input row its run's source could not turn into a grasp: the ``message`` (the results
+    row's ``error``, after the line), the row's ``id`` and ``fields`` carried to its results row."""
+
+    message: str
+    id: Any = None
+    fields: dict = field(default_factory=dict)
+
+    def __str__(self) -> str:
+        return self.message
 
 
 def certify_rows(cols: GraspColumns, rows: Sequence[int], lines: Sequence[int],
@@ -118,10 +142,27 @@ def certify_values(values: Sequence[Any], lines: Sequence[int], options: Options
 
 def certify_chunk_results(chunk: Chunk, options: Options, tol: Tolerances = Tolerances()):
     """Results of ``chunk``: an Arrow table for an Arrow chunk (columnar path), a list of rows
-    for JSON Lines (per-grasp path)."""
+    for JSON Lines or for a run with a source (per-grasp path)."""
+    if options.source is not None:
+        return _certify_sourced(options.source.grasp_values(chunk), chunk.lines, options, tol)
     if not isinstance(chunk.rows, pa.Table):
         return certify_values(chunk_values(chunk), chunk.lines, options, tol)
     return _certify_arrow_rows(chunk.rows, chunk.lines, options, tol)
+
+
+def _certify_sourced(values: Sequence[Any], lines: Sequence[int], options: Options, tol: Tolerances) -> list[dict]:
+    """Results rows of a source's values: the grasps certified, each :class:`RowFailure` an error
+    row with its fields, in order."""
+    grasps = [k for k, v in enumerate(values) if not isinstance(v, RowFailure)]
+    rows: list[dict | None] = [None] * len(values)
+    certified = certify_values([values[k] for k in grasps], [lines[k] for k in grasps], options, tol)
+    for k, row in zip(grasps, certified):
+        rows[k] = row
+    for k, v in enumerate(values):
+        if isinstance(v, RowFailure):
+            carried = {carried_name(key): value for key, value in v.fields.items()}
+            rows[k] = {**error_row(f"line {lines[k]}: {v}", id=v.id, line=lines[k]), **carried}
+    return rows
 
 
 def _certify_arrow_rows(table: pa.Table, lines, options: Options, tol: Tolerances) -> pa.Table:

@@ -6,9 +6,11 @@ and its results are written to ``RESULTS.parts/part-NNNNNN.EXT`` under a tempora
 atomically when complete, with ``part-NNNNNN.EXT.sum`` stating its rows, bytes and CRC-32 (local
 workers write their own parts; dask workers send their results back to the client, which writes
 them, so a remote cluster needs no shared filesystem). Parts of a Parquet output are Arrow IPC
-files (``.arrow``, LZ4): cheap to write and to read back, so the Parquet encoding is done once. As
-parts complete, the main process appends them in chunk order to a temporary results file in the
-parts folder, renamed to ``RESULTS`` when the last one is in; then the parts folder is removed.
+files (``.arrow``, LZ4): cheap to write and to read back, so the Parquet encoding is done once.
+The main process appends the parts in chunk order to a temporary results file in the parts folder
+(JSON Lines parts as they complete; Parquet parts when the last one is in, in one schema: the
+columns carried from JSON rows may differ between chunks), renamed to ``RESULTS`` at the end;
+then the parts folder is removed.
 
 A run killed at any moment leaves only complete parts (plus temporaries, discarded).
 ``resume=True`` keeps the complete parts whose sums match (a part truncated by a crash or a disk
@@ -36,7 +38,7 @@ import zlib
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Sequence
 
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -45,7 +47,8 @@ from .chunk import Options, certify_chunk_results, status_counts
 from ..errors import CertifyError, GraspFileError
 from ..files.outputs import check_output, lock_output, write_error
 from ..files.results import RESULT_SCHEMA, RESULT_WRITE_OPTIONS, carried_clash
-from ..files.reader import Chunk, input_format, is_parquet, iter_chunks, rows_to_table, table_to_rows
+from ..files.reader import (Chunk, conform, input_format, is_parquet, iter_chunks, rows_to_table, table_to_rows,
+                            unified_schema)
 from ..core.validation import TOP_LEVEL
 
 __all__ = ["RunSummary", "run", "check_paths", "certify_chunk", "parts_folder", "MADE_BY"]
@@ -87,6 +90,11 @@ def _part_name(index: int, results: Path) -> str:
 def _read_part(path: Path) -> pa.Table:
     with pa.memory_map(str(path)) as source:
         return pa.ipc.open_file(source).read_all()
+
+
+def _part_schema(path: Path) -> pa.Schema:
+    with pa.memory_map(str(path)) as source:
+        return pa.ipc.open_file(source).schema
 
 
 def _checksum(path: Path) -> tuple[int, int]:
@@ -251,9 +259,10 @@ def _remove_parts(parts: Path) -> None:
 
 
 class _Assembler:
-    """Appends complete parts, in chunk order as they arrive, to the results' temporary file (in
-    the checkpoint folder); :meth:`close` renames it to the results and removes the parts (a run
-    killed before that leaves the parts, from which a resumed run assembles again)."""
+    """Appends complete parts, in chunk order, to the results' temporary file (in the checkpoint
+    folder): JSON Lines parts as they arrive, Parquet parts at :meth:`close`, in the one schema of
+    them all; :meth:`close` then renames it to the results and removes the parts (a run killed
+    before that leaves the parts, from which a resumed run assembles again)."""
 
     def __init__(self, parts: Path, results: Path) -> None:
         self.parts, self.results = parts, results
@@ -263,8 +272,8 @@ class _Assembler:
         self.next, self.ready = 0, set()
 
     def _open(self, schema: pa.Schema = RESULT_SCHEMA):
-        """The output, opened on first use (Parquet: with the first part's schema, the results
-        columns and any columns carried from the input)."""
+        """The output, opened on first use (Parquet: with the parts' schema, the results columns
+        and any columns carried from the input)."""
         if self.out is None:
             self.out = (pq.ParquetWriter(self.tmp, schema, **RESULT_WRITE_OPTIONS) if self.parquet
                         else self.tmp.open("wb"))
@@ -274,20 +283,27 @@ class _Assembler:
         self.ready.add(index)
         while self.next in self.ready:
             self.ready.remove(self.next)
-            part = self.parts / _part_name(self.next, self.results)
-            if self.parquet:
-                table = _read_part(part)
-                self._open(table.schema).write_table(table)
-            else:
-                with part.open("rb") as fh:
+            if not self.parquet:  # Parquet parts are written at the close, under one schema
+                with (self.parts / _part_name(self.next, self.results)).open("rb") as fh:
                     shutil.copyfileobj(fh, self._open())
             self.next += 1
 
+    def _write_parquet(self, n_chunks: int) -> None:
+        """Every part, in order, in the schema of them all (:func:`unified_schema`: the columns
+        carried from JSON rows may differ between parts, in presence or type)."""
+        parts = [self.parts / _part_name(i, self.results) for i in range(n_chunks)]
+        schema = unified_schema([_part_schema(p) for p in parts]) if parts else RESULT_SCHEMA
+        writer = self._open(schema)
+        for part in parts:
+            writer.write_table(conform(_read_part(part), schema))
+
     def close(self, n_chunks: int) -> None:
-        out, self.out = self._open(), None
-        out.close()
         if self.next != n_chunks:
             raise CertifyError(f"internal error: {self.next} of {n_chunks} parts assembled")
+        if self.parquet:
+            self._write_parquet(n_chunks)
+        out, self.out = self._open(), None
+        out.close()
         check_output(self.results, "-o")  # nothing put in the output's place meanwhile
         os.replace(self.tmp, self.results)
         _remove_parts(self.parts)
@@ -370,12 +386,12 @@ class _DaskPool:
             self.cluster.close()
 
 
-def check_paths(grasps: Path, results: Path, chunk_size: int = 1) -> None:
+def check_paths(grasps: Path, results: Path, chunk_size: int = 1, others: Sequence[Path] = ()) -> None:
     """Refuse a run before any work: an input that is not a grasp set, a chunk size below 1, and
     an output that :func:`qualgrasp.certify.files.outputs.check_output` refuses (a folder, a FIFO or
-    device, the input itself through any link, a checkpoint folder ``RESULTS.parts`` that is or
-    holds the input, a name too long for that folder, a folder that cannot be created or
-    written). The output's folder is created if needed.
+    device, the input itself or one of the ``others`` files read (a source's mesh) through any
+    link, a checkpoint folder ``RESULTS.parts`` that is or holds an input, a name too long for that
+    folder, a folder that cannot be created or written). The output's folder is created if needed.
 
     Raises
     ------
@@ -389,7 +405,7 @@ def check_paths(grasps: Path, results: Path, chunk_size: int = 1) -> None:
         clash = carried_clash([n for n in pq.read_schema(grasps).names if n not in TOP_LEVEL])
         if clash:
             raise GraspFileError(f"{grasps}: the columns {clash}")
-    check_output(results, "-o", reads=[grasps], companions=[parts_folder(results)])
+    check_output(results, "-o", reads=[grasps, *others], companions=[parts_folder(results)])
 
 
 def run(grasps: str | Path, results: str | Path, *, options: Options = Options(),
@@ -414,7 +430,7 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
         Called with the number of grasps of each chunk as it completes (or is found complete).
     """
     grasps, results = Path(grasps), Path(results)
-    check_paths(grasps, results, chunk_size)
+    check_paths(grasps, results, chunk_size, options.source.inputs() if options.source is not None else ())
     with lock_output(results, "-o"):
         try:
             return _run(grasps, results, options, workers, dask, resume, chunk_size, progress)

@@ -24,6 +24,7 @@ from ..regions.files import DEFAULT_BUDGET, certify_region_file, verify_region_f
 from ..batch.samples import write_random_grasp_file
 from ..files.reader import count_grasps
 from ..core.validation import MAX_CONTACTS
+from ..meshes.source import PoseSource, check_pose_file
 from .options import fail, printable
 
 __all__ = ["register"]
@@ -49,11 +50,26 @@ def certify_command(
     dask: str = typer.Option(None, "--dask", help="'local' for a dask LocalCluster, or a scheduler address."),
     resume: bool = typer.Option(False, "--resume", help="Continue an interrupted run, keeping its complete chunks."),
     chunk_size: int = typer.Option(4096, help="Grasps per chunk (unit of work and checkpoint)."),
+    mesh: Path = typer.Option(None, "--mesh", help="Read GRASPS as gripper poses (JSON Lines or Parquet, as for "
+                              "'qualgrasp contacts') and close each on this mesh (OBJ, STL, PLY, GLB, OFF) "
+                              "first: contacts and certificates in one run, one results row per pose."),
+    gripper: str = typer.Option(None, help="With --mesh: built-in gripper or gripper file "
+                                "(default franka_panda)."),
+    convention: str = typer.Option(None, help="With --mesh: pose convention (default qualgrasp)."),
+    units: str = typer.Option(None, help="With --mesh: unit the mesh is drawn in (default m)."),
+    mu: float = typer.Option(None, help="With --mesh: friction coefficient (default: the gripper file's)."),
+    model: str = typer.Option(None, help="With --mesh: contact model of the patches, soft or point (default soft)."),
+    mass: float = typer.Option(None, help="With --mesh: mass of the object, kg (default: density 1000 kg/m^3)."),
+    points: bool = typer.Option(None, "--points/--no-points", help="With --mesh: write each patch's points "
+                                "(default: written)."),
 ) -> None:
     """Certify form and force closure of every grasp, one results line per grasp line.
 
-    Exit code 1 when some rows are errors or failed their own re-check, 2 when the run could not
-    start (unreadable input, bad option, output naming the input or a folder, resume refused).
+    With --mesh, GRASPS holds gripper poses: each is closed on the mesh as 'qualgrasp contacts'
+    does and its contacts certified in the same run (a pose without contacts is an error row with
+    its reason). Exit code 1 when some rows are errors or failed their own re-check, 2 when the run
+    could not start (unreadable input, bad option, output naming an input or a folder, resume
+    refused).
     """
     if method not in METHODS:
         fail(f"--method must be one of {', '.join(METHODS)}, got {method!r}")
@@ -65,6 +81,17 @@ def certify_command(
         fail(f"--workers must be 0 (all cores) or a number of processes, got {workers}")
     if chunk_size < 1:
         fail(f"--chunk-size must be at least 1 grasp, got {chunk_size}")
+    mesh_options = {k: v for k, v in dict(gripper=gripper, convention=convention, units=units, mu=mu, model=model,
+                                          mass=mass, points=points).items() if v is not None}
+    if mesh is None and mesh_options:
+        fail(f"--{next(iter(mesh_options))} needs --mesh")
+    source = None
+    if mesh is not None:
+        try:
+            check_pose_file(grasps)
+            source = PoseSource.of(mesh, **mesh_options)
+        except CertifyError as err:
+            fail(str(err))
     total = count_grasps(grasps)
     with Progress(TextColumn("certify"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
                   console=console, disable=quiet) as bar:
@@ -74,11 +101,11 @@ def certify_command(
                                    progress=lambda n: bar.advance(task, n), quality=quality,
                                    eps_gap=eps_gap, eps_budget=eps_budget,
                                    eps_time=eps_time if eps_time > 0 else None, workers=workers or None,
-                                   dask=dask, resume=resume, chunk_size=chunk_size)
+                                   dask=dask, resume=resume, chunk_size=chunk_size, source=source)
         except CertifyError as err:
             fail(str(err))
     if not quiet:
-        table = _status_table(f"{summary.rows} grasps -> {output}", summary)
+        table = _status_table(f"{summary.rows} {'poses' if source else 'grasps'} -> {output}", summary)
         if summary.resumed_chunks:
             table.add_row("chunks kept from the interrupted run", str(summary.resumed_chunks))
         console.print(table)

@@ -39,7 +39,7 @@ from ..core.validation import param_names
 __all__ = ["CONTACT", "GRASP_SCHEMA", "MAX_LINE_BYTES", "READ_ERROR", "SNIFF_BYTES", "is_parquet", "input_format",
            "column_problem", "json_lines", "Chunk",
            "iter_chunks", "count_grasps", "parse_line", "grasps_table", "rows_to_table", "table_to_rows",
-           "chunk_values", "table_values",
+           "carried_array", "json_text", "JSON_TEXT", "unified_schema", "conform", "chunk_values", "table_values",
            "read_results"]
 
 CONTACT = pa.struct([("p", pa.list_(pa.float64())), ("n", pa.list_(pa.float64())), ("model", pa.string())]
@@ -442,14 +442,98 @@ def grasps_table(dicts: list[dict]) -> pa.Table:
 
 
 def rows_to_table(rows: list[dict]) -> pa.Table:
-    """Arrow table (results schema) of results rows; ids become strings."""
+    """Arrow table of results rows: the results schema, then the fields carried from the input
+    (those beyond the results columns, in the order first met), each as the Arrow type its values
+    have, or as JSON text when they have no common type (:func:`carried_array`); ids become
+    strings.
+
+    Examples
+    --------
+    >>> from qualgrasp.certify.files.results import error_row
+    >>> t = rows_to_table([{**error_row("bad", id=1, line=1), "note": "a"},
+    ...                    {**error_row("bad", id=2, line=2), "note": [1, 2]}])
+    >>> t.column_names[-1], t.column("note").to_pylist()
+    ('note', ['"a"', '[1, 2]'])
+    """
     fixed = []
     for r in rows:
         r = dict(r)
         if r.get("id") is not None and not isinstance(r["id"], str):
             r["id"] = json.dumps(r["id"]) if not isinstance(r["id"], (int, float)) else str(r["id"])
         fixed.append(r)
-    return pa.Table.from_pylist(fixed, schema=RESULT_SCHEMA)
+    table = pa.Table.from_pylist(fixed, schema=RESULT_SCHEMA)
+    names = set(RESULT_SCHEMA.names)
+    for key in dict.fromkeys(k for r in fixed for k in r if k not in names):
+        array = carried_array([r.get(key) for r in fixed])
+        table = table.append_column(pa.field(key, array.type, metadata=JSON_TEXT if array.type == pa.large_string()
+                                             else None), array)
+    return table
+
+
+#: Field metadata of a carried column written as JSON text (:func:`carried_array`).
+JSON_TEXT = {b"qualgrasp": b"json"}
+
+
+def carried_array(values: list) -> pa.Array:
+    """An Arrow array of one carried field's JSON values: the type Arrow infers for them, or,
+    when they have none in common (a string in one row, a list in another), their JSON text
+    (``large_string``, whose field :func:`rows_to_table` marks with :data:`JSON_TEXT`; null stays
+    null), so that no value is lost or changed."""
+    try:
+        array = pa.array(values)
+    except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError, OverflowError):
+        return json_text([None if v is None else v for v in values])
+    if array.type == pa.large_string():  # that type means JSON text here
+        return json_text(values)
+    return array
+
+
+def unified_schema(schemas: list[pa.Schema]) -> pa.Schema:
+    """One schema for results tables written in parts (a Parquet output): every column of any
+    part, in the order first met, each of the type its parts' types promote to; a carried column
+    whose types do not promote (a string in one part, a list in another) becomes JSON text
+    (:data:`JSON_TEXT`).
+
+    Examples
+    --------
+    >>> a, b = pa.schema([("x", pa.null()), ("y", pa.int64())]), pa.schema([("x", pa.string()), ("y", pa.list_(pa.int64()))])
+    >>> s = unified_schema([a, b])
+    >>> s.field("x").type, s.field("y").type, s.field("y").metadata
+    (DataType(string), DataType(large_string), {b'qualgrasp': b'json'})
+    """
+    fields = {}
+    for schema in schemas:
+        for f in schema:
+            fields.setdefault(f.name, []).append(f)
+    out = []
+    for name, found in fields.items():
+        if any(f.metadata == JSON_TEXT for f in found):
+            out.append(pa.field(name, pa.large_string(), metadata=JSON_TEXT))
+            continue
+        try:
+            out.append(pa.unify_schemas([pa.schema([f]) for f in found], promote_options="permissive").field(name))
+        except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError):
+            out.append(pa.field(name, pa.large_string(), metadata=JSON_TEXT))
+    return pa.schema(out)
+
+
+def conform(table: pa.Table, schema: pa.Schema) -> pa.Table:
+    """``table`` in ``schema`` (:func:`unified_schema` of its part and the others): its columns
+    cast, those it lacks null, those the schema holds as JSON text written as JSON text."""
+    columns = []
+    for f in schema:
+        if f.name not in table.column_names:
+            columns.append(pa.nulls(table.num_rows, f.type))
+        elif f.metadata == JSON_TEXT and table.schema.field(f.name).metadata != JSON_TEXT:
+            columns.append(json_text(table.column(f.name).to_pylist()))
+        else:
+            columns.append(table.column(f.name).cast(f.type))
+    return pa.Table.from_arrays(columns, schema=schema)
+
+
+def json_text(values: list) -> pa.Array:
+    """JSON text of each value (null stays null), as ``large_string``."""
+    return pa.array([None if v is None else json.dumps(v, allow_nan=False) for v in values], pa.large_string())
 
 
 def table_to_rows(table: pa.Table) -> list[dict]:

@@ -20,15 +20,18 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
+from ..batch.chunk import RowFailure
 from ..cli.options import OptionError, number_in, output_file
+from ..core.grasp import grasp_from_dict
 from ..errors import CertifyError
 from ..files.reader import grasps_table, is_parquet
-from .contacts import RESOLUTION, TOLERANCE, fingertip_contacts, jaw_contacts
+from .contacts import RESOLUTION, TOLERANCE
 from .errors import PoseError
 from .gripper import CONVENTIONS, ParallelJaw, builtin_grippers, load_gripper
 from .mesh import UNITS, load_mesh, mass_properties
-from .poses import contact_row, error_row, grasp_of, read_poses
+from .poses import error_row, read_poses
 from .rays import ENGINES, RayCaster
+from .source import check_contact_options, pose_grasps
 from .sampling import sample_poses
 from .task import check_bound, check_every_direction, every_direction, hold_verdict, least_grip
 
@@ -118,15 +121,7 @@ def contacts_file(mesh_path: Path, poses_path: Path, output: Path, *, gripper: s
         An input or option is refused (the message names it); nothing is written then.
     """
     g = load_gripper(gripper)
-    if convention not in CONVENTIONS:
-        raise OptionError(f"--convention must be one of {', '.join(CONVENTIONS)}, got {convention!r}")
-    if model not in ("soft", "point"):
-        raise OptionError(f"--model must be soft or point, got {model!r}")
-    number_in(tolerance, "--tolerance", 0, 0.1, unit="m")
-    if not 2 <= resolution <= 200:
-        raise OptionError(f"--resolution must be between 2 and 200 cells per side, got {resolution}")
-    if mu is not None:
-        number_in(mu, "--mu", 0, 1e6)
+    check_contact_options(convention, model, tolerance, resolution, mu)
     if hold is not None:
         number_in(hold, "--hold", 0, 1e9, unit="N", low_open=True)
     grav = _parse_gravity(gravity)
@@ -140,25 +135,14 @@ def contacts_file(mesh_path: Path, poses_path: Path, output: Path, *, gripper: s
     summary = ContactsSummary(repairs=mesh.metadata.get("repairs", ()))
     rows, bad = [], []
     for chunk in read_poses(poses_path, g, convention):
-        good = [r for r in chunk if r.error is None]
-        for r in chunk:
-            if r.error is not None:
-                bad.append(error_row(r, "bad_pose", r.error))
-        if isinstance(g, ParallelJaw):
-            outs = jaw_contacts(mesh, g, np.array([r.T for r in good]).reshape(-1, 4, 4),
-                                np.array([r.width for r in good]), tolerance=tolerance, resolution=resolution,
-                                caster=caster)
-        else:
-            outs = fingertip_contacts(mesh, g, np.array([r.fingertips for r in good]).reshape(-1, g.fingers, 3),
-                                      caster=caster)
-        for r, out in zip(good, outs):
-            if not out.ok:
-                bad.append(error_row(r, out.reason, out.message))
+        found = pose_grasps(chunk, mesh, g, caster, props, mu=friction, model=model, tolerance=tolerance,
+                            resolution=resolution, points=points)
+        for r, row in zip(chunk, found):
+            if isinstance(row, RowFailure):
+                bad.append(error_row(r, row.fields["reason"], str(row)))
                 continue
-            grasp = grasp_of(out, friction, model if isinstance(g, ParallelJaw) else "point", props, r.id)
-            row = contact_row(r, out, grasp, g, props, points=points)
             if hold is not None:
-                row.update(_hold_fields(grasp, props, hold, grav, level))
+                row.update(_hold_fields(grasp_from_dict(row), props, hold, grav, level))
                 summary.holds[row["hold_status"]] += 1
             rows.append(row)
     summary.grasps = len(rows)

@@ -38,14 +38,14 @@ import numpy as np
 
 from ..errors import GraspFileError
 from ..core.grasp import Contact, Grasp, grasp_to_dict
-from ..files.reader import chunk_values, iter_chunks
+from ..files.reader import Chunk, chunk_values, iter_chunks
 from ..core.validation import number, numbers, show
 from .contacts import Outcome
 from .errors import PoseError, PoseFileError
 from .gripper import CONVENTIONS, Gripper, ParallelJaw, check_pose, to_qualgrasp
 from .mesh import MassProperties
 
-__all__ = ["PoseRow", "HDF5_MAGIC", "read_poses", "grasp_of", "contact_row", "error_row"]
+__all__ = ["PoseRow", "HDF5_MAGIC", "chunk_poses", "read_poses", "grasp_of", "contact_row", "error_row"]
 
 HDF5_MAGIC = b"\x89HDF\r\n\x1a\n"
 #: Fields of a pose row that are read (the others are carried to the output).
@@ -117,6 +117,13 @@ def _jaw_pose(value: dict, gripper: ParallelJaw, convention: str) -> tuple[np.nd
     return to_qualgrasp(T, convention, gripper, depth), w
 
 
+def chunk_poses(chunk: Chunk, gripper: Gripper, convention: str = "qualgrasp") -> list[PoseRow]:
+    """The poses of one chunk of a JSON Lines or Parquet pose file
+    (:func:`~qualgrasp.certify.files.reader.iter_chunks`), in order; a row that cannot be read is
+    a :class:`PoseRow` with its ``error``."""
+    return [_row(v, line, gripper, convention) for v, line in zip(chunk_values(chunk), chunk.lines)]
+
+
 def read_poses(path: str | Path, gripper: Gripper, convention: str = "qualgrasp", *,
                chunk_size: int = 1024) -> Iterator[list[PoseRow]]:
     """The poses of a pose file (module docstring), in chunks; a row that cannot be read is a
@@ -151,7 +158,7 @@ def read_poses(path: str | Path, gripper: Gripper, convention: str = "qualgrasp"
         return
     try:
         for chunk in iter_chunks(path, chunk_size):
-            yield [_row(v, line, gripper, convention) for v, line in zip(chunk_values(chunk), chunk.lines)]
+            yield chunk_poses(chunk, gripper, convention)
     except GraspFileError as err:
         raise PoseFileError(str(err).replace("neither JSON Lines nor Parquet", "neither JSON Lines, Parquet nor HDF5"))
 
