@@ -147,7 +147,13 @@ def span_margin(vectors) -> np.ndarray:
     angle by which any of them may turn without losing that.
     """
     v = np.asarray(vectors, dtype=float)
-    angles = np.sort(np.arctan2(v[..., 1], v[..., 0]), axis=-1)
+    return _angle_span(np.arctan2(v[..., 1], v[..., 0]))
+
+
+def _angle_span(angles: np.ndarray) -> np.ndarray:
+    """:func:`span_margin` of the vectors at direction ``angles`` (last axis, radians): the
+    search looks directions up instead of recomputing them, with the same arithmetic."""
+    angles = np.sort(angles, axis=-1)
     gaps = np.diff(np.concatenate([angles, angles[..., :1] + 2 * np.pi], axis=-1), axis=-1)
     return (np.pi - gaps.max(axis=-1)) / 2
 
@@ -279,7 +285,7 @@ def triplet_grasps(cands: Candidates, contour: np.ndarray, theta_min: float, siz
     _check(theta_min, margin, gap)
     P, N = np.asarray(cands.points), np.asarray(cands.normals)
     found = []
-    for triple, best in _triplets(cands, contour, theta_min, size, margin, gap, grid):
+    for triple, best in _triplets(cands, contour, theta_min, size, margin, gap, grid, prune=True):
         if best is None or best[1] < margin * theta_min:
             continue
         idx, score, x = best
@@ -335,11 +341,35 @@ def _best_spread(N: np.ndarray, far: np.ndarray) -> float | None:
     return best
 
 
+@dataclass(frozen=True, eq=False)
+class _Looks:
+    """Per-candidate quantities at the points ``X`` (pixels), computed once and looked up by every
+    region triplet scored there: ``cone[row, g] = theta_min - angle(n_c, X[g] - p_c)`` and
+    ``heading[row, g]``, the direction angle of ``X[g] - p_c``, for the candidate ``c`` of
+    ``row = rows[c]`` (-1: not computed); ``normals[c]``, the direction angle of ``n_c``."""
+
+    X: np.ndarray
+    rows: np.ndarray
+    cone: np.ndarray
+    heading: np.ndarray
+    normals: np.ndarray
+
+    @classmethod
+    def at(cls, X: np.ndarray, idx: np.ndarray, P: np.ndarray, N: np.ndarray, theta_min: float) -> "_Looks":
+        rows = np.full(len(P), -1, dtype=np.intp)
+        rows[idx] = np.arange(len(idx))
+        d = X[None] - P[idx][:, None, :]
+        cone = theta_min - angle_between(N[idx][:, None, :], d)
+        return cls(X, rows, cone, np.arctan2(d[..., 1], d[..., 0]), np.arctan2(N[:, 1], N[:, 0]))
+
+
 def _triplets(cands: Candidates, contour: np.ndarray, theta_min: float, size: float, margin: float,
-              gap: float, grid: int):
+              gap: float, grid: int, prune: bool = False):
     """Every region triplet with its best ``(contacts, margin, meeting point)`` (None when it has
     no admissible contacts); a region used more than once keeps the point triples whose normals
-    span with ``margin``."""
+    span with ``margin``. With ``prune``, three distinct regions none of whose triples of normals
+    span with ``margin`` give None at once: their margin, never above their normals' spanning
+    margin, falls short whatever the meeting point."""
     if grid < 2:
         raise SynthesisError(f"grid must be at least 2, got {grid}")
     P, N = np.asarray(cands.points), np.asarray(cands.normals)
@@ -348,9 +378,13 @@ def _triplets(cands: Candidates, contour: np.ndarray, theta_min: float, size: fl
         return
     far = separated(cands.points, gap, size)
     regions = np.unique(cands.region)
-    curved = {int(r): len(np.unique(np.round(N[cands.of_region(r)], 9), axis=0)) > 1 for r in regions}
-    for triple in itertools.combinations_with_replacement(regions, 3):
-        if len(set(triple)) < 3 and not all(curved[int(r)] for r in triple if triple.count(r) > 1):
+    members = {int(r): cands.of_region(r) for r in regions}
+    coarse = _Looks.at(X, np.arange(len(P)), P, N, theta_min)
+    directions = {r: np.unique(coarse.normals[idx]) for r, idx in members.items()}
+    curved = {r: len(np.unique(np.round(N[idx], 9), axis=0)) > 1 for r, idx in members.items()}
+    picks: dict[tuple, np.ndarray] = {}  # picks of the leading regions on the coarse grid, shared by triplets
+    for triple in itertools.combinations_with_replacement((int(r) for r in regions), 3):
+        if len(set(triple)) < 3 and not all(curved[r] for r in triple if triple.count(r) > 1):
             continue  # two contacts on one straight region share their normal: never spanning
         combos = None
         if len(set(triple)) < 3:
@@ -360,63 +394,84 @@ def _triplets(cands: Candidates, contour: np.ndarray, theta_min: float, size: fl
             if not combos.shape[1]:
                 yield triple, None
                 continue
-        yield triple, _search(triple, combos, X, size / grid, cands, far, theta_min)
+        elif prune and _spread_bound([directions[r] for r in triple]) < margin * theta_min:
+            yield triple, None
+            continue
+        yield triple, _search(triple, combos, coarse, size / grid, cands, members, far, theta_min, picks)
 
 
-def _search(triple, combos, X, step, cands, far, theta_min, keep: int = 8):
-    """Best (contacts, margin, meeting point): the grid ``X``, then finer grids around the best."""
+def _spread_bound(directions: list[np.ndarray]) -> float:
+    """Largest spanning margin of three normals, one at each region's distinct ``directions``
+    (radians): a bound on the normal spanning margin of any of their contact triples."""
+    A, B, C = np.meshgrid(*directions, indexing="ij")
+    return float(_angle_span(np.stack([A.ravel(), B.ravel(), C.ravel()], axis=-1)).max())
+
+
+def _search(triple, combos, coarse: _Looks, step, cands, members, far, theta_min, picks, keep: int = 8):
+    """Best (contacts, margin, meeting point): the coarse grid, then finer grids around the best."""
     offsets = np.stack(np.meshgrid(np.arange(-2, 3), np.arange(-2, 3)), axis=-1).reshape(-1, 2)
-    score, T = _scores(triple, combos, X, cands, far, theta_min)
+    P, N = np.asarray(cands.points), np.asarray(cands.normals)
+    used = np.unique(np.concatenate([members[r] for r in set(triple)]))
+    score, T = _scores(triple, combos, coarse, members, far, picks)
+    X = coarse.X
     for _ in range(REFINE):
         if not np.isfinite(score).any():
             return None
         step /= 3
         top = np.argsort(-score)[:keep]
         X = np.vstack([X[top], (X[top][:, None, :] + step * offsets[None]).reshape(-1, 2)])
-        score, T = _scores(triple, combos, X, cands, far, theta_min)
+        score, T = _scores(triple, combos, _Looks.at(X, used, P, N, theta_min), members, far, None)
     g = int(np.argmax(score))
     if not np.isfinite(score[g]):
         return None
     return T[:, g], float(score[g]), X[g]
 
 
-def _scores(triple, combos, X, cands, far, theta_min) -> tuple[np.ndarray, np.ndarray]:
-    """Margin at every point of ``X`` with its best contacts: ``(G,)`` scores, ``(3, G)`` contacts.
+def _scores(triple, combos, looks: _Looks, members, far, picks) -> tuple[np.ndarray, np.ndarray]:
+    """Margin at every point of ``looks.X`` with its best contacts: ``(G,)`` scores, ``(3, G)`` contacts.
 
-    Distinct regions: each region's candidate deepest in its cone at the point. A region used more
-    than once: the best of the admissible ``combos`` (``(3, C)``) at the point.
+    Distinct regions: each region's candidate deepest in its cone at the point (``picks``, when
+    given, keeps the first regions' picks for the next triplets). A region used more than once:
+    the best of the admissible ``combos`` (``(3, C)``) at the point.
     """
-    P, N = np.asarray(cands.points), np.asarray(cands.normals)
     if combos is None:
         taken: list[np.ndarray] = []
-        for r in triple:
-            idx = cands.of_region(r)
-            cone = theta_min - angle_between(N[idx][:, None, :], X[None] - P[idx][:, None, :])
-            taken.append(_pick(idx[np.argsort(-cone, axis=0, kind="stable")], taken, far))
+        for k, r in enumerate(triple):
+            key = triple[:k + 1]
+            if picks is None or key not in picks:
+                idx = members[r]
+                order = idx[np.argsort(-looks.cone[looks.rows[idx]], axis=0, kind="stable")]
+                pick = _pick(order, taken, far)
+                if picks is not None and k < 2:
+                    picks[key] = pick
+            else:
+                pick = picks[key]
+            taken.append(pick)
         T = np.stack(taken)
         valid = (T >= 0).all(axis=0)
         T = np.where(valid, T, 0)
-        score = _margins(T, X, P, N, theta_min)
+        score = _margins(T, np.arange(len(looks.X)), looks)
         return np.where(valid, score, -np.inf), T
-    best = np.full(len(X), -np.inf)
-    T = np.zeros((3, len(X)), dtype=np.intp)
-    for lo in range(0, combos.shape[1], 256):  # chunks bound the (3, C, G, 2) temporaries
+    best = np.full(len(looks.X), -np.inf)
+    T = np.zeros((3, len(looks.X)), dtype=np.intp)
+    G = np.arange(len(looks.X))
+    for lo in range(0, combos.shape[1], 256):  # chunks bound the (3, C, G) temporaries
         part = combos[:, lo:lo + 256]
-        score = _margins(part[:, :, None], X[None], P, N, theta_min)  # (C, G)
+        score = _margins(part[:, :, None], G[None], looks)  # (C, G)
         c = np.argmax(score, axis=0)
-        better = score[c, np.arange(len(X))] > best
-        best[better] = score[c, np.arange(len(X))][better]
+        better = score[c, G] > best
+        best[better] = score[c, G][better]
         T[:, better] = part[:, c[better]]
     return best, T
 
 
-def _margins(T: np.ndarray, X: np.ndarray, P, N, theta_min: float) -> np.ndarray:
-    """Smallest of the cone margins of the meeting points ``X`` and the spanning margins of the
-    force directions and of the normals, for contact triples ``T`` (first axis: the three)."""
-    d = X - P[T]  # (3, ..., 2)
-    cone = (theta_min - angle_between(N[T], d)).min(axis=0)
-    forces = span_margin(np.moveaxis(d, 0, -2))
-    normals = span_margin(np.moveaxis(N[T], 0, -2))
+def _margins(T: np.ndarray, G: np.ndarray, looks: _Looks) -> np.ndarray:
+    """Smallest of the cone margins of the meeting points ``looks.X[G]`` and the spanning margins
+    of the force directions and of the normals, for contact triples ``T`` (first axis: the three)."""
+    R = looks.rows[T]
+    cone = looks.cone[R, G].min(axis=0)
+    forces = _angle_span(np.moveaxis(looks.heading[R, G], 0, -1))
+    normals = _angle_span(np.moveaxis(looks.normals[T], 0, -1))
     return np.minimum(np.minimum(cone, forces), normals)
 
 
