@@ -383,6 +383,7 @@ def _triplets(cands: Candidates, contour: np.ndarray, theta_min: float, size: fl
     directions = {r: np.unique(coarse.normals[idx]) for r, idx in members.items()}
     curved = {r: len(np.unique(np.round(N[idx], 9), axis=0)) > 1 for r, idx in members.items()}
     picks: dict[tuple, np.ndarray] = {}  # picks of the leading regions on the coarse grid, shared by triplets
+    bounds = _spread_bounds(directions) if prune else {}
     for triple in itertools.combinations_with_replacement((int(r) for r in regions), 3):
         if len(set(triple)) < 3 and not all(curved[r] for r in triple if triple.count(r) > 1):
             continue  # two contacts on one straight region share their normal: never spanning
@@ -394,17 +395,29 @@ def _triplets(cands: Candidates, contour: np.ndarray, theta_min: float, size: fl
             if not combos.shape[1]:
                 yield triple, None
                 continue
-        elif prune and _spread_bound([directions[r] for r in triple]) < margin * theta_min:
+        elif prune and bounds[triple] < margin * theta_min:
             yield triple, None
             continue
         yield triple, _search(triple, combos, coarse, size / grid, cands, members, far, theta_min, picks)
 
 
-def _spread_bound(directions: list[np.ndarray]) -> float:
-    """Largest spanning margin of three normals, one at each region's distinct ``directions``
-    (radians): a bound on the normal spanning margin of any of their contact triples."""
-    A, B, C = np.meshgrid(*directions, indexing="ij")
-    return float(_angle_span(np.stack([A.ravel(), B.ravel(), C.ravel()], axis=-1)).max())
+def _spread_bounds(directions: dict[int, np.ndarray]) -> dict[tuple[int, int, int], float]:
+    """For every three distinct regions ``r1 < r2 < r3`` (keys of ``directions``, each region's
+    distinct normal directions, radians), the largest spanning margin of three normals, one on
+    each: a bound on the normal spanning margin of any of their contact triples. One call per
+    region pair, over all the third regions after it."""
+    keys = sorted(directions)
+    bounds = {}
+    for a, b in itertools.combinations(range(len(keys)), 2):
+        rest = [directions[r] for r in keys[b + 1:]]
+        if not rest:
+            continue
+        A, B, C = np.meshgrid(directions[keys[a]], directions[keys[b]], np.concatenate(rest), indexing="ij")
+        span = _angle_span(np.stack([A, B, C], axis=-1)).max(axis=(0, 1))
+        starts = np.cumsum([0] + [len(d) for d in rest[:-1]])
+        for r, value in zip(keys[b + 1:], np.maximum.reduceat(span, starts)):
+            bounds[keys[a], keys[b], r] = float(value)
+    return bounds
 
 
 def _search(triple, combos, coarse: _Looks, step, cands, members, far, theta_min, picks, keep: int = 8):
