@@ -285,7 +285,7 @@ def triplet_grasps(cands: Candidates, contour: np.ndarray, theta_min: float, siz
     _check(theta_min, margin, gap)
     P, N = np.asarray(cands.points), np.asarray(cands.normals)
     found = []
-    for triple, best in _triplets(cands, contour, theta_min, size, margin, gap, grid, prune=True):
+    for triple, best in _triplets(cands, contour, theta_min, size, margin, gap, grid, prune="margin"):
         if best is None or best[1] < margin * theta_min:
             continue
         idx, score, x = best
@@ -323,7 +323,7 @@ def best_triplet_margins(cands: Candidates, contour: np.ndarray, theta_min: floa
     (30.0, True)
     """
     far = separated(cands.points, gap, size)
-    scores = [best[1] for _, best in _triplets(cands, contour, theta_min, size, -1.0, gap, grid)
+    scores = [best[1] for _, best in _triplets(cands, contour, theta_min, size, -1.0, gap, grid, prune="best")
               if best is not None]
     return _best_spread(np.asarray(cands.normals), far), (max(scores) if scores else None)
 
@@ -364,12 +364,17 @@ class _Looks:
 
 
 def _triplets(cands: Candidates, contour: np.ndarray, theta_min: float, size: float, margin: float,
-              gap: float, grid: int, prune: bool = False):
+              gap: float, grid: int, prune: str | None = None):
     """Every region triplet with its best ``(contacts, margin, meeting point)`` (None when it has
     no admissible contacts); a region used more than once keeps the point triples whose normals
-    span with ``margin``. With ``prune``, three distinct regions none of whose triples of normals
-    span with ``margin`` give None at once: their margin, never above their normals' spanning
-    margin, falls short whatever the meeting point."""
+    span with ``margin``.
+
+    A triplet's margin is never above its normals' spanning margin, whatever the meeting point,
+    so some triplets give None unsearched: with ``prune="margin"``, three distinct regions none of
+    whose triples of normals span with ``margin``; with ``prune="best"``, every triplet none of
+    whose triples of normals span with more than the best margin found so far (the largest
+    margin stays that of the plain search).
+    """
     if grid < 2:
         raise SynthesisError(f"grid must be at least 2, got {grid}")
     P, N = np.asarray(cands.points), np.asarray(cands.normals)
@@ -382,23 +387,30 @@ def _triplets(cands: Candidates, contour: np.ndarray, theta_min: float, size: fl
     coarse = _Looks.at(X, np.arange(len(P)), P, N, theta_min)
     directions = {r: np.unique(coarse.normals[idx]) for r, idx in members.items()}
     curved = {r: len(np.unique(np.round(N[idx], 9), axis=0)) > 1 for r, idx in members.items()}
-    picks: dict[tuple, np.ndarray] = {}  # picks of the leading regions on the coarse grid, shared by triplets
     bounds = _spread_bounds(directions) if prune else {}
+    floor = margin * theta_min if prune == "margin" else -np.inf
+    picks: dict[tuple, np.ndarray] = {}  # the first regions' picks on the coarse grid, shared by triplets
     for triple in itertools.combinations_with_replacement((int(r) for r in regions), 3):
+        if picks and (triple[0],) not in picks:
+            picks.clear()  # triplets come in order: the first region's picks are done with
         if len(set(triple)) < 3 and not all(curved[r] for r in triple if triple.count(r) > 1):
             continue  # two contacts on one straight region share their normal: never spanning
         combos = None
         if len(set(triple)) < 3:
             combos = _combinations(triple, cands, far)
             # the normals' spanning margin bounds the score whatever the meeting point
-            combos = combos[:, span_margin(np.moveaxis(N[combos], 0, 1)) >= margin * theta_min]
-            if not combos.shape[1]:
+            spans = span_margin(np.moveaxis(N[combos], 0, 1))
+            combos = combos[:, spans >= margin * theta_min]
+            if not combos.shape[1] or (prune and spans.max() < floor):
                 yield triple, None
                 continue
-        elif prune and bounds[triple] < margin * theta_min:
+        elif prune and bounds[triple] < floor:
             yield triple, None
             continue
-        yield triple, _search(triple, combos, coarse, size / grid, cands, members, far, theta_min, picks)
+        best = _search(triple, combos, coarse, size / grid, cands, members, far, theta_min, picks)
+        if prune == "best" and best is not None:
+            floor = max(floor, best[1])
+        yield triple, best
 
 
 def _spread_bounds(directions: dict[int, np.ndarray]) -> dict[tuple[int, int, int], float]:
