@@ -30,7 +30,10 @@ Three fingers (Ponce & Faverjon 1995, proposition 3; paper definitions 16-17)
     region with ``x`` deepest in its cone, and keep the ``x`` with the largest margin: the
     smallest of the three cone margins ``theta_min - angle(n_i, x - F_i)``, of the spanning margin
     of the force directions and of the normals (``(pi - largest gap) / 2``). One grasp per region
-    triplet.
+    triplet. The normals' spanning margin bounds the margin whatever the point, so a triplet none
+    of whose contact triples has normals spanning with the accepted margin is skipped unsearched;
+    each candidate's cone margins and directions on the coarse grid are computed once and shared
+    by every triplet. Neither changes a grasp found.
 
 A grasp is kept when its margin is at least ``margin * theta_min``: contacts stay inside their
 cones (and forces keep spanning) under angular errors of that size, e.g. normals estimated from
