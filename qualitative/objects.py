@@ -19,6 +19,10 @@ The objects follow the paper (Sinha et al., figures 3 and 4):
 ``"square"``
     A square, the simplest polygon (``/>/>/>/>``).
 
+Beyond the paper's shapes, :func:`gear` gives a spur gear with trapezoidal teeth in pixel
+coordinates (not one of :data:`NAMES`): many small regions, the hard case of three-finger
+synthesis; draw it with :func:`render_polygon`.
+
 Conventions
 -----------
 Coordinates are pixels of the image: x = column, y = row (y points down), pixel centres at
@@ -41,7 +45,7 @@ from shapely.geometry import Polygon
 from .errors import QualitativeError
 
 __all__ = ["NAMES", "RADIUS", "BACKGROUND", "FOREGROUND", "shape", "render", "render_polygon",
-           "normalise", "place"]
+           "normalise", "place", "gear"]
 
 NAMES = ("polygon", "nut", "disc", "figure3", "square")
 RADIUS = 0.21
@@ -152,6 +156,58 @@ def shape(name: str, size: int = 512, rotation: float = 0.0, scale: float = 1.0,
         orientation); the nut has one interior ring (its hole).
     """
     return place(_template(name), size, rotation, scale, offset)
+
+
+def gear(teeth: int = 20, outer: float = 100.0, depth: float = 15.0, size: int = 512,
+         rotation: float = 0.0) -> Polygon:
+    """A spur gear with trapezoidal teeth, centred in a ``size x size`` image (pixels).
+
+    Each tooth pitch (``360 / teeth`` degrees) is, in angle: a root land of 35 %, a rising flank
+    of 10 %, a tip land of 45 % and a falling flank of 10 %; the tips lie on the circle of radius
+    ``outer``, the roots on radius ``outer - depth``. With the defaults, a finger of the default
+    width (0.08 of the object's size) fits on every tip land and root land: 40 feasible regions.
+
+    Parameters
+    ----------
+    teeth : int
+        Number of teeth, at least 3.
+    outer : float
+        Tip radius, pixels.
+    depth : float
+        Tooth depth, pixels, in ``(0, outer)``.
+    size : int
+        Side of the (square) image, pixels; the gear must fit inside it.
+    rotation : float
+        Rotation in degrees about the centre, turning +x towards +y.
+
+    Returns
+    -------
+    shapely.geometry.Polygon
+        Exterior oriented so that the shoelace area on (x, y) is positive; draw it with
+        :func:`render_polygon`.
+
+    Raises
+    ------
+    QualitativeError
+        Fewer than 3 teeth, a depth outside ``(0, outer)`` or a gear that does not fit the image.
+
+    Examples
+    --------
+    >>> g = gear(20)
+    >>> len(g.exterior.coords) - 1, round(g.bounds[2] - g.bounds[0])
+    (80, 200)
+    """
+    if teeth < 3 or not (0 < depth < outer) or not (0 < outer < (size - 1) / 2):
+        raise QualitativeError(f"a gear needs at least 3 teeth, 0 < depth < outer < (size - 1) / 2; got "
+                               f"{teeth} teeth, depth {depth}, outer {outer}, size {size}")
+    pitch = 2 * np.pi / teeth
+    # corners of one tooth as (fraction of the pitch, radius): root land, flank, tip land, flank
+    corners = [(0.0, outer - depth), (0.35, outer - depth), (0.45, outer), (0.9, outer)]
+    angle = np.array([(k + f) * pitch for k in range(teeth) for f, _ in corners]) + np.radians(rotation)
+    radius = np.array([r for _ in range(teeth) for _, r in corners])
+    center = (size - 1) / 2.0
+    ring = np.column_stack([center + radius * np.cos(angle), center + radius * np.sin(angle)])
+    return shapely.geometry.polygon.orient(Polygon(ring), sign=1.0)
 
 
 def render(name: str, size: int = 512, rotation: float = 0.0, scale: float = 1.0,

@@ -30,7 +30,10 @@ Three fingers (Ponce & Faverjon 1995, proposition 3; paper definitions 16-17)
     region with ``x`` deepest in its cone, and keep the ``x`` with the largest margin: the
     smallest of the three cone margins ``theta_min - angle(n_i, x - F_i)``, of the spanning margin
     of the force directions and of the normals (``(pi - largest gap) / 2``). One grasp per region
-    triplet.
+    triplet. The normals' spanning margin bounds the margin whatever the point, so a triplet none
+    of whose contact triples has normals spanning with the accepted margin is skipped unsearched;
+    each candidate's cone margins and directions on the coarse grid are computed once and shared
+    by every triplet. Neither changes a grasp found.
 
 A grasp is kept when its margin is at least ``margin * theta_min``: contacts stay inside their
 cones (and forces keep spanning) under angular errors of that size, e.g. normals estimated from
@@ -147,7 +150,13 @@ def span_margin(vectors) -> np.ndarray:
     angle by which any of them may turn without losing that.
     """
     v = np.asarray(vectors, dtype=float)
-    angles = np.sort(np.arctan2(v[..., 1], v[..., 0]), axis=-1)
+    return _angle_span(np.arctan2(v[..., 1], v[..., 0]))
+
+
+def _angle_span(angles: np.ndarray) -> np.ndarray:
+    """:func:`span_margin` of the vectors at direction ``angles`` (last axis, radians): the
+    search looks directions up instead of recomputing them, with the same arithmetic."""
+    angles = np.sort(angles, axis=-1)
     gaps = np.diff(np.concatenate([angles, angles[..., :1] + 2 * np.pi], axis=-1), axis=-1)
     return (np.pi - gaps.max(axis=-1)) / 2
 
@@ -279,7 +288,7 @@ def triplet_grasps(cands: Candidates, contour: np.ndarray, theta_min: float, siz
     _check(theta_min, margin, gap)
     P, N = np.asarray(cands.points), np.asarray(cands.normals)
     found = []
-    for triple, best in _triplets(cands, contour, theta_min, size, margin, gap, grid):
+    for triple, best in _triplets(cands, contour, theta_min, size, margin, gap, grid, prune="margin"):
         if best is None or best[1] < margin * theta_min:
             continue
         idx, score, x = best
@@ -317,7 +326,7 @@ def best_triplet_margins(cands: Candidates, contour: np.ndarray, theta_min: floa
     (30.0, True)
     """
     far = separated(cands.points, gap, size)
-    scores = [best[1] for _, best in _triplets(cands, contour, theta_min, size, -1.0, gap, grid)
+    scores = [best[1] for _, best in _triplets(cands, contour, theta_min, size, -1.0, gap, grid, prune="best")
               if best is not None]
     return _best_spread(np.asarray(cands.normals), far), (max(scores) if scores else None)
 
@@ -335,11 +344,40 @@ def _best_spread(N: np.ndarray, far: np.ndarray) -> float | None:
     return best
 
 
+@dataclass(frozen=True, eq=False)
+class _Looks:
+    """Per-candidate quantities at the points ``X`` (pixels), computed once and looked up by every
+    region triplet scored there: ``cone[row, g] = theta_min - angle(n_c, X[g] - p_c)`` and
+    ``heading[row, g]``, the direction angle of ``X[g] - p_c``, for the candidate ``c`` of
+    ``row = rows[c]`` (-1: not computed); ``normals[c]``, the direction angle of ``n_c``."""
+
+    X: np.ndarray
+    rows: np.ndarray
+    cone: np.ndarray
+    heading: np.ndarray
+    normals: np.ndarray
+
+    @classmethod
+    def at(cls, X: np.ndarray, idx: np.ndarray, P: np.ndarray, N: np.ndarray, theta_min: float) -> "_Looks":
+        rows = np.full(len(P), -1, dtype=np.intp)
+        rows[idx] = np.arange(len(idx))
+        d = X[None] - P[idx][:, None, :]
+        cone = theta_min - angle_between(N[idx][:, None, :], d)
+        return cls(X, rows, cone, np.arctan2(d[..., 1], d[..., 0]), np.arctan2(N[:, 1], N[:, 0]))
+
+
 def _triplets(cands: Candidates, contour: np.ndarray, theta_min: float, size: float, margin: float,
-              gap: float, grid: int):
+              gap: float, grid: int, prune: str | None = None):
     """Every region triplet with its best ``(contacts, margin, meeting point)`` (None when it has
     no admissible contacts); a region used more than once keeps the point triples whose normals
-    span with ``margin``."""
+    span with ``margin``.
+
+    A triplet's margin is never above its normals' spanning margin, whatever the meeting point,
+    so some triplets give None unsearched: with ``prune="margin"``, three distinct regions none of
+    whose triples of normals span with ``margin``; with ``prune="best"``, every triplet none of
+    whose triples of normals span with more than the best margin found so far (the largest
+    margin stays that of the plain search).
+    """
     if grid < 2:
         raise SynthesisError(f"grid must be at least 2, got {grid}")
     P, N = np.asarray(cands.points), np.asarray(cands.normals)
@@ -348,75 +386,120 @@ def _triplets(cands: Candidates, contour: np.ndarray, theta_min: float, size: fl
         return
     far = separated(cands.points, gap, size)
     regions = np.unique(cands.region)
-    curved = {int(r): len(np.unique(np.round(N[cands.of_region(r)], 9), axis=0)) > 1 for r in regions}
-    for triple in itertools.combinations_with_replacement(regions, 3):
-        if len(set(triple)) < 3 and not all(curved[int(r)] for r in triple if triple.count(r) > 1):
+    members = {int(r): cands.of_region(r) for r in regions}
+    coarse = _Looks.at(X, np.arange(len(P)), P, N, theta_min)
+    directions = {r: np.unique(coarse.normals[idx]) for r, idx in members.items()}
+    curved = {r: len(np.unique(np.round(N[idx], 9), axis=0)) > 1 for r, idx in members.items()}
+    bounds = _spread_bounds(directions) if prune else {}
+    floor = margin * theta_min if prune == "margin" else -np.inf
+    picks: dict[tuple, np.ndarray] = {}  # the first regions' picks on the coarse grid, shared by triplets
+    for triple in itertools.combinations_with_replacement((int(r) for r in regions), 3):
+        if picks and (triple[0],) not in picks:
+            picks.clear()  # triplets come in order: the first region's picks are done with
+        if len(set(triple)) < 3 and not all(curved[r] for r in triple if triple.count(r) > 1):
             continue  # two contacts on one straight region share their normal: never spanning
         combos = None
         if len(set(triple)) < 3:
             combos = _combinations(triple, cands, far)
             # the normals' spanning margin bounds the score whatever the meeting point
-            combos = combos[:, span_margin(np.moveaxis(N[combos], 0, 1)) >= margin * theta_min]
-            if not combos.shape[1]:
+            spans = span_margin(np.moveaxis(N[combos], 0, 1))
+            combos = combos[:, spans >= margin * theta_min]
+            if not combos.shape[1] or (prune and spans.max() < floor):
                 yield triple, None
                 continue
-        yield triple, _search(triple, combos, X, size / grid, cands, far, theta_min)
+        elif prune and bounds[triple] < floor:
+            yield triple, None
+            continue
+        best = _search(triple, combos, coarse, size / grid, cands, members, far, theta_min, picks)
+        if prune == "best" and best is not None:
+            floor = max(floor, best[1])
+        yield triple, best
 
 
-def _search(triple, combos, X, step, cands, far, theta_min, keep: int = 8):
-    """Best (contacts, margin, meeting point): the grid ``X``, then finer grids around the best."""
+def _spread_bounds(directions: dict[int, np.ndarray]) -> dict[tuple[int, int, int], float]:
+    """For every three distinct regions ``r1 < r2 < r3`` (keys of ``directions``, each region's
+    distinct normal directions, radians), the largest spanning margin of three normals, one on
+    each: a bound on the normal spanning margin of any of their contact triples. One call per
+    region pair, over all the third regions after it."""
+    keys = sorted(directions)
+    bounds = {}
+    for a, b in itertools.combinations(range(len(keys)), 2):
+        rest = [directions[r] for r in keys[b + 1:]]
+        if not rest:
+            continue
+        A, B, C = np.meshgrid(directions[keys[a]], directions[keys[b]], np.concatenate(rest), indexing="ij")
+        span = _angle_span(np.stack([A, B, C], axis=-1)).max(axis=(0, 1))
+        starts = np.cumsum([0] + [len(d) for d in rest[:-1]])
+        for r, value in zip(keys[b + 1:], np.maximum.reduceat(span, starts)):
+            bounds[keys[a], keys[b], r] = float(value)
+    return bounds
+
+
+def _search(triple, combos, coarse: _Looks, step, cands, members, far, theta_min, picks, keep: int = 8):
+    """Best (contacts, margin, meeting point): the coarse grid, then finer grids around the best."""
     offsets = np.stack(np.meshgrid(np.arange(-2, 3), np.arange(-2, 3)), axis=-1).reshape(-1, 2)
-    score, T = _scores(triple, combos, X, cands, far, theta_min)
+    P, N = np.asarray(cands.points), np.asarray(cands.normals)
+    used = np.unique(np.concatenate([members[r] for r in set(triple)]))
+    score, T = _scores(triple, combos, coarse, members, far, picks)
+    X = coarse.X
     for _ in range(REFINE):
         if not np.isfinite(score).any():
             return None
         step /= 3
         top = np.argsort(-score)[:keep]
         X = np.vstack([X[top], (X[top][:, None, :] + step * offsets[None]).reshape(-1, 2)])
-        score, T = _scores(triple, combos, X, cands, far, theta_min)
+        score, T = _scores(triple, combos, _Looks.at(X, used, P, N, theta_min), members, far, None)
     g = int(np.argmax(score))
     if not np.isfinite(score[g]):
         return None
     return T[:, g], float(score[g]), X[g]
 
 
-def _scores(triple, combos, X, cands, far, theta_min) -> tuple[np.ndarray, np.ndarray]:
-    """Margin at every point of ``X`` with its best contacts: ``(G,)`` scores, ``(3, G)`` contacts.
+def _scores(triple, combos, looks: _Looks, members, far, picks) -> tuple[np.ndarray, np.ndarray]:
+    """Margin at every point of ``looks.X`` with its best contacts: ``(G,)`` scores, ``(3, G)`` contacts.
 
-    Distinct regions: each region's candidate deepest in its cone at the point. A region used more
-    than once: the best of the admissible ``combos`` (``(3, C)``) at the point.
+    Distinct regions: each region's candidate deepest in its cone at the point (``picks``, when
+    given, keeps the first regions' picks for the next triplets). A region used more than once:
+    the best of the admissible ``combos`` (``(3, C)``) at the point.
     """
-    P, N = np.asarray(cands.points), np.asarray(cands.normals)
     if combos is None:
         taken: list[np.ndarray] = []
-        for r in triple:
-            idx = cands.of_region(r)
-            cone = theta_min - angle_between(N[idx][:, None, :], X[None] - P[idx][:, None, :])
-            taken.append(_pick(idx[np.argsort(-cone, axis=0, kind="stable")], taken, far))
+        for k, r in enumerate(triple):
+            key = triple[:k + 1]
+            if picks is None or key not in picks:
+                idx = members[r]
+                order = idx[np.argsort(-looks.cone[looks.rows[idx]], axis=0, kind="stable")]
+                pick = _pick(order, taken, far)
+                if picks is not None and k < 2:
+                    picks[key] = pick
+            else:
+                pick = picks[key]
+            taken.append(pick)
         T = np.stack(taken)
         valid = (T >= 0).all(axis=0)
         T = np.where(valid, T, 0)
-        score = _margins(T, X, P, N, theta_min)
+        score = _margins(T, np.arange(len(looks.X)), looks)
         return np.where(valid, score, -np.inf), T
-    best = np.full(len(X), -np.inf)
-    T = np.zeros((3, len(X)), dtype=np.intp)
-    for lo in range(0, combos.shape[1], 256):  # chunks bound the (3, C, G, 2) temporaries
+    best = np.full(len(looks.X), -np.inf)
+    T = np.zeros((3, len(looks.X)), dtype=np.intp)
+    G = np.arange(len(looks.X))
+    for lo in range(0, combos.shape[1], 256):  # chunks bound the (3, C, G) temporaries
         part = combos[:, lo:lo + 256]
-        score = _margins(part[:, :, None], X[None], P, N, theta_min)  # (C, G)
+        score = _margins(part[:, :, None], G[None], looks)  # (C, G)
         c = np.argmax(score, axis=0)
-        better = score[c, np.arange(len(X))] > best
-        best[better] = score[c, np.arange(len(X))][better]
+        better = score[c, G] > best
+        best[better] = score[c, G][better]
         T[:, better] = part[:, c[better]]
     return best, T
 
 
-def _margins(T: np.ndarray, X: np.ndarray, P, N, theta_min: float) -> np.ndarray:
-    """Smallest of the cone margins of the meeting points ``X`` and the spanning margins of the
-    force directions and of the normals, for contact triples ``T`` (first axis: the three)."""
-    d = X - P[T]  # (3, ..., 2)
-    cone = (theta_min - angle_between(N[T], d)).min(axis=0)
-    forces = span_margin(np.moveaxis(d, 0, -2))
-    normals = span_margin(np.moveaxis(N[T], 0, -2))
+def _margins(T: np.ndarray, G: np.ndarray, looks: _Looks) -> np.ndarray:
+    """Smallest of the cone margins of the meeting points ``looks.X[G]`` and the spanning margins
+    of the force directions and of the normals, for contact triples ``T`` (first axis: the three)."""
+    R = looks.rows[T]
+    cone = looks.cone[R, G].min(axis=0)
+    forces = _angle_span(np.moveaxis(looks.heading[R, G], 0, -1))
+    normals = _angle_span(np.moveaxis(looks.normals[T], 0, -1))
     return np.minimum(np.minimum(cone, forces), normals)
 
 
