@@ -18,7 +18,8 @@ Every plot is written as PNG and PDF with :func:`qualgrasp.experiments.style.sav
   count, beside the route's sampled robustness (pooled fraction held, in the tick labels).
 
 Panels and labels come from the procedure registry (:mod:`qualgrasp.qualitative.synthesis.procedures`):
-one panel (or row) per registered procedure, with its baseline; colours tell the procedure (:func:`~qualgrasp.experiments.style.procedure_colour`), line
+one panel (or row) per registered procedure, with its baseline; colours tell the procedure
+(:func:`~qualgrasp.experiments.style.procedure_colour`), line
 style and marker the method (solid and circles: qualitative; dashed and triangles: baseline).
 """
 

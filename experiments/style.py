@@ -29,7 +29,8 @@ from qualgrasp.qualitative.plots.outline import STYLE as CURVATURE
 from qualgrasp.qualitative.synthesis import procedures
 
 __all__ = ["RC", "DPI", "CURVATURE", "ZPLUS", "ZMINUS", "TCOLOR", "CONE", "GOOD", "BAD", "GRASP_LINE",
-           "ZONE", "MEET", "OBJECT", "PROCEDURE_COLOURS", "procedure_colour", "context", "new_figure", "show_image", "clean", "check_formats", "save"]
+           "ZONE", "MEET", "OBJECT", "PROCEDURE_COLOURS", "procedure_colour", "context", "new_figure", "show_image",
+           "clean", "check_formats", "save"]
 
 DPI = 200
 GOOD = "tab:green"  # a verdict that holds: closure, positive spanning

@@ -496,7 +496,8 @@ def unified_schema(schemas: list[pa.Schema]) -> pa.Schema:
 
     Examples
     --------
-    >>> a, b = pa.schema([("x", pa.null()), ("y", pa.int64())]), pa.schema([("x", pa.string()), ("y", pa.list_(pa.int64()))])
+    >>> a = pa.schema([("x", pa.null()), ("y", pa.int64())])
+    >>> b = pa.schema([("x", pa.string()), ("y", pa.list_(pa.int64()))])
     >>> s = unified_schema([a, b])
     >>> s.field("x").type, s.field("y").type, s.field("y").metadata
     (DataType(string), DataType(large_string), {b'qualgrasp': b'json'})

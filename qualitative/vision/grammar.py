@@ -189,7 +189,8 @@ def check_turnings(symbols: str, turnings) -> None:
 
 
 def validate(outline: Any) -> None:
-    """Check that an outline string (or an extracted :class:`~qualgrasp.qualitative.vision.outline.Outline`) is well formed.
+    """Check that an outline string (or an extracted :class:`~qualgrasp.qualitative.vision.outline.Outline`)
+    is well formed.
 
     Parameters
     ----------

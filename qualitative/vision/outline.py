@@ -659,7 +659,8 @@ def outline_contour(contour: np.ndarray, *, scale: float = DEFAULT_SCALE, sample
     Returns
     -------
     Outline
-        Well formed (checked with :func:`~qualgrasp.qualitative.vision.grammar.validate`), segments in canonical order, with the
+        Well formed (checked with :func:`~qualgrasp.qualitative.vision.grammar.validate`), segments in
+        canonical order, with the
         ``scale`` it was computed at.
 
     Raises

@@ -10,7 +10,8 @@ for their size (0.004 to 0.009 for the study's silhouettes), never more than 0.0
 :func:`outline_scales` (an image) and :func:`outline_contour_scales` (a contour) give the
 **hierarchy** (curvature scale space, Mokhtarian and Mackworth 1992): the intervals of scale over
 which the string stays the same (:class:`ScaleInterval`), from the default scale 0.004 (fine) to
-:data:`~qualgrasp.qualitative.vision.outline.SCALE_MAX` (coarse: there 21 of the 24 study cells have no concave symbol left, while deep
+:data:`~qualgrasp.qualitative.vision.outline.SCALE_MAX` (coarse: there 21 of the 24 study cells have no
+concave symbol left, while deep
 concavities such as the polygon's notch, figure 3's slot or the horse's legs remain), found on a
 geometric grid (4 scales per octave) and located by bisection to 1 %. The image is segmented and
 the contour resampled once; only the smoothing and the classification are repeated per scale.
@@ -79,7 +80,8 @@ def finger_scale(outline: Outline | np.ndarray, finger_width: float, *, samples:
     ----------
     outline : Outline or numpy.ndarray
         An extracted outline (its :attr:`~Outline.size` and :attr:`~Outline.perimeter`), or an
-        ``(m, 2)`` closed contour in pixels (resampled like :func:`~qualgrasp.qualitative.vision.outline.outline_contour` does).
+        ``(m, 2)`` closed contour in pixels (resampled like
+        :func:`~qualgrasp.qualitative.vision.outline.outline_contour` does).
     finger_width : float
         Pad width, fraction of the object's size (the project's default is
         :data:`qualgrasp.qualitative.synthesis.regions.FINGER_WIDTH`, 0.08).
@@ -89,7 +91,8 @@ def finger_scale(outline: Outline | np.ndarray, finger_width: float, *, samples:
     Returns
     -------
     float
-        Scale, fraction of the perimeter (pass it as ``scale`` to :func:`~qualgrasp.qualitative.vision.outline.outline_contour`); for a
+        Scale, fraction of the perimeter (pass it as ``scale`` to
+        :func:`~qualgrasp.qualitative.vision.outline.outline_contour`); for a
         disc and the default pad, ``0.08 / (4 pi) = 0.0064``.
 
     Raises
@@ -119,7 +122,8 @@ def finger_scale(outline: Outline | np.ndarray, finger_width: float, *, samples:
 
 def planning_scale(outline: Outline | np.ndarray, finger_width: float, *, samples: int = 1024) -> float:
     """The scale every qualitative command reads an object's outline at by default: the finger's
-    (:func:`finger_scale`), never finer than :data:`~qualgrasp.qualitative.vision.outline.DEFAULT_SCALE` nor coarser than
+    (:func:`finger_scale`), never finer than :data:`~qualgrasp.qualitative.vision.outline.DEFAULT_SCALE` nor
+    coarser than
     :data:`~qualgrasp.qualitative.vision.outline.SCALE_MAX`.
 
     ``qualgrasp outline``, ``regions``, ``synthesize``, ``independent-regions``, ``compare`` and the
@@ -160,7 +164,8 @@ def outline_contour_scales(contour: np.ndarray, *, fine: float = DEFAULT_SCALE, 
     """The scale hierarchy of a contour's outline (curvature scale space), from fine to coarse.
 
     The contour is resampled once; at each scale only the smoothing and the classification of
-    :func:`~qualgrasp.qualitative.vision.outline.outline_contour` are repeated. The string is computed on a geometric grid of
+    :func:`~qualgrasp.qualitative.vision.outline.outline_contour` are repeated. The string is computed on a
+    geometric grid of
     ``per_octave`` scales per doubling from ``fine`` to ``coarse`` (both included); where two
     neighbouring scales differ, the change is located by bisection (geometric middles) until the
     bracket is narrower than a factor ``1 + tolerance``, and a boundary is put at the bracket's
@@ -174,7 +179,8 @@ def outline_contour_scales(contour: np.ndarray, *, fine: float = DEFAULT_SCALE, 
     fine, coarse : float
         Scale range covered, fractions of the perimeter, ``0 < fine < coarse <= SCALE_MAX``. Default
         from :data:`~qualgrasp.qualitative.vision.outline.DEFAULT_SCALE` (0.004, the fine end: the first interval's string is the default
-        outline) to :data:`~qualgrasp.qualitative.vision.outline.SCALE_MAX` (0.032, where the built-in objects and most real cells have
+        outline) to :data:`~qualgrasp.qualitative.vision.outline.SCALE_MAX` (0.032, where the built-in
+        objects and most real cells have
         become convex blobs: no concave symbol).
     per_octave : int
         Grid scales per doubling of the scale (4: neighbours about 19 % apart).
@@ -184,7 +190,8 @@ def outline_contour_scales(contour: np.ndarray, *, fine: float = DEFAULT_SCALE, 
     samples : int
         Number of samples after resampling by arc length.
     corner_angle, cusp_angle, straight, flat_angle : float
-        As for :func:`~qualgrasp.qualitative.vision.outline.outline_contour` (the corner window is ``WINDOW`` scales at every scale).
+        As for :func:`~qualgrasp.qualitative.vision.outline.outline_contour` (the corner window is ``WINDOW``
+        scales at every scale).
 
     Returns
     -------
@@ -247,7 +254,8 @@ def outline_scales(src: ImageSource, *, threshold: float | None = None, largest:
                    rect: tuple[int, int, int, int] | None = None, **options) -> tuple[ScaleInterval, ...]:
     """The scale hierarchy of the outline of the object in an image, from fine to coarse.
 
-    The image is segmented and its contour extracted once (see :func:`~qualgrasp.qualitative.vision.outline.outline_image`); the
+    The image is segmented and its contour extracted once (see
+    :func:`~qualgrasp.qualitative.vision.outline.outline_image`); the
     hierarchy is that of :func:`outline_contour_scales`.
 
     Parameters
@@ -268,7 +276,8 @@ def outline_scales(src: ImageSource, *, threshold: float | None = None, largest:
     Returns
     -------
     tuple of ScaleInterval
-        From ``fine`` (default 0.004) to ``coarse`` (default :data:`~qualgrasp.qualitative.vision.outline.SCALE_MAX`, 0.032).
+        From ``fine`` (default 0.004) to ``coarse`` (default
+        :data:`~qualgrasp.qualitative.vision.outline.SCALE_MAX`, 0.032).
 
     Examples
     --------
