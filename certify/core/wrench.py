@@ -15,6 +15,7 @@ from typing import Sequence
 
 import numpy as np
 
+from . import exact as ex
 from .. import models as registry
 from ..errors import ArgumentError
 from .._kernels.linalg import ETA
@@ -34,6 +35,8 @@ __all__ = [
     "grasp_arrays",
     "variants_of",
     "force_column_errors",
+    "planar_generator_rank",
+    "planar_pair_normal",
 ]
 
 
@@ -188,6 +191,89 @@ def generator_columns(P, N, mu, models, center, length, *, frictionless: bool = 
             Pk = np.where((offset != 0)[:, None], Pk + (conv(offset) * width[..., owner])[..., None] * T, Pk)
     W = wrench(Pk, F, np.asarray(center)[..., None, :], np.asarray(length)[..., None])
     return np.swapaxes(W, -1, -2), owner
+
+
+def planar_generator_rank(P, N, mu, width, owner, offset, friction, cols=None) -> int:
+    """Exact rank of the planar generator columns of one grasp (:func:`generator_columns`'
+    formulas on the float data, in exact arithmetic), or of the generators ``cols`` only.
+
+    The torque row ``((q - c) x f) / L`` is ``(q x f - c x f) / L``, a row operation away from
+    ``q x f``, so the rank does not depend on ``center`` and ``length``; the rows ``f_x, f_y,
+    q x f`` are evaluated in integers (every float scaled by ``2**1074``) and ranked by
+    :func:`qualgrasp.certify.core.exact.rank`. The same rank as
+    ``exact.rank(generator_columns(...exact...))``, without building Fractions.
+
+    Parameters
+    ----------
+    P, N : array, shape (m, 2)
+        Contact points and inward unit normals (floats, as the grasp stores them).
+    mu, width : array, shape (m,)
+    owner, offset, friction : array, shape (k,)
+        The generator layout (:func:`generator_layout`).
+    cols : sequence of int, optional
+        Generators to rank (default all).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> P = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]])
+    >>> owner, offset, friction = np.arange(3), np.zeros(3), np.zeros(3)
+    >>> planar_generator_rank(P, -P, np.zeros(3), np.zeros(3), owner, offset, friction)  # through 0
+    2
+    >>> planar_generator_rank(P + 0.5, -P, np.zeros(3), np.zeros(3), owner, offset, friction)
+    2
+    >>> planar_generator_rank(P, -P[[1, 2, 0]], np.zeros(3), np.zeros(3), owner, offset, friction)
+    3
+    """
+    rows: list[list[int]] = [[], [], []]
+    for j in (range(len(owner)) if cols is None else cols):
+        fx, fy, qx, qy = _generator_integers(P, N, mu, width, owner, offset, friction, j)
+        rows[0].append(fx)
+        rows[1].append(fy)
+        rows[2].append(qx * fy - qy * fx)
+    return ex.rank(rows)
+
+
+def _generator_integers(P, N, mu, width, owner, offset, friction, j) -> tuple[int, int, int, int]:
+    """Force ``f = n + s t`` and point ``q = p + o t`` of planar generator ``j``
+    (:func:`generator_columns`), exactly, as integers: the values times ``DYADIC**3``."""
+    S = ex.DYADIC
+    i = int(owner[j])
+    nx, ny, px, py = (ex.dyadic_integer(v) for v in (N[i, 0], N[i, 1], P[i, 0], P[i, 1]))
+    sm = ex.dyadic_integer(friction[j]) * ex.dyadic_integer(mu[i]) if friction[j] != 0 else 0
+    so = ex.dyadic_integer(offset[j]) * ex.dyadic_integer(width[i]) if offset[j] != 0 else 0
+    return (nx * S * S - sm * ny, ny * S * S + sm * nx,  # t = (-n_y, n_x)
+            px * S * S - so * ny, py * S * S + so * nx)
+
+
+def planar_pair_normal(P, N, mu, width, center, length, owner, offset, friction) -> tuple[int, int, int]:
+    """A positive multiple of the cross product ``w_0 x w_1`` of the exact wrenches of a planar
+    grasp with two generators (:func:`generator_columns`' formulas in exact arithmetic), as
+    integers: the direction orthogonal to both, exactly (zero when they are parallel).
+
+    With ``T_j = (q_j - c) x f_j`` the wrench is ``(f_j, T_j / L)``; ``L (w_0 x w_1)`` is
+    ``(f_0y T_1 - T_0 f_1y, T_0 f_1x - f_0x T_1, L (f_0 x f_1))``, every term a product of
+    floats, evaluated in integers (:func:`qualgrasp.certify.core.exact.dyadic_integer`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> P, N = np.array([[1.0, 0.0], [-1.0, 0.0]]), np.array([[-1.0, 0.0], [1.0, 0.0]])
+    >>> z = planar_pair_normal(P, N, np.zeros(2), np.zeros(2), np.zeros(2), 1.0, np.arange(2),
+    ...                        np.zeros(2), np.zeros(2))
+    >>> [v != 0 for v in z]  # antipodal: the wrenches are opposite, parallel
+    [False, False, False]
+    """
+    S = ex.DYADIC
+    cx, cy = (ex.dyadic_integer(v) * S * S for v in center[:2])
+    f, T = [], []
+    for j in range(2):
+        fx, fy, qx, qy = _generator_integers(P, N, mu, width, owner, offset, friction, j)
+        f.append((fx, fy))
+        T.append((qx - cx) * fy - (qy - cy) * fx)
+    (f0x, f0y), (f1x, f1y) = f
+    L = ex.dyadic_integer(length)
+    return (f0y * T[1] - T[0] * f1y, T[0] * f1x - f0x * T[1], L * S * S * (f0x * f1y - f0y * f1x))
 
 
 def force_columns(P, N, models, center, length):
