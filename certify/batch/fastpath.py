@@ -33,7 +33,7 @@ import scipy.sparse as sp
 
 from .._kernels.barrier import barrier_batch
 from .._kernels.linalg import U as U_ROUND, projection_bound, world_values
-from .._kernels.planar import planar_batch, planar_generators
+from .._kernels.planar import planar_batch, planar_generators, thin_screen
 from .._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
 from ..core.certificates import Tolerances, verify
 from ..core.closure import decide, farkas_from_arrays
@@ -50,7 +50,7 @@ from ..solvers.squeeze import squeeze_farkas
 from ..files.reader import rows_to_table
 from ._arrow import assemble, group_table
 from .. import models as registry
-from ..core.exact import dyadic_integer
+from ..core.exact import dyadic_integers
 from ..core.wrench import (force_column_errors, force_columns, generator_columns, generator_layout,
                            planar_generator_rank, planar_pair_normal)
 
@@ -234,37 +234,60 @@ def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
                 code[i], verified[i] = 3, ok
         return (code, t, lam, basis, y), tight_rows, verified
     U, sv, _ = np.linalg.svd(W, full_matrices=False) if len(rows) else (None, np.ones((0, 1)), None)
+    thin_rows = np.flatnonzero(sv[:, -1] <= tol.rank * sv[:, 0])
+    if not len(thin_rows):
+        return (code, t, lam, basis, y), tight_rows, verified
+    at = rows[thin_rows]
+    frictionless = not offset.any() and not friction.any()
+    ok, yf, tight, proved, full = thin_screen(np.ascontiguousarray(W[thin_rows]), np.ascontiguousarray(E[thin_rows]),
+                                              np.ascontiguousarray(y[at]), np.ascontiguousarray(t[at]), tol.margin,
+                                              1e-7, np.ascontiguousarray(P[at]), np.ascontiguousarray(N[at]),
+                                              owner, frictionless)
+    has_y = np.any(y[at] != 0, axis=1)
+    strict = has_y & ok & ~tight.any(axis=1)
+    code[at[strict & proved]] = 2
+    y[at[strict & proved]] = yf[strict & proved]
+    code[at[has_y & ~ok & full]] = 5  # no certificate from the dual direction, exact rank 3
+    # every generator tight, exact rank 3: nothing is left once projected, the checker refuses it
+    refused = has_y & ok & tight.all(axis=1) & full
+    code[at[refused]], y[at[refused]], verified[at[refused]] = 3, yf[refused], False
     cone, first, ones = _ray_blocks(k)
     arrays = (cone, first, ones, np.zeros((k, 2)), np.zeros(k), np.zeros(k))
     solver = make_solver("fast")
-    for r in np.flatnonzero(sv[:, -1] <= tol.rank * sv[:, 0]):
-        i = rows[r]
-        exact_rank = lambda cols=None, i=i: planar_generator_rank(  # noqa: E731
-            P[i], N[i], mu[i], width[i], owner, offset, friction, cols)
+    for q in np.flatnonzero(~has_y | (ok & ~strict & ~refused) | (~ok & ~full)):
+        r, i = thin_rows[q], at[q]
+        rank_all = []  # the exact rank of every generator, computed once
+
+        def exact_rank(cols=None, i=i, rank_all=rank_all):
+            if cols is not None and len(cols) < k:
+                return planar_generator_rank(P[i], N[i], mu[i], width[i], owner, offset, friction, cols)
+            if not rank_all:
+                rank_all.append(3 if full[q] else
+                                planar_generator_rank(P[i], N[i], mu[i], width[i], owner, offset, friction))
+            return rank_all[0]
+
         pair_normal = lambda cols, i=i: planar_pair_normal(  # noqa: E731
             P[i], N[i], mu[i], width[i], c[i], L[i], owner[cols], offset[cols], friction[cols])
-        ti, yi = t[i], y[i]
-        if not np.any(yi != 0):  # no dual basis: the fast solver asks clarabel, as grasp by grasp
+        if has_y[q]:
+            yc, mask = (yf[q], tight[q]) if ok[q] else (None, None)
+        else:  # no dual basis: the fast solver asks clarabel, as grasp by grasp
             ti, yi = _solve_generators(solver, W[r])
-        cert = None if yi is None or not ti < tol.margin else farkas_from_arrays(W[r], arrays, "generators", yi)
-        if cert is not None:
-            yc = np.array(cert.y)
-            mask = np.zeros(k, dtype=bool)
-            mask[list(cert.tight)] = True
-        elif exact_rank() == 3:
-            code[i] = 5
-            continue
-        else:
+            cert = None if yi is None or not ti < tol.margin else farkas_from_arrays(W[r], arrays, "generators", yi)
+            yc, mask = (None, None) if cert is None else (np.array(cert.y), np.isin(np.arange(k), cert.tight))
+        if yc is None:
+            if exact_rank() == 3:
+                code[i] = 5
+                continue
             yc, mask = U[r, :, -1], np.ones(k, dtype=bool)
         if not mask.any():
             if verify_farkas_general(W[r], E[r], *arrays, yc, mask, 0.0):
                 code[i], y[i] = 2, yc
             continue
-        ok, shift = _orthogonal(W[r], E[r], np.flatnonzero(mask), exact_rank, pair_normal, yc)
-        if ok and not mask.all():
-            ok = None if not verify_farkas_general(W[r], E[r], *arrays, yc, mask, shift) else ok
-        if ok is not None:
-            code[i], y[i], verified[i] = (3 if mask.all() else 4), yc, ok
+        proof, shift = _orthogonal(W[r], E[r], np.flatnonzero(mask), exact_rank, pair_normal, yc)
+        if proof and not mask.all():
+            proof = None if not verify_farkas_general(W[r], E[r], *arrays, yc, mask, shift) else proof
+        if proof is not None:
+            code[i], y[i], verified[i] = (3 if mask.all() else 4), yc, proof
             if not mask.all():
                 tight_rows[int(i)] = np.flatnonzero(mask)
     return (code, t, lam, basis, y), tight_rows, verified
@@ -304,7 +327,7 @@ def _pair_orthogonal(z, y) -> bool | None:
     to its projection off their span is ``|y| sin(y, z)``, compared with ``1e-6 |y|`` exactly in
     integers: True below half of it, False above twice of it (the checker's own rounding
     cannot cross those), None otherwise or for parallel generators."""
-    Y = [dyadic_integer(v) for v in y]
+    Y = dyadic_integers(y)[0]
     nz = sum(v * v for v in z)
     ny = sum(v * v for v in Y)
     if nz == 0 or ny == 0:

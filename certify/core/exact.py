@@ -13,25 +13,24 @@ import math
 from fractions import Fraction
 from typing import Sequence
 
-__all__ = ["row_echelon", "rank", "solve", "independent_columns", "project_out", "DYADIC", "dyadic_integer"]
+__all__ = ["row_echelon", "rank", "solve", "independent_columns", "project_out", "dyadic_integers"]
 
-DYADIC = 1 << 1074
-"""Every finite float times this is an integer (:func:`dyadic_integer`)."""
+Matrix = Sequence[Sequence[Fraction]]
 
 
-def dyadic_integer(v: float) -> int:
-    """The float ``v`` times :data:`DYADIC`, an exact integer (integer arithmetic on scaled
-    floats is exact and much cheaper than :class:`~fractions.Fraction`).
+def dyadic_integers(values) -> tuple[list[int], int]:
+    """The floats ``values`` times ``2**s``, for the least ``s >= 0`` making them all integers:
+    ``(integers, s)``. Integer arithmetic on them is exact and much cheaper than
+    :class:`~fractions.Fraction` (and than a fixed scale such as ``2**1074``).
 
     Examples
     --------
-    >>> dyadic_integer(0.75) == 3 * DYADIC // 4, dyadic_integer(-2.0) == -2 * DYADIC
-    (True, True)
+    >>> dyadic_integers([0.75, -2.0, 3.0])
+    ([3, -8, 12], 2)
     """
-    num, den = float(v).as_integer_ratio()
-    return num * (DYADIC // den)
-
-Matrix = Sequence[Sequence[Fraction]]
+    ratios = [float(v).as_integer_ratio() for v in values]
+    s = max((den.bit_length() - 1 for _, den in ratios), default=0)
+    return [num << (s - den.bit_length() + 1) for num, den in ratios], s
 
 
 def row_echelon(A: Matrix) -> tuple[list[list[Fraction]], list[int]]:

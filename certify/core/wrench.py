@@ -199,7 +199,7 @@ def planar_generator_rank(P, N, mu, width, owner, offset, friction, cols=None) -
 
     The torque row ``((q - c) x f) / L`` is ``(q x f - c x f) / L``, a row operation away from
     ``q x f``, so the rank does not depend on ``center`` and ``length``; the rows ``f_x, f_y,
-    q x f`` are evaluated in integers (every float scaled by ``2**1074``) and ranked by
+    q x f`` are evaluated in integers (every float scaled by one power of two) and ranked by
     :func:`qualgrasp.certify.core.exact.rank`. The same rank as
     ``exact.rank(generator_columns(...exact...))``, without building Fractions.
 
@@ -225,25 +225,33 @@ def planar_generator_rank(P, N, mu, width, owner, offset, friction, cols=None) -
     >>> planar_generator_rank(P, -P[[1, 2, 0]], np.zeros(3), np.zeros(3), owner, offset, friction)
     3
     """
-    rows: list[list[int]] = [[], [], []]
-    for j in (range(len(owner)) if cols is None else cols):
-        fx, fy, qx, qy = _generator_integers(P, N, mu, width, owner, offset, friction, j)
-        rows[0].append(fx)
-        rows[1].append(fy)
-        rows[2].append(qx * fy - qy * fx)
-    return ex.rank(rows)
+    cols = range(len(owner)) if cols is None else cols
+    fx, fy, qx, qy, _, _ = _generator_integers(P, N, mu, width, (0.0, 0.0), owner, offset, friction, cols)
+    return ex.rank([fx, fy, [a * d - b * c for a, b, c, d in zip(qx, qy, fx, fy)]])
 
 
-def _generator_integers(P, N, mu, width, owner, offset, friction, j) -> tuple[int, int, int, int]:
-    """Force ``f = n + s t`` and point ``q = p + o t`` of planar generator ``j``
-    (:func:`generator_columns`), exactly, as integers: the values times ``DYADIC**3``."""
-    S = ex.DYADIC
-    i = int(owner[j])
-    nx, ny, px, py = (ex.dyadic_integer(v) for v in (N[i, 0], N[i, 1], P[i, 0], P[i, 1]))
-    sm = ex.dyadic_integer(friction[j]) * ex.dyadic_integer(mu[i]) if friction[j] != 0 else 0
-    so = ex.dyadic_integer(offset[j]) * ex.dyadic_integer(width[i]) if offset[j] != 0 else 0
-    return (nx * S * S - sm * ny, ny * S * S + sm * nx,  # t = (-n_y, n_x)
-            px * S * S - so * ny, py * S * S + so * nx)
+def _generator_integers(P, N, mu, width, center, owner, offset, friction, cols):
+    """Forces ``f = n + s t`` and points ``q = p + o t`` of the planar generators ``cols``
+    (:func:`generator_columns`), and the ``center``, exactly, as integers: every value times one
+    power of two (:func:`qualgrasp.certify.core.exact.dyadic_integers`), cubed for ``f``, ``q``
+    and the center. Returns ``(fx, fy, qx, qy, (cx, cy), S)`` with ``S`` that power."""
+    cols = list(cols)
+    own = [int(owner[j]) for j in cols]
+    floats = [v for i in own for v in (N[i, 0], N[i, 1], P[i, 0], P[i, 1], mu[i], width[i])]
+    floats += [v for j in cols for v in (offset[j], friction[j])] + [center[0], center[1]]
+    ints, s = ex.dyadic_integers(floats)
+    S2 = 1 << (2 * s)
+    fx, fy, qx, qy = [], [], [], []
+    for a, j in enumerate(cols):
+        nx, ny, px, py, mu_i, w_i = ints[6 * a: 6 * a + 6]
+        off, fr = ints[6 * len(cols) + 2 * a: 6 * len(cols) + 2 * a + 2]
+        sm, so = fr * mu_i, off * w_i
+        fx.append(nx * S2 - sm * ny)  # t = (-n_y, n_x)
+        fy.append(ny * S2 + sm * nx)
+        qx.append(px * S2 - so * ny)
+        qy.append(py * S2 + so * nx)
+    cx, cy = ints[-2] * S2, ints[-1] * S2
+    return fx, fy, qx, qy, (cx, cy), 1 << s
 
 
 def planar_pair_normal(P, N, mu, width, center, length, owner, offset, friction) -> tuple[int, int, int]:
@@ -253,7 +261,7 @@ def planar_pair_normal(P, N, mu, width, center, length, owner, offset, friction)
 
     With ``T_j = (q_j - c) x f_j`` the wrench is ``(f_j, T_j / L)``; ``L (w_0 x w_1)`` is
     ``(f_0y T_1 - T_0 f_1y, T_0 f_1x - f_0x T_1, L (f_0 x f_1))``, every term a product of
-    floats, evaluated in integers (:func:`qualgrasp.certify.core.exact.dyadic_integer`).
+    floats, evaluated in integers (:func:`qualgrasp.certify.core.exact.dyadic_integers`).
 
     Examples
     --------
@@ -264,16 +272,12 @@ def planar_pair_normal(P, N, mu, width, center, length, owner, offset, friction)
     >>> [v != 0 for v in z]  # antipodal: the wrenches are opposite, parallel
     [False, False, False]
     """
-    S = ex.DYADIC
-    cx, cy = (ex.dyadic_integer(v) * S * S for v in center[:2])
-    f, T = [], []
-    for j in range(2):
-        fx, fy, qx, qy = _generator_integers(P, N, mu, width, owner, offset, friction, j)
-        f.append((fx, fy))
-        T.append((qx - cx) * fy - (qy - cy) * fx)
-    (f0x, f0y), (f1x, f1y) = f
-    L = ex.dyadic_integer(length)
-    return (f0y * T[1] - T[0] * f1y, T[0] * f1x - f0x * T[1], L * S * S * (f0x * f1y - f0y * f1x))
+    fx, fy, qx, qy, (cx, cy), S = _generator_integers(P, N, mu, width, center, owner, offset, friction, range(2))
+    T = [(qx[j] - cx) * fy[j] - (qy[j] - cy) * fx[j] for j in range(2)]  # scale S^6
+    (L,), s = ex.dyadic_integers([length])
+    # f is scaled by S^3, T by S^6, L by 2^s: bring L f_0 x f_1 to S^9
+    z2 = (fx[0] * fy[1] - fy[0] * fx[1]) * L * S ** 3
+    return (fy[0] * T[1] - T[0] * fy[1]) << s, (T[0] * fx[1] - fx[0] * T[1]) << s, z2
 
 
 def force_columns(P, N, models, center, length):
