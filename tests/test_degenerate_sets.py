@@ -6,7 +6,9 @@ from fractions import Fraction
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
+from typer.testing import CliRunner
 
+from qualgrasp.cli import app
 from qualgrasp.certify.batch import certify_file, verify_file
 from qualgrasp.certify.batch.chunk import Options, certify_values
 from qualgrasp.certify.batch.fastpath import certify_table
@@ -109,3 +111,24 @@ def test_exact_rank_of_integers_and_fractions():
     assert ex.rank([[0, 0], [0, 0]]) == 0
     big = 1 << 3000
     assert ex.rank([[big, 1], [big * big, big]]) == 1
+
+
+def test_sample_degenerate_command(tmp_path):
+    """qualgrasp sample --degenerate KIND writes the kind's grasps; a bad kind, --dim 3 or one
+    contact is a one-line error with exit code 2."""
+    runner = CliRunner()
+    out = tmp_path / "d.parquet"
+    result = runner.invoke(app, ["sample", str(out), "--n", "7", "--contacts", "2", "--degenerate", "antipodal-disc"])
+    assert result.exit_code == 0, result.output
+    rows = pq.read_table(out).to_pylist()
+    assert len(rows) == 7
+    for row in rows:  # each contact on the other's normal line, normals opposite
+        (a, b) = row["contacts"]
+        d = np.subtract(b["p"], a["p"])
+        assert abs(d[0] * a["n"][1] - d[1] * a["n"][0]) < 1e-9 and np.allclose(a["n"], np.negative(b["n"]))
+    for args, words in ((["--degenerate", "round"], "--degenerate must be one of"),
+                        (["--degenerate", "mixed", "--dim", "3"], "planar grasps only"),
+                        (["--degenerate", "mixed", "--contacts", "1"], "at least 2 contacts")):
+        result = runner.invoke(app, ["sample", str(tmp_path / "x.parquet"), "--n", "3", *args])
+        lines = [line for line in result.output.strip().splitlines() if line.strip()]
+        assert result.exit_code == 2 and len(lines) == 1 and words in lines[0], result.output

@@ -8,12 +8,12 @@ import numpy as np
 
 from .epsilon import planar_epsilon_one
 from .jit import kernel
-from .linalg import ETA, U, gamma, null_direction, pivot_basis_into, thin
+from .linalg import ETA, U, gamma, null_direction, pivot_basis_into, projection_bound, thin
 from .cones import farkas_direction
 from .lp import lp_planar_one
 from .recheck import verify_farkas_general, verify_interior_general, verify_null_general
 
-__all__ = ["DUAL_BELOW", "planar_generators", "planar_batch", "thin_screen"]
+__all__ = ["DUAL_BELOW", "planar_generators", "planar_batch", "thin_screen", "pair_null_rows"]
 
 #: The LP's dual bases are scanned only below this optimum (a verdict against closure, or a
 #: near-degenerate one, needs the dual direction; a clear closure does not).
@@ -266,7 +266,88 @@ def _full_rank(P, N, owner):
 
 
 @kernel
-def thin_screen(W, E, Y, T, margin, rel, P, N, owner, frictionless):
+def _at_most_two(P, N, width, owner, one_each):
+    """Proof that the exact generators (no friction edges: forces along the normals) have rank
+    at most 2: every normal parallel to the first (``n_i x n_0 = 0`` exactly, by comparing
+    error-free products: the force rows are then proportional), or, with one generator per
+    contact (``one_each``: no pad offsets), at most two distinct contacts (point, normal and
+    width equal as floats: equal generators)."""
+    i0 = owner[0]
+    a, b = N[i0, 0], N[i0, 1]
+    parallel = not (a == 0.0 and b == 0.0) and _in_range(a) and _in_range(b)
+    second = -1
+    two = one_each
+    for j in range(1, owner.shape[0]):
+        i = owner[j]
+        if parallel:
+            if not (_in_range(N[i, 0]) and _in_range(N[i, 1])):
+                parallel = False
+            else:
+                p, e = _two_prod(a, N[i, 1])
+                q, f = _two_prod(b, N[i, 0])
+                parallel = p == q and e == f
+        if two and i != i0 and not _same_contact(P, N, width, i, i0):
+            if second < 0:
+                second = i
+            elif i != second and not _same_contact(P, N, width, i, second):
+                two = False
+        if not (parallel or two):
+            return False
+    return True
+
+
+@kernel
+def _same_contact(P, N, width, i, j):
+    return (P[i, 0] == P[j, 0] and P[i, 1] == P[j, 1] and N[i, 0] == N[j, 0] and N[i, 1] == N[j, 1]
+            and width[i] == width[j])
+
+
+@kernel
+def pair_null_rows(W, E, Y):
+    """For matrices ``W`` (B, 3, k) whose exact generators have rank at most 2, does the exact
+    checker accept ``Y[b]`` as orthogonal to all of them? 1 proved (two generators proved
+    independent in floats: the rank is 2 and their span is the generators'; the exact
+    projection of ``y`` onto it is within ``1e-6 |y|``, :func:`projection_bound`), 0 refuted (a
+    generator's functional on ``y`` alone is beyond twice that), -1 undecided."""
+    B, d, k = W.shape
+    out = np.full(B, -1, dtype=np.int64)
+    C2 = np.empty((3, 2))
+    E2 = np.empty((3, 2))
+    g = gamma(5)
+    for b in range(B):
+        y = Y[b]
+        ny = np.sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2])
+        found = False
+        for a in range(k):
+            for c in range(a + 1, k):
+                for i in range(3):
+                    C2[i, 0], C2[i, 1] = W[b, i, a], W[b, i, c]
+                    E2[i, 0], E2[i, 1] = E[b, i, a], E[b, i, c]
+                bound = projection_bound(C2, E2, y)
+                if np.isfinite(bound):
+                    found = True
+                    if bound <= 1e-6 * ny * (1.0 - 8 * U):
+                        out[b] = 1
+                    break
+            if found:
+                break
+        if out[b] == 1:
+            continue
+        for j in range(k):  # |projection| >= |c . y| / |c| for any one generator c
+            acc, err, nc = 0.0, 0.0, 0.0
+            for i in range(3):
+                acc += W[b, i, j] * y[i]
+                err += (E[b, i, j] + g * abs(W[b, i, j])) * abs(y[i])
+                nc += (abs(W[b, i, j]) + E[b, i, j]) ** 2
+            nc = np.sqrt(nc) * (1 + 4 * U)
+            if (abs(acc) - err) * (1 - 4 * U) > 2e-6 * ny * (1 + 4 * U) * nc:
+                out[b] = 0
+                break
+    return out
+
+
+@kernel
+def thin_screen(W, E, Y, T, margin, rel, P, N, width, owner, no_friction, no_offset):
     """The columnar part of the rule for numerically rank-deficient planar generator matrices
     (``qualgrasp.certify.batch.fastpath``): for each of the ``B`` matrices ``W`` (B, 3, k) with
     error bounds ``E``, the solver's direction ``Y`` (B, 3) and optimum ``T`` (B,):
@@ -275,13 +356,16 @@ def thin_screen(W, E, Y, T, margin, rel, P, N, owner, frictionless):
       :func:`qualgrasp.certify.core.closure.farkas_from_arrays` (same kernel, every generator a
       ray): ``ok``, its direction ``yf`` and tight generators ``tight``, and for a strict
       direction its rigorous float re-check ``proved``;
-    * with ``frictionless`` generators at the contacts (``owner``: no friction edges, no pad
-      offsets), ``full``: rank 3 of the exact generators proved in floats (:func:`_full_rank`).
+    * with generators without friction edges (``no_friction``; ``owner`` their contacts),
+      ``at_most_two``: rank at most 2 proved (:func:`_at_most_two`); without pad offsets as
+      well (``no_offset``), ``full``: rank 3 of the exact generators proved in floats
+      (:func:`_full_rank`).
     """
     B, d, k = W.shape
     ok = np.zeros(B, dtype=np.bool_)
     proved = np.zeros(B, dtype=np.bool_)
     full = np.zeros(B, dtype=np.bool_)
+    parallel = np.zeros(B, dtype=np.bool_)
     yf = np.zeros((B, 3))
     tight = np.zeros((B, k), dtype=np.bool_)
     rays = np.zeros(k, dtype=np.int64)
@@ -296,6 +380,8 @@ def thin_screen(W, E, Y, T, margin, rel, P, N, owner, frictionless):
             tight[b, :] = tt
             if ok[b] and not tt.any():
                 proved[b] = verify_farkas_general(W[b], E[b], rays, first, ones, n0, z, z, yf[b], tt, 0.0)
-        if frictionless:
+        if no_friction and no_offset:
             full[b] = _full_rank(P[b], N[b], owner)
-    return ok, yf, tight, proved, full
+        if no_friction and not full[b]:
+            parallel[b] = _at_most_two(P[b], N[b], width[b], owner, no_offset)
+    return ok, yf, tight, proved, full, parallel

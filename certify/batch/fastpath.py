@@ -15,9 +15,16 @@ grouped by contact pattern (dimension, contact count, each contact's model and v
   built (the squeeze rule, then clarabel); form closure with six or more contacts by the fast
   solver's own route.
 
-Every row these rules do not settle (invalid input, numerically thin or near-degenerate problems,
-certificates the float re-check cannot prove, spatial rows that need the epsilon) goes through
-the per-grasp path, so the two agree by construction. This module solves; the results tables
+Planar rows whose generator matrix is numerically rank deficient (normals through one point:
+antipodal grasps of discs, squares grasped through the centre; repeated or collinear contacts) are
+decided by the per-grasp rules on the arrays (:func:`_planar_thin`: the dual direction's Farkas
+certificate, clarabel where the enumeration has no dual direction, the exact rank in integers or
+proved in floats), each certificate's exact re-check decided without Fractions; a certificate the
+per-grasp path states but its exact re-check refuses is stated the same, unverified.
+
+Every row these rules do not settle (invalid input, near-degenerate problems, certificates the
+float re-check cannot decide, spatial rows that need the epsilon) goes through the per-grasp
+path, so the two agree by construction. This module solves; the results tables
 are built in Arrow by ``qualgrasp.certify.batch._arrow``.
 """
 
@@ -33,7 +40,7 @@ import scipy.sparse as sp
 
 from .._kernels.barrier import barrier_batch
 from .._kernels.linalg import U as U_ROUND, projection_bound, world_values
-from .._kernels.planar import planar_batch, planar_generators, thin_screen
+from .._kernels.planar import pair_null_rows, planar_batch, planar_generators, thin_screen
 from .._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
 from ..core.certificates import Tolerances, verify
 from ..core.closure import decide, farkas_from_arrays
@@ -238,11 +245,10 @@ def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
     if not len(thin_rows):
         return (code, t, lam, basis, y), tight_rows, verified
     at = rows[thin_rows]
-    frictionless = not offset.any() and not friction.any()
-    ok, yf, tight, proved, full = thin_screen(np.ascontiguousarray(W[thin_rows]), np.ascontiguousarray(E[thin_rows]),
-                                              np.ascontiguousarray(y[at]), np.ascontiguousarray(t[at]), tol.margin,
-                                              1e-7, np.ascontiguousarray(P[at]), np.ascontiguousarray(N[at]),
-                                              owner, frictionless)
+    ok, yf, tight, proved, full, parallel = thin_screen(
+        np.ascontiguousarray(W[thin_rows]), np.ascontiguousarray(E[thin_rows]), np.ascontiguousarray(y[at]),
+        np.ascontiguousarray(t[at]), tol.margin, 1e-7, np.ascontiguousarray(P[at]), np.ascontiguousarray(N[at]),
+        np.ascontiguousarray(width[at]), owner, not friction.any(), not offset.any())
     has_y = np.any(y[at] != 0, axis=1)
     strict = has_y & ok & ~tight.any(axis=1)
     code[at[strict & proved]] = 2
@@ -254,7 +260,18 @@ def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
     cone, first, ones = _ray_blocks(k)
     arrays = (cone, first, ones, np.zeros((k, 2)), np.zeros(k), np.zeros(k))
     solver = make_solver("fast")
-    for q in np.flatnonzero(~has_y | (ok & ~strict & ~refused) | (~ok & ~full)):
+    # rank at most 2 (parallel normals, two distinct contacts): the all-tight direction, or the last singular vector
+    # when the dual direction gives no certificate, decided in one compiled pass
+    pair = has_y & parallel & (~ok | tight.all(axis=1))
+    if pair.any():
+        yp = np.where(ok[pair][:, None], yf[pair], U[thin_rows[pair], :, -1])
+        state = pair_null_rows(np.ascontiguousarray(W[thin_rows[pair]]), np.ascontiguousarray(E[thin_rows[pair]]),
+                               np.ascontiguousarray(yp))
+        done = state >= 0
+        sel = at[pair][done]
+        code[sel], y[sel], verified[sel] = 3, yp[done], state[done] == 1
+        pair[np.flatnonzero(pair)[~done]] = False
+    for q in np.flatnonzero((~has_y | (ok & ~strict & ~refused) | (~ok & ~full)) & ~pair):
         r, i = thin_rows[q], at[q]
         rank_all = []  # the exact rank of every generator, computed once
 
