@@ -13,7 +13,11 @@ grasps (a prefix of them for the slow routes):
 * **exact verify**: the rational-arithmetic checker on the per-grasp certificates.
 
 The table gives microseconds per grasp, grasps per second and each route's time per grasp as a
-multiple of the batch path's. Speeds are single-process; ``qualgrasp certify --workers N`` runs N
+multiple of the batch path's. The **degenerate planar** rows time the batch path, without and with
+quality, on a degenerate planar set (``qualgrasp sample --degenerate mixed``: normals through one
+point, repeated or collinear contacts) and on a generic set of the same size, model and contact
+count, in the same run; their ratio is the degenerate set's time per grasp as a multiple of the
+generic set's. Speeds are single-process; ``qualgrasp certify --workers N`` runs N
 such processes.
 
 ``qualgrasp bench --quality`` times epsilon on small grasps (bound gaps, the 8-edge linearisation
@@ -32,15 +36,16 @@ from rich.console import Console
 from rich.progress import Progress
 from rich.table import Table
 
-from ..certify.batch import Options, certify_table, random_grasps
+from ..certify.batch import Options, certify_table, random_grasp_table, random_grasps
 from ..certify.core import Grasp, force_closure, form_closure, grasp_to_dict, verify
 from ..certify.core.problem import grasp_system
 from ..certify.files import grasps_table
+from ..certify.files.columns import grasp_columns
 from ..certify.quality.bounds import check_norm, epsilon, epsilon_of_points, epsilons
 from ..certify.report import certify_grasp
 from ..certify.solvers import make_solver
 
-__all__ = ["KINDS", "BenchRow", "run_bench", "print_bench", "CONTACTS", "ContactsRow", "epsilon_linearised",
+__all__ = ["KINDS", "DEGENERATE_KIND", "BenchRow", "run_bench", "print_bench", "CONTACTS", "ContactsRow", "epsilon_linearised",
            "run_contacts_bench", "print_contacts_bench"]
 
 #: name -> keyword arguments of :func:`qualgrasp.certify.batch.samples.random_grasp`
@@ -52,6 +57,11 @@ KINDS = {
     "spatial point, 3 contacts": dict(dim=3, n_contacts=3, model="point", spread=0.3),
     "spatial soft, 2 contacts": dict(dim=3, n_contacts=2, model="soft", spread=0.15),
 }
+
+
+#: The degenerate planar set of the benchmark, :func:`~qualgrasp.certify.batch.samples.random_grasp_table`'s
+#: keyword arguments (its generic counterpart drops ``degenerate``).
+DEGENERATE_KIND = dict(dim=2, n_contacts=4, model="point", degenerate="mixed")
 
 
 @dataclass(frozen=True)
@@ -76,20 +86,46 @@ def _time(fn, items, progress=None) -> float:
     return time.perf_counter() - start
 
 
-def _batch_seconds(grasps) -> float:
-    """Seconds of the columnar batch path on ``grasps`` (table built outside the timing)."""
+def _batch_seconds(grasps, quality: bool = False, table=None) -> float:
+    """Seconds of the columnar batch path on ``grasps`` (their ``table``, built outside the
+    timing when not given)."""
 
-    table = grasps_table([grasp_to_dict(g) for g in grasps])
+    table = grasps_table([grasp_to_dict(g) for g in grasps]) if table is None else table
     lines = list(range(1, len(grasps) + 1))
-    options = Options(quality=False)
+    options = Options(quality=quality)
 
     def slow(idx):
-        return [certify_grasp(grasps[i], quality=False).row(line=lines[i]) for i in idx]
+        return [certify_grasp(grasps[i], quality=quality).row(line=lines[i]) for i in idx]
 
     certify_table(table.slice(0, 8), lines[:8], options, slow=slow)  # compile outside the timing
     start = time.perf_counter()
     certify_table(table, lines, options, slow=slow)
     return time.perf_counter() - start
+
+
+def _degenerate_rows(n: int, seed: int, reference_n: int) -> list[BenchRow]:
+    """The degenerate planar rows: the batch path without and with quality on the degenerate
+    set and on a generic one (same size, model and contacts, same run), ratio to the generic
+    set; and the per-grasp fast route on the degenerate grasps, ratio to the generic batch."""
+    generic = {k: v for k, v in DEGENERATE_KIND.items() if k != "degenerate"}
+    label = (f"degenerate planar ({DEGENERATE_KIND['degenerate']}, {DEGENERATE_KIND['model']}, "
+             f"{DEGENERATE_KIND['n_contacts']} contacts) vs generic")
+    tables = {"generic": random_grasp_table(seed, n, **generic),
+              "degenerate": random_grasp_table(seed, n, **DEGENERATE_KIND)}
+    grasps = {name: grasp_columns(t).grasps(range(n)) for name, t in tables.items()}
+    rows = []
+    for quality in (False, True):
+        base = _batch_seconds(grasps["generic"], quality, tables["generic"])
+        deg = _batch_seconds(grasps["degenerate"], quality, tables["degenerate"])
+        what = "with quality" if quality else "no quality"
+        rows += [BenchRow(label, f"qualgrasp batch, generic set, {what}", n, base, 1.0),
+                 BenchRow(label, f"qualgrasp batch, degenerate set, {what}", n, deg, deg / base)]
+        if not quality:
+            fast, few = make_solver("fast"), grasps["degenerate"][:max(reference_n, 1)]
+            seconds = _time(lambda g: certify_grasp(g, solver=fast, quality=False), few)
+            rows.append(BenchRow(label, "per-grasp fast route (both certificates), degenerate set", len(few),
+                                 seconds, (seconds / len(few)) / (base / n)))
+    return rows
 
 
 def run_bench(n: int = 20000, seed: int = 0, reference_n: int = 300,
@@ -123,6 +159,9 @@ def run_bench(n: int = 20000, seed: int = 0, reference_n: int = 300,
             for route, count, seconds in routes:
                 rows.append(BenchRow(kind, route, count, seconds, (seconds / count) / t_batch))
             bar.remove_task(task)
+        task = bar.add_task("degenerate planar", total=None)
+        rows += _degenerate_rows(n, seed, reference_n)
+        bar.remove_task(task)
     return rows
 
 

@@ -14,8 +14,14 @@ from ..files.results import CERTIFICATE, RESULT_SCHEMA, carried_name, result_tab
 __all__ = ["list_array", "certificates", "group_table", "assemble", "carry"]
 
 
-_STATUS = pa.array(["no_closure", "closure"])
-_KIND = pa.array(["farkas", "interior"])
+_STATUS = pa.array(["no_closure", "closure", "degenerate"])
+_KIND = pa.array(["farkas", "interior", "degenerate"])
+
+
+def _kind_index(code: np.ndarray) -> pa.Array:
+    """Index into :data:`_STATUS` and :data:`_KIND` of verdict codes (1 closure, 5 degenerate,
+    others no closure)."""
+    return pa.array(np.select([code == 1, code == 5], [1, 2], 0).astype(np.int8))
 
 
 def list_array(values: np.ndarray, valid: np.ndarray | None, type_: pa.DataType) -> pa.Array:
@@ -37,10 +43,11 @@ def certificates(code: np.ndarray, lam: np.ndarray, basis: np.ndarray, y: np.nda
                   tight: dict | None = None) -> pa.Array:
     """Certificate structs from verdict codes: 1 interior (values, basis), 2 strict Farkas,
     3 Farkas orthogonal to every one of the ``blocks`` cone blocks (null space), 4 Farkas with
-    the tight blocks ``tight[row]``."""
+    the tight blocks ``tight[row]``, 5 degenerate (reason ``rank``)."""
     n, k = lam.shape
     nb = k if blocks is None else blocks
     interior = code == 1
+    degenerate = code == 5
     lengths = np.where(code == 3, nb, 0).astype(np.int32)
     extra = {r: np.asarray(v, dtype=np.int32) for r, v in (tight or {}).items() if code[r] == 4}
     for r, v in extra.items():
@@ -53,17 +60,18 @@ def certificates(code: np.ndarray, lam: np.ndarray, basis: np.ndarray, y: np.nda
         flat[(offsets[null_rows][:, None] + np.arange(nb)).ravel()] = np.tile(np.arange(nb), len(null_rows))
     for r, v in extra.items():
         flat[offsets[r]:offsets[r + 1]] = v
+    farkas = ~interior & ~degenerate
     tight_arr = pa.ListArray.from_arrays(pa.array(offsets), pa.array(flat, type=pa.int32()),
-                                         mask=pa.array(interior))
+                                         mask=pa.array(~farkas))
     return pa.StructArray.from_arrays([
-        _KIND.take(pa.array(interior.astype(np.int8))),
+        _KIND.take(_kind_index(code)),
         pa.array([layout]).take(pa.array(np.zeros(n, np.int8))),
         list_array(lam, interior, CERTIFICATE.field("values").type),
         list_array(basis.astype(np.int32), interior, CERTIFICATE.field("basis").type),
-        list_array(y, ~interior, CERTIFICATE.field("y").type),
+        list_array(y, farkas, CERTIFICATE.field("y").type),
         tight_arr,
-        pa.array(lengths == nb, mask=interior),
-        pa.nulls(n, pa.string()),
+        pa.array(lengths == nb, mask=~farkas),
+        pa.array(np.where(degenerate, "rank", None), type=pa.string()),
     ], fields=list(CERTIFICATE))
 
 
@@ -92,14 +100,14 @@ def group_table(cols: GraspColumns, rows: np.ndarray, lines: np.ndarray, out, op
         "id": cols.id_column(rows),
         "line": pa.array(lines, type=pa.int64()),
         "dim": pa.array(np.full(n, dim, dtype=np.int8)),
-        "status": _STATUS.take(pa.array(closure.astype(np.int8))),
-        "form_closure": pa.array(fclosure),
-        "force_closure": pa.array(closure),
+        "status": _STATUS.take(_kind_index(code)),
+        "form_closure": pa.array(fclosure, mask=fcode == 5),
+        "force_closure": pa.array(closure, mask=code == 5),
         "margin": pa.array(np.where(closure, t, 0.0)),
-        "form_status": _STATUS.take(pa.array(fclosure.astype(np.int8))),
+        "form_status": _STATUS.take(_kind_index(fcode)),
         "form_margin": pa.array(np.where(fclosure, ft, 0.0)),
         "certificate": cert,
-        "verified": pa.array(np.ones(n, dtype=bool)),
+        "verified": pa.array(out.get("verified", np.ones(n, dtype=bool))),
         "error": pa.nulls(n, pa.string()),
         "center": list_array(np.ascontiguousarray(cols.center[rows, :dim]), None, pa.list_(pa.float64())),
         "length": pa.array(cols.length[rows]),

@@ -15,9 +15,16 @@ grouped by contact pattern (dimension, contact count, each contact's model and v
   built (the squeeze rule, then clarabel); form closure with six or more contacts by the fast
   solver's own route.
 
-Every row these rules do not settle (invalid input, numerically thin or near-degenerate problems,
-certificates the float re-check cannot prove, spatial rows that need the epsilon) goes through
-the per-grasp path, so the two agree by construction. This module solves; the results tables
+Planar rows whose generator matrix is numerically rank deficient (normals through one point:
+antipodal grasps of discs, squares grasped through the centre; repeated or collinear contacts) are
+decided by the per-grasp rules on the arrays (:func:`_planar_thin`: the dual direction's Farkas
+certificate, clarabel where the enumeration has no dual direction, the exact rank in integers or
+proved in floats), each certificate's exact re-check decided without Fractions; a certificate the
+per-grasp path states but its exact re-check refuses is stated the same, unverified.
+
+Every row these rules do not settle (invalid input, near-degenerate problems, certificates the
+float re-check cannot decide, spatial rows that need the epsilon) goes through the per-grasp
+path, so the two agree by construction. This module solves; the results tables
 are built in Arrow by ``qualgrasp.certify.batch._arrow``.
 """
 
@@ -25,16 +32,19 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from itertools import combinations
 
 import numpy as np
 import pyarrow as pa
+import scipy.sparse as sp
 
 from .._kernels.barrier import barrier_batch
-from .._kernels.linalg import projection_bound, world_values
-from .._kernels.planar import planar_batch, planar_generators
+from .._kernels.linalg import U as U_ROUND, projection_bound, world_values
+from .._kernels.planar import pair_null_rows, planar_batch, planar_generators, thin_screen
 from .._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
 from ..core.certificates import Tolerances, verify
 from ..core.closure import decide, farkas_from_arrays
+from ..errors import SolverError
 from ..files.columns import GraspColumns, grasp_columns
 from ..core.cones import LORENTZ, cone_code
 from ..core.grasp import Contact, Grasp
@@ -47,7 +57,9 @@ from ..solvers.squeeze import squeeze_farkas
 from ..files.reader import rows_to_table
 from ._arrow import assemble, group_table
 from .. import models as registry
-from ..core.wrench import force_column_errors, force_columns, generator_columns, generator_layout
+from ..core.exact import dyadic_integers
+from ..core.wrench import (force_column_errors, force_columns, generator_columns, generator_layout,
+                           planar_generator_rank, planar_pair_normal)
 
 __all__ = ["certify_table", "PlanarScreen", "planar_screen"]
 
@@ -170,12 +182,208 @@ def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances
     c, L = cols.center[rows, :2], cols.length[rows]
     (code, t, lam, basis, y, code_f, t_f, lam_f, basis_f, y_f, _) = _planar_kernel(
         P, N, mu, width, c, L, models, variants, tol, False)
-    settled = (code > 0) & (code_f > 0)
     out = {"force": (code, t, lam, basis, y), "form": (code_f, t_f, lam_f, basis_f, y_f)}
+    verified = {}
+    for side, frictionless in (("force", False), ("form", True)):
+        layout = generator_layout(models, variants, 2, frictionless=frictionless)
+        if side == "form" and all(np.array_equal(a, b) for a, b in zip(layout, generator_layout(models, variants, 2))):
+            out["form"], out["form_tight"] = out["force"], out["tight"]  # frictionless: form is force
+            break
+        out[side], out["tight" if side == "force" else "form_tight"], verified[side] = _planar_thin(
+            P, N, mu, width, c, L, layout, out[side], tol)
+    out["verified"] = verified["force"] & verified.get("form", verified["force"])
+    code, code_f = out["force"][0], out["form"][0]
+    settled = (code > 0) & (code_f > 0)
     if options.quality:
         out["eps"] = _planar_quality(cols, rows, (code == 1) & settled, P, N, mu, width, c, L, models,
                                      variants, options)
     return settled, out
+
+
+THIN_CODES = {2: "strict Farkas", 3: "null space", 4: "Farkas with tight generators", 5: "degenerate (rank)"}
+"""Verdict codes :func:`_planar_thin` gives rows whose generators are numerically rank deficient."""
+
+
+def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
+    """Settle the rows of a planar group that the compiled rules leave because their generator
+    matrix is numerically rank deficient (normals through one point, repeated or collinear
+    contacts), by the per-grasp rules of :func:`qualgrasp.certify.core.closure.decide` on the
+    arrays, each certificate's exact re-check decided without rationals.
+
+    With fewer than three generators ``decide`` states the null direction the compiled kernel
+    already tried. With three or more and a singular value ratio at most ``tol.rank`` it takes,
+    in order: the Farkas certificate of the fast solver's dual direction (the kernel's, or
+    clarabel's when the kernel has none, as :class:`qualgrasp.certify.solvers.FastSolver` does;
+    :func:`qualgrasp.certify.core.closure.farkas_from_arrays`, the same call); else, by the exact
+    rank (:func:`qualgrasp.certify.core.wrench.planar_generator_rank`: integers, no Fractions),
+    the null direction of the last left singular vector, or ``degenerate`` (reason ``rank``).
+    The exact re-check is then decided: a strict direction by the rigorous float check; one
+    orthogonal to some generators by :func:`_orthogonal`; ``degenerate`` by the exact rank
+    itself (what the checker recomputes). A certificate proved to fail the re-check is stated
+    unverified, as the per-grasp path states it; rows decided neither way stay unsettled (the
+    per-grasp path). ``verdict`` is the side's ``(code, t, lam, basis, y)``; returns it updated
+    (codes :data:`THIN_CODES`), the tight generators of code-4 rows and the verified flags."""
+    code, t, lam, basis, y = (np.array(a) for a in verdict)
+    verified = np.ones(len(code), dtype=bool)
+    owner, offset, friction = layout
+    k = len(owner)
+    rows = np.flatnonzero(code == 0)
+    tight_rows: dict[int, np.ndarray] = {}
+    W = np.empty((len(rows), 3, k))
+    E = np.empty((len(rows), 3, k))
+    for r, i in enumerate(rows):
+        planar_generators(P[i], N[i], mu[i], width[i], c[i], L[i], owner, offset, friction, W[r], E[r])
+    if k < 3:  # the kernel's float proof of its null direction failed: decided exactly
+        for i in rows if k == 2 else ():
+            ok = _pair_orthogonal(planar_pair_normal(P[i], N[i], mu[i], width[i], c[i], L[i], owner, offset,
+                                                     friction), y[i])
+            if ok is not None:
+                code[i], verified[i] = 3, ok
+        return (code, t, lam, basis, y), tight_rows, verified
+    U, sv, _ = np.linalg.svd(W, full_matrices=False) if len(rows) else (None, np.ones((0, 1)), None)
+    thin_rows = np.flatnonzero(sv[:, -1] <= tol.rank * sv[:, 0])
+    if not len(thin_rows):
+        return (code, t, lam, basis, y), tight_rows, verified
+    at = rows[thin_rows]
+    ok, yf, tight, proved, full, parallel = thin_screen(
+        np.ascontiguousarray(W[thin_rows]), np.ascontiguousarray(E[thin_rows]), np.ascontiguousarray(y[at]),
+        np.ascontiguousarray(t[at]), tol.margin, 1e-7, np.ascontiguousarray(P[at]), np.ascontiguousarray(N[at]),
+        np.ascontiguousarray(width[at]), owner, not friction.any(), not offset.any())
+    has_y = np.any(y[at] != 0, axis=1)
+    strict = has_y & ok & ~tight.any(axis=1)
+    code[at[strict & proved]] = 2
+    y[at[strict & proved]] = yf[strict & proved]
+    code[at[has_y & ~ok & full]] = 5  # no certificate from the dual direction, exact rank 3
+    # every generator tight, exact rank 3: nothing is left once projected, the checker refuses it
+    refused = has_y & ok & tight.all(axis=1) & full
+    code[at[refused]], y[at[refused]], verified[at[refused]] = 3, yf[refused], False
+    cone, first, ones = _ray_blocks(k)
+    arrays = (cone, first, ones, np.zeros((k, 2)), np.zeros(k), np.zeros(k))
+    solver = make_solver("fast")
+    # rank at most 2 (parallel normals, two distinct contacts): the all-tight direction, or the last singular vector
+    # when the dual direction gives no certificate, decided in one compiled pass
+    pair = has_y & parallel & (~ok | tight.all(axis=1))
+    if pair.any():
+        yp = np.where(ok[pair][:, None], yf[pair], U[thin_rows[pair], :, -1])
+        state = pair_null_rows(np.ascontiguousarray(W[thin_rows[pair]]), np.ascontiguousarray(E[thin_rows[pair]]),
+                               np.ascontiguousarray(yp))
+        done = state >= 0
+        sel = at[pair][done]
+        code[sel], y[sel], verified[sel] = 3, yp[done], state[done] == 1
+        pair[np.flatnonzero(pair)[~done]] = False
+    for q in np.flatnonzero((~has_y | (ok & ~strict & ~refused) | (~ok & ~full)) & ~pair):
+        r, i = thin_rows[q], at[q]
+        rank_all = []  # the exact rank of every generator, computed once
+
+        def exact_rank(cols=None, i=i, rank_all=rank_all):
+            if cols is not None and len(cols) < k:
+                return planar_generator_rank(P[i], N[i], mu[i], width[i], owner, offset, friction, cols)
+            if not rank_all:
+                rank_all.append(3 if full[q] else
+                                planar_generator_rank(P[i], N[i], mu[i], width[i], owner, offset, friction))
+            return rank_all[0]
+
+        pair_normal = lambda cols, i=i: planar_pair_normal(  # noqa: E731
+            P[i], N[i], mu[i], width[i], c[i], L[i], owner[cols], offset[cols], friction[cols])
+        if has_y[q]:
+            yc, mask = (yf[q], tight[q]) if ok[q] else (None, None)
+        else:  # no dual basis: the fast solver asks clarabel, as grasp by grasp
+            ti, yi = _solve_generators(solver, W[r])
+            cert = None if yi is None or not ti < tol.margin else farkas_from_arrays(W[r], arrays, "generators", yi)
+            yc, mask = (None, None) if cert is None else (np.array(cert.y), np.isin(np.arange(k), cert.tight))
+        if yc is None:
+            if exact_rank() == 3:
+                code[i] = 5
+                continue
+            yc, mask = U[r, :, -1], np.ones(k, dtype=bool)
+        if not mask.any():
+            if verify_farkas_general(W[r], E[r], *arrays, yc, mask, 0.0):
+                code[i], y[i] = 2, yc
+            continue
+        proof, shift = _orthogonal(W[r], E[r], np.flatnonzero(mask), exact_rank, pair_normal, yc)
+        if proof and not mask.all():
+            proof = None if not verify_farkas_general(W[r], E[r], *arrays, yc, mask, shift) else proof
+        if proof is not None:
+            code[i], y[i], verified[i] = (3 if mask.all() else 4), yc, proof
+            if not mask.all():
+                tight_rows[int(i)] = np.flatnonzero(mask)
+    return (code, t, lam, basis, y), tight_rows, verified
+
+
+def _orthogonal(C, E, cols, exact_rank, pair_normal, y):
+    """Is ``y`` orthogonal to the exact generators ``cols`` as the exact checker requires (its
+    exact projection off their span non-zero and within ``1e-6 |y|`` of ``y``)? ``(True,
+    bound on that distance)``, ``(False, inf)`` when proved not, ``(None, inf)`` when undecided.
+
+    The exact rank ``r`` of the generators is computed: 3 leaves nothing once projected (not);
+    two independent generators have an exact normal direction (``pair_normal(cols)``,
+    :func:`_pair_orthogonal`); otherwise ``r`` of them proved independent in floats span the
+    same space, which bounds the projection
+    (:func:`qualgrasp.certify._kernels.linalg.projection_bound`); a generator whose functional
+    on ``y`` is far from zero proves the projection large (:func:`_refuted`)."""
+    ny = np.sqrt(y @ y)
+    r = exact_rank(cols)
+    if r == 3:
+        return False, np.inf
+    if r == 2 and len(cols) == 2:
+        ok = _pair_orthogonal(pair_normal(cols), y)
+        return ok, (0.5e-6 * ny * (1 + 8 * U_ROUND) if ok else np.inf)
+    for keep in combinations(cols, r):
+        keep = list(keep)
+        bound = projection_bound(np.ascontiguousarray(C[:, keep]), np.ascontiguousarray(E[:, keep]), y)
+        if np.isfinite(bound):
+            if bound <= 1e-6 * ny * (1.0 - 8 * U_ROUND):
+                return True, bound
+            break
+    return (False if _refuted(C, E, cols, y) else None), np.inf
+
+
+def _pair_orthogonal(z, y) -> bool | None:
+    """Does the exact checker accept ``y`` as orthogonal to two generators whose exact normal
+    direction is ``z`` (:func:`qualgrasp.certify.core.wrench.planar_pair_normal`)? Its distance
+    to its projection off their span is ``|y| sin(y, z)``, compared with ``1e-6 |y|`` exactly in
+    integers: True below half of it, False above twice of it (the checker's own rounding
+    cannot cross those), None otherwise or for parallel generators."""
+    Y = dyadic_integers(y)[0]
+    nz = sum(v * v for v in z)
+    ny = sum(v * v for v in Y)
+    if nz == 0 or ny == 0:
+        return None
+    yz = sum(a * b for a, b in zip(Y, z))
+    gap = (ny * nz - yz * yz) * 10**12  # |y|^2 |z|^2 sin^2 / 1e-12
+    if 4 * gap < ny * nz:
+        return True
+    if gap > 4 * ny * nz:
+        return False
+    return None
+
+
+def _refuted(C, E, cols, y) -> bool:
+    """Rigorous float proof that the exact projection of ``y`` onto the span of the exact
+    generators ``cols`` (within ``E`` of ``C``) is longer than ``2e-6 |y|``: for any one
+    generator ``c`` it is at least ``|c . y| / |c|``. Twice the checker's threshold, so that its
+    own rounding cannot accept it."""
+    g = 5 * U_ROUND / (1 - 5 * U_ROUND)
+    ny = np.sqrt(y @ y) * (1 + 4 * U_ROUND)
+    for j in cols:
+        a = abs(C[:, j] @ y)
+        err = np.sum((E[:, j] + g * np.abs(C[:, j])) * np.abs(y))
+        nc = np.sqrt(np.sum((np.abs(C[:, j]) + E[:, j]) ** 2)) * (1 + 4 * U_ROUND)
+        if (a - err) * (1 - 4 * U_ROUND) > 2e-6 * ny * nc:
+            return True
+    return False
+
+
+def _solve_generators(solver, W):
+    """``(t, y)`` of the fast solver on the closure programme of the generator columns ``W``
+    (``y`` None when it has none, ``t`` -inf when it fails: decide then goes by the rank)."""
+    k = W.shape[1]
+    problem = ClosureProblem(W, tuple(range(k)), (), sp.identity(k, format="csr"), System(W, (), "generators"))
+    try:
+        sol = solver.solve(problem)
+    except SolverError:
+        return -np.inf, None
+    return sol.t, sol.y
 
 
 def _planar_quality(cols, rows, closure, P, N, mu, width, c, L, models, variants, options):

@@ -13,7 +13,8 @@ from ..core.grasp import Contact, Grasp
 from ..files.outputs import atomic_output
 from ..files.reader import CONTACT, GRASP_SCHEMA, is_parquet
 
-__all__ = ["RANGES", "random_grasp", "random_grasps", "textbook_grasps", "random_grasp_table", "write_random_grasp_file"]
+__all__ = ["RANGES", "DEGENERATE", "random_grasp", "random_grasps", "textbook_grasps", "random_grasp_table",
+           "degenerate_geometry", "write_random_grasp_file"]
 
 
 #: Ranges of the uniform draws of each model parameter.
@@ -118,21 +119,110 @@ def textbook_grasps() -> list[Grasp]:
     return gs
 
 
+#: Kinds of degenerate planar grasp sets (:func:`degenerate_geometry`), each with what it draws.
+DEGENERATE = {
+    "antipodal-disc": "antipodal pairs of contacts on a disc, normals through its centre "
+                      "(an odd count leaves the last contact without its partner)",
+    "centre-disc": "contacts at random angles on a disc, normals through its centre",
+    "centre-square": "contacts at the middles of a square's sides (right, left, top, bottom, then "
+                     "again), normals through its centre",
+    "duplicated": "random contacts each given twice (contact 2j+1 repeats contact 2j)",
+    "collinear": "contacts on one line, normals across it on alternating sides",
+    "mixed": "each grasp one of the kinds above, drawn at random",
+}
+
+
+def _rotation(angle: np.ndarray) -> np.ndarray:
+    """``(B, 2)`` unit vectors at the given angles."""
+    return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
+
+
+def degenerate_geometry(kind: str, rng: np.random.Generator, count: int, n_contacts: int):
+    """Contact points and inward normals ``(count, n_contacts, 2)`` of planar grasps whose
+    wrenches are degenerate: every normal through one point (discs, squares grasped through
+    the centre), repeated contacts, or contacts on one line with parallel normals.
+
+    Each grasp is placed at a random centre in ``[-1, 1]^2``, with a random size in
+    ``[0.5, 1.5]`` and a random rotation; ``kind`` is a key of :data:`DEGENERATE`.
+
+    Raises
+    ------
+    ValueError
+        Unknown ``kind``, or fewer than 2 contacts.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> p, n = degenerate_geometry("antipodal-disc", np.random.default_rng(0), 1, 2)
+    >>> d = p[0, 1] - p[0, 0]  # the second contact lies on the first one's normal line
+    >>> bool(np.allclose(n[0, 0], -n[0, 1])), bool(abs(d[0] * n[0, 0, 1] - d[1] * n[0, 0, 0]) < 1e-12)
+    (True, True)
+    """
+    if kind not in DEGENERATE:
+        raise ValueError(f"degenerate kind must be one of {', '.join(DEGENERATE)}, got {kind!r}")
+    if n_contacts < 2:
+        raise ValueError(f"degenerate grasps need at least 2 contacts, got {n_contacts}")
+    m = n_contacts
+    centre = rng.uniform(-1, 1, size=(count, 1, 2))
+    size = rng.uniform(0.5, 1.5, size=(count, 1, 1))
+    turn = rng.uniform(0, 2 * np.pi, size=(count, 1))
+    kinds = [k for k in DEGENERATE if k != "mixed"]
+    which = rng.integers(len(kinds), size=count) if kind == "mixed" else np.full(count, kinds.index(kind))
+    j = np.arange(m)
+    angle = {
+        "antipodal-disc": rng.uniform(0, 2 * np.pi, size=(count, (m + 1) // 2)).repeat(2, axis=1)[:, :m]
+        + np.pi * (j % 2),
+        "centre-disc": rng.uniform(0, 2 * np.pi, size=(count, m)),
+        "centre-square": turn + np.array([0, np.pi, np.pi / 2, 3 * np.pi / 2])[j % 4],
+    }
+    p = np.empty((count, m, 2))
+    n = np.empty((count, m, 2))
+    for w, name in enumerate(kinds):
+        rows = which == w
+        if not rows.any():
+            continue
+        if name in angle:  # every normal through the centre
+            u = _rotation(angle[name][rows])
+            p[rows], n[rows] = centre[rows] + size[rows] * u, -u
+        elif name == "duplicated":
+            u = rng.normal(size=(int(rows.sum()), (m + 1) // 2, 2))
+            u /= np.linalg.norm(u, axis=2, keepdims=True)
+            q = u * rng.uniform(0.7, 1.3, size=u.shape[:2] + (1,))
+            v = -u + 0.7 * rng.normal(size=u.shape)
+            p[rows] = (centre[rows] + size[rows] * q).repeat(2, axis=1)[:, :m]
+            n[rows] = v.repeat(2, axis=1)[:, :m]
+        else:  # collinear
+            along = _rotation(turn[rows])
+            across = np.stack([-along[..., 1], along[..., 0]], axis=-1)
+            s = rng.uniform(-1, 1, size=(int(rows.sum()), m, 1))
+            p[rows] = centre[rows] + size[rows] * s * along
+            n[rows] = np.where((j % 2 == 0)[None, :, None], 1.0, -1.0) * across
+    return p, n
+
+
 def random_grasp_table(seed: int, count: int, *, dim: int = 2, n_contacts: int = 3,
                        model: str = "point", mu: tuple[float, float] = RANGES["mu"],
                        torsion: tuple[float, float] = RANGES["torsion"],
                        width: tuple[float, float] = RANGES["width"], spread: float = 0.7,
-                       start: int = 0):
+                       start: int = 0, degenerate: str | None = None):
     """An Arrow grasp table (:data:`qualgrasp.certify.files.reader.GRASP_SCHEMA`) of ``count`` random grasps drawn
     like :func:`random_grasp` (same distribution, vectorised; not the same draws), ids
-    ``r{start}, r{start+1}, ...``; ``center`` and ``length`` left to their defaults."""
+    ``r{start}, r{start+1}, ...``; ``center`` and ``length`` left to their defaults.
+    ``degenerate``: a kind of :data:`DEGENERATE` (planar only), whose contact points and normals
+    :func:`degenerate_geometry` draws instead (``spread`` unused); the model parameters are
+    drawn as above."""
 
     rng = np.random.default_rng(seed)
     m = n_contacts
-    u = rng.normal(size=(count, m, dim))
-    u /= np.linalg.norm(u, axis=2, keepdims=True)
-    p = u * rng.uniform(0.7, 1.3, size=(count, m, 1))
-    n = -u + spread * rng.normal(size=(count, m, dim))
+    if degenerate is not None:
+        if dim != 2:
+            raise ValueError(f"degenerate grasp sets are planar (dim 2), got dim {dim}")
+        p, n = degenerate_geometry(degenerate, rng, count, m)
+    else:
+        u = rng.normal(size=(count, m, dim))
+        u /= np.linalg.norm(u, axis=2, keepdims=True)
+        p = u * rng.uniform(0.7, 1.3, size=(count, m, 1))
+        n = -u + spread * rng.normal(size=(count, m, dim))
     total = count * m
     lists = lambda a: pa.ListArray.from_arrays(pa.array(np.arange(0, total * dim + 1, dim, dtype=np.int32)),
                                                pa.array(a.reshape(-1)))

@@ -21,7 +21,7 @@ from .. import models
 from ..batch.jobs import certify_file, verify_file
 from ..errors import CertifyError
 from ..regions.files import DEFAULT_BUDGET, certify_region_file, verify_region_file
-from ..batch.samples import write_random_grasp_file
+from ..batch.samples import DEGENERATE, write_random_grasp_file
 from ..files.reader import count_grasps
 from ..core.validation import MAX_CONTACTS
 from ..meshes.source import PoseSource, check_pose_file
@@ -188,10 +188,15 @@ def sample_command(
     contacts: int = typer.Option(3, help="Contacts per grasp."),
     model: str = typer.Option("point", help="Contact model: " + ", ".join(models.names()) + "."),
     seed: int = typer.Option(0, help="Random seed."),
+    degenerate: str = typer.Option(None, "--degenerate", metavar="KIND", help=(
+        "Planar grasps with degenerate wrenches instead of a blob: "
+        + "; ".join(f"{k}: {v}" for k, v in DEGENERATE.items()) + ".")),
 ) -> None:
     """Write a random grasp set, for trying the toolkit and for benchmarks at scale.
 
-    Contacts are placed around a random blob; about a third of the grasps are in closure."""
+    Contacts are placed around a random blob; about a third of the grasps are in closure. With
+    --degenerate KIND, the contacts are placed so that the wrenches are degenerate (normals
+    through one point, repeated or collinear contacts), as round or square objects give."""
     if n < 0:
         fail(f"--n must be a number of grasps (>= 0), got {n}")
     if dim not in (2, 3):
@@ -203,8 +208,16 @@ def sample_command(
     if dim not in models.get(model).dims:
         fail(f"--model {model} exists in {' and '.join(map(str, models.get(model).dims))} dimensions only, "
               f"not with --dim {dim}")
+    if degenerate is not None:
+        if degenerate not in DEGENERATE:
+            fail(f"--degenerate must be one of {', '.join(DEGENERATE)}, got {degenerate!r}")
+        if dim != 2:
+            fail(f"--degenerate makes planar grasps only (--dim 2), got --dim {dim}")
+        if contacts < 2:
+            fail(f"--degenerate needs at least 2 contacts, got --contacts {contacts}")
     try:
-        count = write_random_grasp_file(output, n, seed=seed, dim=dim, n_contacts=contacts, model=model)
+        count = write_random_grasp_file(output, n, seed=seed, dim=dim, n_contacts=contacts, model=model,
+                                        degenerate=degenerate)
     except CertifyError as err:
         fail(str(err))
     console.print(f"wrote {count} grasps to {output}")

@@ -15,6 +15,7 @@ from typing import Sequence
 
 import numpy as np
 
+from . import exact as ex
 from .. import models as registry
 from ..errors import ArgumentError
 from .._kernels.linalg import ETA
@@ -34,6 +35,8 @@ __all__ = [
     "grasp_arrays",
     "variants_of",
     "force_column_errors",
+    "planar_generator_rank",
+    "planar_pair_normal",
 ]
 
 
@@ -188,6 +191,93 @@ def generator_columns(P, N, mu, models, center, length, *, frictionless: bool = 
             Pk = np.where((offset != 0)[:, None], Pk + (conv(offset) * width[..., owner])[..., None] * T, Pk)
     W = wrench(Pk, F, np.asarray(center)[..., None, :], np.asarray(length)[..., None])
     return np.swapaxes(W, -1, -2), owner
+
+
+def planar_generator_rank(P, N, mu, width, owner, offset, friction, cols=None) -> int:
+    """Exact rank of the planar generator columns of one grasp (:func:`generator_columns`'
+    formulas on the float data, in exact arithmetic), or of the generators ``cols`` only.
+
+    The torque row ``((q - c) x f) / L`` is ``(q x f - c x f) / L``, a row operation away from
+    ``q x f``, so the rank does not depend on ``center`` and ``length``; the rows ``f_x, f_y,
+    q x f`` are evaluated in integers (every float scaled by one power of two) and ranked by
+    :func:`qualgrasp.certify.core.exact.rank`. The same rank as
+    ``exact.rank(generator_columns(...exact...))``, without building Fractions.
+
+    Parameters
+    ----------
+    P, N : array, shape (m, 2)
+        Contact points and inward unit normals (floats, as the grasp stores them).
+    mu, width : array, shape (m,)
+    owner, offset, friction : array, shape (k,)
+        The generator layout (:func:`generator_layout`).
+    cols : sequence of int, optional
+        Generators to rank (default all).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> P = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]])
+    >>> owner, offset, friction = np.arange(3), np.zeros(3), np.zeros(3)
+    >>> planar_generator_rank(P, -P, np.zeros(3), np.zeros(3), owner, offset, friction)  # through 0
+    2
+    >>> planar_generator_rank(P + 0.5, -P, np.zeros(3), np.zeros(3), owner, offset, friction)
+    2
+    >>> planar_generator_rank(P, -P[[1, 2, 0]], np.zeros(3), np.zeros(3), owner, offset, friction)
+    3
+    """
+    cols = range(len(owner)) if cols is None else cols
+    fx, fy, qx, qy, _, _ = _generator_integers(P, N, mu, width, (0.0, 0.0), owner, offset, friction, cols)
+    return ex.rank([fx, fy, [a * d - b * c for a, b, c, d in zip(qx, qy, fx, fy)]])
+
+
+def _generator_integers(P, N, mu, width, center, owner, offset, friction, cols):
+    """Forces ``f = n + s t`` and points ``q = p + o t`` of the planar generators ``cols``
+    (:func:`generator_columns`), and the ``center``, exactly, as integers: every value times one
+    power of two (:func:`qualgrasp.certify.core.exact.dyadic_integers`), cubed for ``f``, ``q``
+    and the center. Returns ``(fx, fy, qx, qy, (cx, cy), S)`` with ``S`` that power."""
+    cols = list(cols)
+    own = [int(owner[j]) for j in cols]
+    floats = [v for i in own for v in (N[i, 0], N[i, 1], P[i, 0], P[i, 1], mu[i], width[i])]
+    floats += [v for j in cols for v in (offset[j], friction[j])] + [center[0], center[1]]
+    ints, s = ex.dyadic_integers(floats)
+    S2 = 1 << (2 * s)
+    fx, fy, qx, qy = [], [], [], []
+    for a, j in enumerate(cols):
+        nx, ny, px, py, mu_i, w_i = ints[6 * a: 6 * a + 6]
+        off, fr = ints[6 * len(cols) + 2 * a: 6 * len(cols) + 2 * a + 2]
+        sm, so = fr * mu_i, off * w_i
+        fx.append(nx * S2 - sm * ny)  # t = (-n_y, n_x)
+        fy.append(ny * S2 + sm * nx)
+        qx.append(px * S2 - so * ny)
+        qy.append(py * S2 + so * nx)
+    cx, cy = ints[-2] * S2, ints[-1] * S2
+    return fx, fy, qx, qy, (cx, cy), 1 << s
+
+
+def planar_pair_normal(P, N, mu, width, center, length, owner, offset, friction) -> tuple[int, int, int]:
+    """A positive multiple of the cross product ``w_0 x w_1`` of the exact wrenches of a planar
+    grasp with two generators (:func:`generator_columns`' formulas in exact arithmetic), as
+    integers: the direction orthogonal to both, exactly (zero when they are parallel).
+
+    With ``T_j = (q_j - c) x f_j`` the wrench is ``(f_j, T_j / L)``; ``L (w_0 x w_1)`` is
+    ``(f_0y T_1 - T_0 f_1y, T_0 f_1x - f_0x T_1, L (f_0 x f_1))``, every term a product of
+    floats, evaluated in integers (:func:`qualgrasp.certify.core.exact.dyadic_integers`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> P, N = np.array([[1.0, 0.0], [-1.0, 0.0]]), np.array([[-1.0, 0.0], [1.0, 0.0]])
+    >>> z = planar_pair_normal(P, N, np.zeros(2), np.zeros(2), np.zeros(2), 1.0, np.arange(2),
+    ...                        np.zeros(2), np.zeros(2))
+    >>> [v != 0 for v in z]  # antipodal: the wrenches are opposite, parallel
+    [False, False, False]
+    """
+    fx, fy, qx, qy, (cx, cy), S = _generator_integers(P, N, mu, width, center, owner, offset, friction, range(2))
+    T = [(qx[j] - cx) * fy[j] - (qy[j] - cy) * fx[j] for j in range(2)]  # scale S^6
+    (L,), s = ex.dyadic_integers([length])
+    # f is scaled by S^3, T by S^6, L by 2^s: bring L f_0 x f_1 to S^9
+    z2 = (fx[0] * fy[1] - fy[0] * fx[1]) * L * S ** 3
+    return (fy[0] * T[1] - T[0] * fy[1]) << s, (T[0] * fx[1] - fx[0] * T[1]) << s, z2
 
 
 def force_columns(P, N, models, center, length):
