@@ -86,3 +86,45 @@ def test_spatial_cases_name_every_case():
     rows = spatial_cases(SpatialPhysics(dt=2e-3, iterations=20))
     assert [r.case for r in rows][2:5] == [f"box: least grip force, mu {m:g}" for m in (0.25, 0.5, 1.0)]
     assert all(abs(r.error) <= TOLERANCE for r in rows[2:5])
+
+
+def _app():
+    import typer
+
+    from qualgrasp.experiments.physics.cli import register
+
+    app = typer.Typer()
+
+    @app.callback()
+    def main():
+        pass
+
+    register(app)
+    return app
+
+
+@pytest.mark.parametrize("args, message", [
+    (["validate", "--spatial", "--setting", "huge"], "--setting must be one of"),
+    (["validate", "--spatial", "--out", "file"], "is not a folder"),
+])
+def test_spatial_refused_options_exit_2_with_one_line(args, message, tmp_path, monkeypatch):
+    from typer.testing import CliRunner
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "file").write_text("x")
+    result = CliRunner().invoke(_app(), args)
+    assert result.exit_code == 2, result.output
+    assert message in result.output and "Traceback" not in result.output
+
+
+def test_spatial_without_mujoco_exits_2(monkeypatch, tmp_path):
+    import importlib.util
+
+    from typer.testing import CliRunner
+
+    from qualgrasp.experiments.physics import cli
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(cli.importlib.util, "find_spec", lambda name, *a: None if name == "mujoco" else real(name, *a))
+    result = CliRunner().invoke(_app(), ["validate", "--spatial", "--out", str(tmp_path / "out")])
+    assert result.exit_code == 2 and "needs mujoco" in result.output, result.output
