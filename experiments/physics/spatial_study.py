@@ -218,7 +218,7 @@ def summarise_spatial(trials: list[dict], poses: list[dict]) -> dict:
 
     Examples
     --------
-    >>> rows = [{"mesh": "m", "setting": "default", "ratio": r, "certified": r > 1, "held": r > 0.9,
+    >>> rows = [{"mesh": "m", "pose": 0, "setting": "default", "ratio": r, "certified": r > 1, "held": r > 0.9,
     ...          "held_shake": r > 1.5, "seconds": 0.1} for r in (0.5, 0.95, 2.0)]
     >>> s = summarise_spatial(rows, [])
     >>> s["overall"]["held"]["precision"], s["overall"]["held"]["recall"], s["overall"]["held_shake"]["recall"]
