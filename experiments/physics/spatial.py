@@ -18,16 +18,24 @@ gravity points along ``-z`` of it (the models' up axis, as the certification of
   carrying two box pads of the gripper's pad size (pad width along ``y``, pad height along ``z``,
   finger thickness along ``x``), each on a slide joint along ``x`` driven by a force actuator: pad A
   (at ``x = +width / 2``) is pushed along ``-x`` and pad B along ``+x``, each with the grip force
-  ``F`` (``F`` ramped in over ``SpatialPhysics.close`` seconds). The pads' slide joints are damped
+  ``F`` (``F`` ramped in over ``SpatialPhysics.close`` seconds). The two slides are coupled
+  (an equality constraint keeps the pads symmetric about the hand's origin, as the Franka hand's
+  fingers are): the hand bears any net force along the closing axis, so the pads press with
+  ``F -+ lambda`` where the weight pushes the object towards one of them. Two pads pressed by
+  independent forces could bear none, and would let every object whose weight has a component
+  along the closing axis slide down with them. The pads' slide joints are damped
   (``F / SpatialPhysics.close_speed``) so that they meet the object slowly. The hand itself has
   six joints (three slides, three hinges about its origin) whose motion is prescribed (positions
   and velocities set before every step; the hand is heavy and its weight compensated), so the pads
   move with the hand's true velocity and friction sees it.
-* **Contacts.** Elliptic friction cones of dimension 4 (``condim = 4``): MuJoCo's cone
-  ``f_t1^2 / mu^2 + f_t2^2 / mu^2 + m^2 / mu_s^2 <= f_n^2`` with the torsional coefficient
-  ``mu_s = mu torsion`` (``torsion`` the certified patch's torsional length) is exactly certify's
-  ``soft`` contact, ``norm((f_t, m / torsion)) <= mu f_n``, for one contact point per pad; the
-  pads' friction wins over the object's (a higher ``priority``). ``impratio`` (the friction
+* **Contacts.** Elliptic friction cones; MuJoCo's multi-point convex collisions (``multiccd``)
+  put several contact points where a pad meets a piece. ``condim = 3`` (the default): Coulomb
+  friction ``mu`` at each point, the patch's resistance to twisting coming only from the points'
+  spread. ``condim = 4``: each point also carries torsional friction with MuJoCo's cone
+  ``f_t1^2 / mu^2 + f_t2^2 / mu^2 + m^2 / mu_s^2 <= f_n^2``, ``mu_s = mu torsion`` (``torsion``
+  the certified patch's torsional length): exactly certify's ``soft`` contact, ``norm((f_t,
+  m / torsion)) <= mu f_n``, for one point per pad, and more torsion than certified when a pad
+  has several points. The pads' friction wins over the object's (a higher ``priority``). ``impratio`` (the friction
   constraints' stiffness relative to the normal's) and the solver's iterations and time step are
   :class:`SpatialPhysics` fields.
 
@@ -280,7 +288,8 @@ def world_xml(obj: SpatialObject, jaw: Jaw, force: float, physics: SpatialPhysic
             f'fullinertia="{inertia}"/>{geoms}</body>'
             f'<body name="hand" pos="{_fmt(jaw.T[:3, 3])}" quat="{_fmt(_quat(jaw.T[:3, :3]))}" gravcomp="1">'
             f'{hand_joints}<inertial pos="0 0 0" mass="1000" diaginertia="10 10 10"/>{pads}</body>'
-            f'</worldbody><actuator><motor name="grip_a" joint="slide_a" gear="-1"/>'
+            f'</worldbody><equality><joint joint1="slide_a" joint2="slide_b" polycoef="0 -1 0 0 0"/></equality>'
+            f'<actuator><motor name="grip_a" joint="slide_a" gear="-1"/>'
             f'<motor name="grip_b" joint="slide_b" gear="1"/></actuator></mujoco>')
 
 
@@ -434,6 +443,8 @@ def trial(obj: SpatialObject, jaw: Jaw, force: float, physics: SpatialPhysics = 
     >>> [trial(obj, jaw, f, shake=False).held for f in (1.0, 6.0)]      # m g / (2 mu) = 2.94 N
     [False, True]
     """
+    if not (math.isfinite(force) and force > 0):
+        raise ValueError(f"the grip force must be a finite positive number of newtons, got {force}")
     start = time.perf_counter()
     world = _World(obj, jaw, force, physics)
     _close(world, force, physics)

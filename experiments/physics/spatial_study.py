@@ -70,9 +70,11 @@ upper end; empty when infinite); the certified verdict at the force (``holds``, 
 ``undecided``) and ``certified`` (it is ``holds``); the physical outcome (held under gravity, after
 the shake, dropped, slips in mm, contacts after closing) and the trial's wall-clock seconds."""
 
-POSE_COLUMNS = ("mesh", "source", "pose", "pieces", "decomposition", "f_lo", "f_min", "f_phys", "seconds")
+POSE_COLUMNS = ("mesh", "source", "pose", "pieces", "decomposition", "f_lo", "f_min", "f_phys", "f_phys_soft",
+                "seconds")
 """Per pose: the mesh's convex pieces and how they were made, the certified least grip force and
-the smallest that held in physics (N; empty when infinite), seconds of its bisection."""
+the smallest that held in physics (N; empty when infinite; ``f_phys_soft`` with condim 4), seconds
+of the two bisections."""
 
 
 @dataclass(frozen=True)
@@ -82,7 +84,9 @@ class SpatialValidation:
     Attributes
     ----------
     physics, second : SpatialPhysics
-        The main and the second physics setting.
+        The main and the second physics setting. Every trial also runs with the main setting's
+        contacts of dimension 4 (setting ``soft``: certify's soft contacts, the torsional friction
+        of the certified patch at each contact point).
     poses : int
         Poses sampled per mesh.
     ratios : tuple of float
@@ -177,7 +181,8 @@ def validate_mesh(name: str, mesh, source: str, settings: SpatialValidation, *, 
     finite = [b.hi for _, _, b in grasps if math.isfinite(b.hi)]
     fallback = float(np.median(finite)) if finite else settings.mass * 9.80665 / (2 * settings.mu)
     trials, poses = [], []
-    settings_run = [("default", settings.physics)] + ([("second", settings.second)] if recheck else [])
+    settings_run = [("default", settings.physics), ("soft", replace(settings.physics, condim=4))]
+    settings_run += [("second", settings.second)] if recheck else []
     for k, jaw, b in grasps:
         ref = b.hi if math.isfinite(b.hi) else fallback
         for label, physics in settings_run:
@@ -192,8 +197,9 @@ def validate_mesh(name: str, mesh, source: str, settings: SpatialValidation, *, 
                                "contacts": t.contacts, "seconds": t.seconds})
         t0 = time.perf_counter()
         f_phys = least_physical_grip(obj, jaw, ref / 8, 8 * ref, settings.physics, precision=settings.precision)
+        f_soft = least_physical_grip(obj, jaw, ref / 8, 8 * ref, settings_run[1][1], precision=settings.precision)
         poses.append({"mesh": name, "source": source, "pose": k, "pieces": len(pieces), "decomposition": method,
-                      "f_lo": _finite(b.lo), "f_min": _finite(b.hi), "f_phys": _finite(f_phys),
+                      "f_lo": _finite(b.lo), "f_min": _finite(b.hi), "f_phys": _finite(f_phys), "f_phys_soft": _finite(f_soft),
                       "seconds": time.perf_counter() - t0})
     return trials, poses
 
@@ -225,22 +231,28 @@ def summarise_spatial(trials: list[dict], poses: list[dict]) -> dict:
     (1.0, 0.5, 1.0)
     """
     main = [r for r in trials if r["setting"] == "default"]
-    out = {"overall": {o: _pr(main, o) for o in ("held", "held_shake")}, "per_mesh": {}, "by_ratio": {}}
+    soft = [r for r in trials if r["setting"] == "soft"]
+    out = {"overall": {o: _pr(main, o) for o in ("held", "held_shake")},
+           "soft": {o: _pr(soft, o) for o in ("held", "held_shake")}, "per_mesh": {}, "by_ratio": {}}
     for mesh in dict.fromkeys(r["mesh"] for r in main):
-        sel = [r for r in main if r["mesh"] == mesh]
-        out["per_mesh"][mesh] = {o: _pr(sel, o) for o in ("held", "held_shake")}
+        out["per_mesh"][mesh] = {o: _pr([r for r in main if r["mesh"] == mesh], o) for o in ("held", "held_shake")}
+        out["per_mesh"][mesh]["soft"] = _pr([r for r in soft if r["mesh"] == mesh], "held")
     for ratio in sorted({r["ratio"] for r in main}):
         sel = [r for r in main if r["ratio"] == ratio]
+        sel_soft = [r for r in soft if r["ratio"] == ratio]
         out["by_ratio"][ratio] = {"trials": len(sel), "held": _rate(sum(r["held"] for r in sel), len(sel)),
                                   "held_shake": _rate(sum(r["held_shake"] for r in sel), len(sel)),
+                                  "held_soft": _rate(sum(r["held"] for r in sel_soft), len(sel_soft)),
                                   "certified": _rate(sum(r["certified"] for r in sel), len(sel))}
-    both = [p for p in poses if p["f_min"] is not None and p["f_phys"] is not None]
-    rho = (float(spearmanr([p["f_min"] for p in both], [p["f_phys"] for p in both]).statistic)
-           if len(both) >= 3 else None)
-    ratio = [p["f_phys"] / p["f_min"] for p in both]
-    out["spearman"] = {"rho": rho, "n": len(both), "poses": len(poses),
-                       "ratio_median": float(np.median(ratio)) if ratio else None,
-                       "ratio_range": (float(min(ratio)), float(max(ratio))) if ratio else None}
+    for key, column in (("spearman", "f_phys"), ("spearman_soft", "f_phys_soft")):
+        both = [p for p in poses if p["f_min"] is not None and p.get(column) is not None]
+        rho = (float(spearmanr([p["f_min"] for p in both], [p[column] for p in both]).statistic)
+               if len(both) >= 3 else None)
+        ratio = [p[column] / p["f_min"] for p in both]
+        out[key] = {"rho": rho, "n": len(both), "poses": len(poses),
+                    "finite": sum(1 for p in poses if p["f_min"] is not None),
+                    "ratio_median": float(np.median(ratio)) if ratio else None,
+                    "ratio_range": (float(min(ratio)), float(max(ratio))) if ratio else None}
     seconds = np.array([r["seconds"] for r in main])
     out["seconds"] = (float(np.median(seconds)), float(np.percentile(seconds, 95))) if len(seconds) else (None, None)
     second = {(r["mesh"], r["pose"], r["ratio"]): r for r in trials if r["setting"] == "second"}
@@ -274,26 +286,34 @@ def spatial_markdown(summary: dict, closed: dict, settings: SpatialValidation, m
         cells = " | ".join(f"{closed[k][i].measured:.4g} | {closed[k][i].error:+.4f}" for k in closed)
         lines.append(f"| {c.case} | {c.formula} | {c.exact:.4g} {c.unit} | {cells} |")
     lines += ["", "## Certified to hold at F against held in physics", "",
+              "Outcomes: `held` (under gravity, point contacts: condim 3), `held_shake` (and after the shake), "
+              "`soft` (held under gravity with condim 4: the certified soft contact's torsional friction).", "",
               "| meshes | outcome | trials | certified | held | certified and held | certified, not held | "
               "held, not certified | precision | recall |", "|---|---|---|---|---|---|---|---|---|---|"]
-    rows = [("all", summary["overall"])] + list(summary["per_mesh"].items())
+    rows = [("all", {**summary["overall"], "soft": summary["soft"]["held"]})] + list(summary["per_mesh"].items())
     for mesh, c in rows:
-        for outcome in ("held", "held_shake"):
+        for outcome in ("held", "held_shake", "soft"):
             s = c[outcome]
             lines.append(f"| {mesh} | {outcome} | {s['trials']} | {s['certified']} | {s['held']} | {s['tp']} | "
                          f"{s['fp']} | {s['fn']} | {_cell(s['precision'])} | {_cell(s['recall'])} |")
     lines += ["", "## Held rate against the grip force", "",
-              "| F / F_min | trials | certified | held | held after the shake |", "|---|---|---|---|---|"]
+              "| F / F_min | trials | certified | held | held after the shake | held (soft, condim 4) |",
+              "|---|---|---|---|---|---|"]
     for ratio, b in summary["by_ratio"].items():
         lines.append(f"| {ratio:g} | {b['trials']} | {_cell(b['certified'])} | {_cell(b['held'])} | "
-                     f"{_cell(b['held_shake'])} |")
-    sp = summary["spearman"]
-    rng = sp["ratio_range"]
+                     f"{_cell(b['held_shake'])} | {_cell(b['held_soft'])} |")
     lines += ["", "## The smallest grip force that holds in physics", "",
-              f"Poses with a finite certified F_min and a physical F_phys (between F_min / 8 and 8 F_min, to the "
-              f"ratio {settings.precision:g}): {sp['n']} of {sp['poses']}. Spearman's rank correlation of F_min with "
-              f"F_phys: {_cell(sp['rho'], '+.3f')}; F_phys / F_min median {_cell(sp['ratio_median'])}, range "
-              f"{_cell(rng[0] if rng else None)} to {_cell(rng[1] if rng else None)}.", ""]
+              f"F_phys by bisection between F_min / 8 and 8 F_min (the mesh's median F_min when it is infinite), to "
+              f"the ratio {settings.precision:g}.", "",
+              "| contacts | poses | finite F_min | finite F_min and F_phys | Spearman F_min, F_phys | "
+              "F_phys / F_min median | range |", "|---|---|---|---|---|---|---|"]
+    for key, name in (("spearman", "condim 3"), ("spearman_soft", "condim 4 (soft)")):
+        sp = summary[key]
+        rng = sp["ratio_range"]
+        lines.append(f"| {name} | {sp['poses']} | {sp['finite']} | {sp['n']} | {_cell(sp['rho'], '+.3f')} | "
+                     f"{_cell(sp['ratio_median'])} | {_cell(rng[0] if rng else None)} to "
+                     f"{_cell(rng[1] if rng else None)} |")
+    lines.append("")
     med, p95 = summary["seconds"]
     lines.append(f"Seconds per trial (close, release, shake): median {_cell(med)}, 95th percentile {_cell(p95)}.")
     sec = summary["second"]
@@ -322,8 +342,11 @@ def plot_held_rate(out: Path, trials: list[dict]) -> Path:
         ax.plot(ratios, rate, color="0.6", lw=0.7, alpha=0.7)
     overall = [np.mean([r["held"] for r in main if r["ratio"] == x]) for x in ratios]
     shaken = [np.mean([r["held_shake"] for r in main if r["ratio"] == x]) for x in ratios]
-    ax.plot(ratios, overall, color="tab:blue", lw=2.5, marker="o", label="held under gravity, all meshes")
+    soft = [np.mean([r["held"] for r in trials if r["setting"] == "soft" and r["f_min"] is not None
+                     and r["ratio"] == x] or [np.nan]) for x in ratios]
+    ax.plot(ratios, overall, color="tab:blue", lw=2.5, marker="o", label="held under gravity, all meshes (condim 3)")
     ax.plot(ratios, shaken, color="tab:orange", lw=2.0, ls="--", marker="s", label="held after the shake")
+    ax.plot(ratios, soft, color="tab:green", lw=2.0, ls="-.", marker="^", label="held, soft contacts (condim 4)")
     ax.axvline(1.0, color="k", lw=0.8, ls=":", label="certified least grip force")
     ax.set_xscale("log")
     ax.set_xticks(ratios, [f"{x:g}" for x in ratios])
