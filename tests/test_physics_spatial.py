@@ -128,3 +128,17 @@ def test_spatial_without_mujoco_exits_2(monkeypatch, tmp_path):
     monkeypatch.setattr(cli.importlib.util, "find_spec", lambda name, *a: None if name == "mujoco" else real(name, *a))
     result = CliRunner().invoke(_app(), ["validate", "--spatial", "--out", str(tmp_path / "out")])
     assert result.exit_code == 2 and "needs mujoco" in result.output, result.output
+
+
+def test_weight_along_the_closing_axis_is_borne_by_the_coupled_pads():
+    """The closing axis vertical: the coupled pads (the Franka hand's fingers) close with 2 F in all,
+    and the lower one carries the weight while 2 F >= m g. Pads pressed by independent forces would
+    slide down with the object at any grip force."""
+    obj, jaw = box_grasp(0.5)
+    T = np.eye(4)
+    T[:3, :3] = trimesh.transformations.rotation_matrix(math.pi / 2, (0, 1, 0))[:3, :3]  # hand x along world -z
+    vertical = type(jaw)(T, 0.08, jaw.gripper, 0.5, (0.0, 0.0))  # across the 70 mm faces
+    weight = BOX_MASS * G
+    held = trial(obj, vertical, 0.6 * weight)
+    assert held.held and held.held_shake and held.slip < 2e-3
+    assert trial(obj, vertical, 0.4 * weight).dropped

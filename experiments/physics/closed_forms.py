@@ -37,6 +37,11 @@ Spatial cases (:func:`spatial_cases`, MuJoCo: :mod:`qualgrasp.experiments.physic
   for ``mu`` in :data:`MUS`; measured by :func:`~qualgrasp.experiments.physics.spatial.least_physical_grip`
   to the ratio :data:`SPATIAL_PRECISION` (the upper end of the final bracket is reported: the
   error lies within ``[-0.2 %, 0]`` of the one stated).
+* **Box, weight along the closing axis.** The same box gripped across its 70 mm faces with the
+  closing axis vertical: the pads are coupled (the hand closes them with ``2 F`` in all), so the
+  lower pad carries the weight while ``2 F >= m g``: **``F* = m g / 2``** (certify's least grip
+  force is ``m g``: there each pad's normal force is at most ``F``, here the lower one's is
+  ``F + m g / 2``).
 * **Box, creep at 2 F*.** The slip under gravity (``Physics.hold`` seconds) at twice ``F*``, ``mu``
   0.5: static friction holds, **slip 0**; a soft-constraint engine lets it creep (the error is the
   slip in mm).
@@ -220,6 +225,13 @@ def spatial_cases(physics=None) -> list[ClosedForm]:
         measured = least_physical_grip(obj, jaw, exact / 3, exact * 3.7, physics, precision=SPATIAL_PRECISION)
         rows.append(_row(f"box: least grip force, mu {mu:g}", "m g / (2 mu)", exact, measured, "N"))
     obj, jaw = box_grasp(0.5)
+    T = np.eye(4)
+    T[:3, :3] = ((0, 0, 1), (0, 1, 0), (-1, 0, 0))  # the hand's closing axis x along -z
+    vertical = replace(jaw, T=T, width=0.08)
+    exact = BOX_MASS * G / 2
+    rows.append(_row("box: weight along the closing axis", "m g / 2", exact,
+                     least_physical_grip(obj, vertical, exact / 3, exact * 3.7, physics, precision=SPATIAL_PRECISION),
+                     "N"))
     slip = trial(obj, jaw, 2 * BOX_MASS * G, physics, shake=False).slip
     rows.append(ClosedForm("box: creep at 2 F*, mu 0.5", "0", 0.0, 1000 * slip, 1000 * slip, "mm"))
     return rows

@@ -24,7 +24,8 @@ gravity points along ``-z`` of it (the models' up axis, as the certification of
   ``F -+ lambda`` where the weight pushes the object towards one of them. Two pads pressed by
   independent forces could bear none, and would let every object whose weight has a component
   along the closing axis slide down with them. The pads' slide joints are damped
-  (``F / SpatialPhysics.close_speed``) so that they meet the object slowly. The hand itself has
+  (``F / SpatialPhysics.close_speed``) while they close, so that they meet the object slowly, and
+  undamped afterwards. The hand itself has
   six joints (three slides, three hinges about its origin) whose motion is prescribed (positions
   and velocities set before every step; the hand is heavy and its weight compensated), so the pads
   move with the hand's true velocity and friction sees it.
@@ -363,6 +364,10 @@ def _close(world: _World, force: float, physics: SpatialPhysics) -> None:
         world.data.ctrl[:] = force * min(1.0, (k + 1) / ramp)
         world.step()
     world.model.opt.gravity[:] = (0.0, 0.0, -G)
+    # the damping only slows the pads' approach: a hand squeezing with F does not resist the
+    # pads' slow motion, and a damper would hold a slowly sliding pair (an error of 2 % at m g / 2)
+    for pad in ("slide_a", "slide_b"):
+        world.model.dof_damping[world.model.jnt_dofadr[world.model.joint(pad).id]] = 0.0
     world.reference = world.relative()
 
 
