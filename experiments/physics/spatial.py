@@ -184,6 +184,9 @@ class Trial:
         Slip after the release, and after the shake (m; the slip when the trial stopped).
     contacts : int
         Contacts between the pads and the object at the reference (after closing).
+    settle : float
+        How far the squeeze moved the object (m; as the slip, from its pose before closing to the
+        reference): it re-seats an object its pads first touch at their edges.
     seconds : float
         Wall-clock time of the trial.
     """
@@ -194,6 +197,7 @@ class Trial:
     slip: float
     slip_shake: float
     contacts: int
+    settle: float
     seconds: float
 
 
@@ -331,7 +335,11 @@ class _World:
 
     def slip(self) -> float:
         """Displacement of the object relative to the hand since the reference (module notes), m."""
-        c0, R0 = self.reference
+        return self.moved(*self.reference)
+
+    def moved(self, c0: np.ndarray, R0: np.ndarray) -> float:
+        """Displacement of the object relative to the hand since it was at ``c0``, ``R0`` (hand frame):
+        its centre of mass's plus the radius times its rotation angle, m."""
         c, R = self.relative()
         angle = math.acos(max(-1.0, min(1.0, (np.trace(R0.T @ R) - 1) / 2)))
         return float(np.linalg.norm(c - c0) + self.radius * angle)
@@ -452,13 +460,14 @@ def trial(obj: SpatialObject, jaw: Jaw, force: float, physics: SpatialPhysics = 
         raise ValueError(f"the grip force must be a finite positive number of newtons, got {force}")
     start = time.perf_counter()
     world = _World(obj, jaw, force, physics)
+    before = world.relative()
     _close(world, force, physics)
-    contacts = world.contacts()
+    contacts, settle = world.contacts(), world.moved(*before)
     slip = _release(world, physics)
     dropped = slip > physics.reach / 2
     slip_shake = slip if dropped or not shake else _shake(world, physics)
     dropped = dropped or slip_shake > physics.reach / 2
-    return Trial(slip <= physics.slip, slip_shake <= physics.slip, dropped, slip, slip_shake, contacts,
+    return Trial(slip <= physics.slip, slip_shake <= physics.slip, dropped, slip, slip_shake, contacts, settle,
                  time.perf_counter() - start)
 
 

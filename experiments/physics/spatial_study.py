@@ -54,21 +54,26 @@ from ..mesh_study import made_up_meshes, real_meshes
 from . import closed_forms
 from .spatial import Jaw, SpatialObject, SpatialPhysics, convex_pieces, least_physical_grip, trial
 
-__all__ = ["SECOND", "TRIAL_COLUMNS", "POSE_COLUMNS", "SpatialValidation", "SPATIAL_VALIDATIONS", "study_meshes",
+__all__ = ["SETTLED", "SECOND", "TRIAL_COLUMNS", "POSE_COLUMNS", "SpatialValidation", "SPATIAL_VALIDATIONS", "study_meshes",
            "pieces_of", "validate_mesh", "summarise_spatial", "spatial_markdown", "plot_held_rate",
            "validate_spatial"]
+
+SETTLED = 0.002
+"""An object the squeeze moved farther than this (m) was re-seated in the pads: the certified
+contacts, computed on the object as it was before closing, are not the ones it is held by."""
 
 SECOND = SpatialPhysics(dt=2e-3, iterations=20, impratio=10.0)
 """The second physics setting: twice the time step, 20 solver iterations, impratio 10."""
 
 TRIAL_COLUMNS = ("mesh", "source", "pose", "setting", "ratio", "force", "f_lo", "f_min", "verdict", "certified",
-                 "held", "held_shake", "dropped", "slip_mm", "slip_shake_mm", "contacts", "seconds")
+                 "held", "held_shake", "dropped", "slip_mm", "slip_shake_mm", "contacts", "settle_mm", "seconds")
 """Per physical trial: the mesh, its source and the pose's index; the physics setting
 (``default``, ``second``); the grip force as a ratio of ``F_min`` (of the mesh's median when
 ``F_min`` is infinite) and in newtons; the certified bracket ``f_lo <= F_min`` (N, ``f_min`` its
 upper end; empty when infinite); the certified verdict at the force (``holds``, ``slips``,
 ``undecided``) and ``certified`` (it is ``holds``); the physical outcome (held under gravity, after
-the shake, dropped, slips in mm, contacts after closing) and the trial's wall-clock seconds."""
+the shake, dropped, slips in mm, contacts after closing, how far the squeeze moved the object in
+mm) and the trial's wall-clock seconds."""
 
 POSE_COLUMNS = ("mesh", "source", "pose", "pieces", "decomposition", "f_lo", "f_min", "f_phys", "f_phys_soft",
                 "seconds")
@@ -194,7 +199,7 @@ def validate_mesh(name: str, mesh, source: str, settings: SpatialValidation, *, 
                                "f_lo": _finite(b.lo), "f_min": _finite(b.hi), "verdict": verdict,
                                "certified": verdict == "holds", "held": t.held, "held_shake": t.held_shake,
                                "dropped": t.dropped, "slip_mm": 1000 * t.slip, "slip_shake_mm": 1000 * t.slip_shake,
-                               "contacts": t.contacts, "seconds": t.seconds})
+                               "contacts": t.contacts, "settle_mm": 1000 * t.settle, "seconds": t.seconds})
         t0 = time.perf_counter()
         f_phys = least_physical_grip(obj, jaw, ref / 8, 8 * ref, settings.physics, precision=settings.precision)
         f_soft = least_physical_grip(obj, jaw, ref / 8, 8 * ref, settings_run[1][1], precision=settings.precision)
@@ -253,6 +258,15 @@ def summarise_spatial(trials: list[dict], poses: list[dict]) -> dict:
                     "finite": sum(1 for p in poses if p["f_min"] is not None),
                     "ratio_median": float(np.median(ratio)) if ratio else None,
                     "ratio_range": (float(min(ratio)), float(max(ratio))) if ratio else None}
+    groups = {"certified and held": (True, True), "certified, not held": (True, False),
+              "held, not certified": (False, True), "neither": (False, False)}
+    out["settled"] = {}
+    for label, rows in (("default", main), ("soft", soft)):
+        out["settled"][label] = {}
+        for name, (cert, held) in groups.items():
+            sel = [r for r in rows if r["certified"] == cert and r["held"] == held]
+            out["settled"][label][name] = (len(sel), sum(1 for r in sel if r.get("settle_mm", 0.0) > 1000 * SETTLED))
+    out["false_positives"] = [r for r in main + soft if r["certified"] and not r["held"]]
     seconds = np.array([r["seconds"] for r in main])
     out["seconds"] = (float(np.median(seconds)), float(np.percentile(seconds, 95))) if len(seconds) else (None, None)
     second = {(r["mesh"], r["pose"], r["ratio"]): r for r in trials if r["setting"] == "second"}
@@ -313,6 +327,22 @@ def spatial_markdown(summary: dict, closed: dict, settings: SpatialValidation, m
         lines.append(f"| {name} | {sp['poses']} | {sp['finite']} | {sp['n']} | {_cell(sp['rho'], '+.3f')} | "
                      f"{_cell(sp['ratio_median'])} | {_cell(rng[0] if rng else None)} to "
                      f"{_cell(rng[1] if rng else None)} |")
+    lines.append("")
+    lines += ["", "## Objects the squeeze re-seated", "",
+              f"Trials in which closing the pads moved the object more than {1000 * SETTLED:g} mm (centre of mass "
+              "plus radius times rotation): the certified contacts are those of the object before closing.", "",
+              "| contacts | " + " | ".join(summary["settled"]["default"]) + " |",
+              "|---|" + "---|" * len(summary["settled"]["default"])]
+    for label, groups in summary["settled"].items():
+        lines.append(f"| {label} | " + " | ".join(f"{k} of {n}" for n, k in groups.values()) + " |")
+    fps = summary["false_positives"]
+    lines += ["", f"## Certified to hold, not held: {len(fps)} trials", ""]
+    if fps:
+        lines += ["| mesh | pose | contacts | F / F_min | F (N) | slip (mm) | dropped | squeeze moved it (mm) |",
+                  "|---|---|---|---|---|---|---|---|"]
+        for r in fps:
+            lines.append(f"| {r['mesh']} | {r['pose']} | {r['setting']} | {r['ratio']:g} | {r['force']:.3g} | "
+                         f"{r['slip_mm']:.1f} | {r['dropped']} | {r.get('settle_mm', 0.0):.1f} |")
     lines.append("")
     med, p95 = summary["seconds"]
     lines.append(f"Seconds per trial (close, release, shake): median {_cell(med)}, 95th percentile {_cell(p95)}.")
