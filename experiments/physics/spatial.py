@@ -313,6 +313,7 @@ class _World:
         self.mj = mujoco
         self.model = mujoco.MjModel.from_xml_string(world_xml(obj, jaw, force, physics))
         self.data = mujoco.MjData(self.model)
+        mujoco.mj_forward(self.model, self.data)  # the bodies' poses, read before the first step
         self.object = self.model.body("object").id
         self.hand = self.model.body("hand").id
         self.hand_q = np.array([self.model.jnt_qposadr[self.model.joint(f"hand_{k}").id] for k in range(6)])

@@ -286,8 +286,11 @@ def spatial_markdown(summary: dict, closed: dict, settings: SpatialValidation, m
     sources = {}
     for _, source in meshes.values():
         sources[source] = sources.get(source, 0) + 1
+    grasped = len(summary["per_mesh"])
     lines = [f"# Spatial validation (MuJoCo): {len(meshes)} meshes, {seconds:.0f} s", "",
-             "Meshes: " + ", ".join(f"{n} from {s}" for s, n in sources.items()) + ".", "",
+             "Meshes: " + ", ".join(f"{n} from {s}" for s, n in sources.items()) + f"; {grasped} with at least "
+             "one sampled pose whose pads touch it (the others are wider than the hand opens, or no pose was "
+             "found).", "",
              f"Physics: {ph.label()}; pads of the Franka hand, mass {settings.mass:g} kg, mu {settings.mu:g}; "
              f"close, release under gravity for {ph.hold:g} s (**held**: slip at most {1000 * ph.slip:g} mm), "
              f"shake (peak {ph.shake_accel:.2f} m/s^2 along and {ph.shake_alpha:g} rad/s^2 about each axis of "
