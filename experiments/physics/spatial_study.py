@@ -225,7 +225,8 @@ def summarise_spatial(trials: list[dict], poses: list[dict]) -> dict:
     """Headline numbers (module notes): ``overall`` and ``per_mesh`` precision/recall (against
     ``held`` and ``held_shake``), ``by_ratio`` held rates, ``spearman`` of ``F_min`` with ``F_phys``,
     ``seconds`` per trial (median, 95th percentile), ``second`` (agreement of the held verdicts
-    at the two settings).
+    at the two settings), ``settled`` (trials the squeeze moved more than :data:`SETTLED`, per
+    confusion cell), ``unmoved`` (precision/recall on the others), ``false_positives``.
 
     Examples
     --------
@@ -266,6 +267,8 @@ def summarise_spatial(trials: list[dict], poses: list[dict]) -> dict:
         for name, (cert, held) in groups.items():
             sel = [r for r in rows if r["certified"] == cert and r["held"] == held]
             out["settled"][label][name] = (len(sel), sum(1 for r in sel if r.get("settle_mm", 0.0) > 1000 * SETTLED))
+    out["unmoved"] = {label: _pr([r for r in rows if r.get("settle_mm", 0.0) <= 1000 * SETTLED], "held")
+                      for label, rows in (("default", main), ("soft", soft))}
     out["false_positives"] = [r for r in main + soft if r["certified"] and not r["held"]]
     seconds = np.array([r["seconds"] for r in main])
     out["seconds"] = (float(np.median(seconds)), float(np.percentile(seconds, 95))) if len(seconds) else (None, None)
@@ -338,6 +341,13 @@ def spatial_markdown(summary: dict, closed: dict, settings: SpatialValidation, m
               "|---|" + "---|" * len(summary["settled"]["default"])]
     for label, groups in summary["settled"].items():
         lines.append(f"| {label} | " + " | ".join(f"{k} of {n}" for n, k in groups.values()) + " |")
+    lines += ["", "Certified to hold at F against held, on the trials in which the squeeze moved the object at most "
+              f"{1000 * SETTLED:g} mm (the certified contacts are then those it is held by):", "",
+              "| contacts | trials | certified | held | certified and held | certified, not held | held, not certified | "
+              "precision | recall |", "|---|---|---|---|---|---|---|---|---|"]
+    for label, c in summary["unmoved"].items():
+        lines.append(f"| {label} | {c['trials']} | {c['certified']} | {c['held']} | {c['tp']} | {c['fp']} | {c['fn']} | "
+                     f"{_cell(c['precision'])} | {_cell(c['recall'])} |")
     fps = summary["false_positives"]
     lines += ["", f"## Certified to hold, not held: {len(fps)} trials", ""]
     if fps:
