@@ -9,19 +9,20 @@ object, then push it, and see whether it stays.
   bounded force, Coulomb friction, no gravity) and the trial (squeeze, then disturbance wrenches
   of growing magnitude in a set of directions; the largest resisted without slipping);
 * :mod:`~qualgrasp.experiments.physics.closed_forms`: the simulator's own error on cases with
-  closed-form answers;
+  closed-form answers (planar and spatial);
 * :mod:`~qualgrasp.experiments.physics.study`: the validation study (the qualitative, baseline and
   random grasps of the study's objects, nominal and with placement errors inside and outside
   their certified regions) and :func:`~qualgrasp.experiments.physics.study.validate`;
-* :mod:`~qualgrasp.experiments.physics.plots`: its figures; :mod:`~qualgrasp.experiments.physics.cli`:
-  ``qualgrasp validate``.
+* :mod:`~qualgrasp.experiments.physics.spatial`: the spatial world (MuJoCo: a mesh's convex pieces
+  as a free body with the certification's mass properties, two box pads on slide joints pressed
+  with a grip force) and its trial (close, release under gravity, shake; held, slip);
+* :mod:`~qualgrasp.experiments.physics.spatial_study`: the spatial study (parallel-jaw poses on
+  meshes, their certified least grip force against gravity, executed below and above it) and
+  :func:`~qualgrasp.experiments.physics.spatial_study.validate_spatial`;
+* :mod:`~qualgrasp.experiments.physics.plots`: the planar study's figures;
+  :mod:`~qualgrasp.experiments.physics.cli`: ``qualgrasp validate`` (``--spatial``).
 
-pymunk is an optional dependency (``pip install "qualgrasp[physics]"``), imported only where a
-world is built, so the package imports without it.
-
-A spatial backend (MuJoCo, with meshes and a gripper) goes beside :mod:`planar` as its own module
-with the same three calls on its own object and finger types: ``squeeze``, ``hold`` (one wrench,
-``Hold``) and ``resistance`` (the largest resisted in every direction of a 6-D direction set,
-``Resistance``); the study's per-grasp trial (``_trial``) then picks the backend by the grasp's
-dimension, and its rows, summary and figures stay as they are.
+pymunk and mujoco are optional dependencies (``pip install "qualgrasp[physics]"``, with coacd for
+the meshes' convex decomposition), imported only where a world is built, so the package imports
+without them.
 """

@@ -1,5 +1,6 @@
 """Command-line layer of :mod:`qualgrasp.experiments.physics`: ``qualgrasp validate``, a thin
-wrapper over :func:`qualgrasp.experiments.physics.study.validate`."""
+wrapper over :func:`qualgrasp.experiments.physics.study.validate` (planar) and, with ``--spatial``,
+:func:`qualgrasp.experiments.physics.spatial_study.validate_spatial` (meshes in MuJoCo)."""
 
 from __future__ import annotations
 
@@ -49,13 +50,21 @@ def validate_command(
         setting: str = typer.Option("full", "--setting", help="Size of the work: quick or full."),
         quick: bool = typer.Option(False, "--quick", help="Same as --setting quick (few grasps and trials)."),
         workers: int = typer.Option(2, "--workers", help="Processes."),
+        spatial: bool = typer.Option(False, "--spatial", help="Also (alone without images) the spatial study: "
+                                                              "grasps on the object meshes of installed packages "
+                                                              "(made-up meshes fill up to 20), certified to hold "
+                                                              "their weight, executed in MuJoCo."),
 ) -> None:
     """Do certified grasps hold in a physics engine? Planar trials (pymunk) of the qualitative, baseline
     and random grasps of every object, nominal and with placement errors inside and outside their
-    certified regions; the simulator's error on closed-form cases. Exit code 2 on a refused option
-    or output folder, or when pymunk is not installed."""
-    if importlib.util.find_spec("pymunk") is None:
+    certified regions; the simulator's error on closed-form cases. With --spatial, parallel-jaw
+    grasps on meshes in MuJoCo against their certified least grip force. Exit code 2 on a refused
+    option or output folder, or when pymunk (mujoco for --spatial) is not installed."""
+    planar = folder is not None or builtins or silhouettes or wings or not spatial
+    if planar and importlib.util.find_spec("pymunk") is None:
         _fail('the physical validation needs pymunk: pip install "qualgrasp[physics]"')
+    if spatial and importlib.util.find_spec("mujoco") is None:
+        _fail('the spatial validation needs mujoco: pip install "qualgrasp[physics]"')
     setting = "quick" if quick else setting
     if setting not in VALIDATIONS:
         _fail(f"--setting must be one of {', '.join(VALIDATIONS)}, got {setting!r}")
@@ -71,8 +80,12 @@ def validate_command(
     images: list = sorted(p for p in folder.iterdir() if p.suffix.lower() in _IMAGE_SUFFIXES) if folder else []
     images += list(BUILTINS) if builtins else []
     images += bundled(silhouettes, with_horse=bool(silhouettes), wings=wings) if silhouettes or wings else []
-    if not images:
+    if not images and not spatial:
         _fail("no images: give a FOLDER of images, --builtins, --silhouettes N or --wings N")
+    if spatial:
+        _spatial(out, setting)
+    if not images:
+        return
     settings = replace(VALIDATIONS[setting], workers=workers)
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                   console=console) as bar:
@@ -80,6 +93,37 @@ def validate_command(
         result = validate(images, out, settings=settings,
                           progress=lambda message: bar.update(task, advance=1, description=message))
     _print(result)
+
+
+def _spatial(out: Path, setting: str) -> None:
+    """Run and print the spatial study (the same --setting)."""
+    from .spatial_study import validate_spatial
+
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                  console=console) as bar:
+        task = bar.add_task("validate --spatial", total=None)
+        result = validate_spatial(out, settings=setting,
+                                  progress=lambda message: bar.update(task, advance=1, description=message))
+    table = Table(title="the spatial simulator on closed-form cases (relative error; exact 0: the value measured)",
+                  box=None, padding=(0, 1, 0, 0), pad_edge=False)
+    for col in ("case", "closed form", *result["closed"]):
+        table.add_column(col, no_wrap=True)
+    for group in zip(*result["closed"].values()):
+        c = group[0]
+        table.add_row(c.case, c.formula, *(f"{g.error:+.4f}" if g.exact else f"{g.measured:.3g} {g.unit}"
+                                           for g in group))
+    console.print(table)
+    s = result["summary"]
+    for outcome, what in (("held", "held under gravity"), ("held_shake", "held after the shake")):
+        o = s["overall"][outcome]
+        console.print(f"certified to hold at F against {what}: {o['trials']} trials on {len(s['per_mesh'])} meshes, "
+                      f"precision {_fmt(o['precision'])}, recall {_fmt(o['recall'])}", soft_wrap=True)
+    sp = s["spearman"]
+    console.print(f"Spearman of the certified least grip force with the least that holds in physics: "
+                  f"{_fmt(sp['rho'], '+.2f')} ({sp['n']} poses)", soft_wrap=True)
+    for path in result["files"]:
+        console.print(f"wrote {path}", soft_wrap=True)
+    console.print(f"{len(result['trials'])} spatial trials in {result['seconds']:.0f} s", soft_wrap=True)
 
 
 def _fmt(value, spec=".3f") -> str:

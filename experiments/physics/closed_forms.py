@@ -27,6 +27,25 @@ Cases (:func:`cases`)
   pymunk circle, no facets): every contact force passes through the centre, so **no torque is
   resisted**, ``tau* = 0``, however small.
 
+Spatial cases (:func:`spatial_cases`, MuJoCo: :mod:`qualgrasp.experiments.physics.spatial`; SI units)
+------------------------------------------------------------------------------------------------
+* **Box, grip force.** A box of 50 x 60 x 70 mm and mass :data:`BOX_MASS` squeezed by the two pads
+  across its 50 mm faces, at their centres, without gravity: each pad's normal contact force is
+  **the grip force ``F``** (5 N); also the deepest penetration.
+* **Box, least grip force.** The same grasp with gravity along the faces (``-z``): the two friction
+  forces, each at most ``mu F``, hold the weight iff ``2 mu F >= m g``: **``F* = m g / (2 mu)``**,
+  for ``mu`` in :data:`MUS`; measured by :func:`~qualgrasp.experiments.physics.spatial.least_physical_grip`
+  to the ratio :data:`SPATIAL_PRECISION` (the upper end of the final bracket is reported: the
+  error lies within ``[-0.2 %, 0]`` of the one stated).
+* **Box, weight along the closing axis.** The same box gripped across its 70 mm faces with the
+  closing axis vertical: the pads are coupled (the hand closes them with ``2 F`` in all), so the
+  lower pad carries the weight while ``2 F >= m g``: **``F* = m g / 2``** (certify's least grip
+  force is ``m g``: there each pad's normal force is at most ``F``, here the lower one's is
+  ``F + m g / 2``).
+* **Box, creep at 2 F*.** The slip under gravity (``Physics.hold`` seconds) at twice ``F*``, ``mu``
+  0.5: static friction holds, **slip 0**; a soft-constraint engine lets it creep (the error is the
+  slip in mm).
+
 Each measured value is the bisection of :func:`qualgrasp.experiments.physics.planar.resistance`
 in the one direction of the case (to the ratio :data:`PRECISION`, floor :data:`FLOOR`), whose
 lower end is reported; the relative error is ``measured / closed form - 1`` (the absolute value
@@ -45,7 +64,8 @@ from shapely.geometry import box
 
 from .planar import Finger, Physics, PlanarObject, resistance, squeeze
 
-__all__ = ["MUS", "PRECISION", "FLOOR", "ClosedForm", "square_grasp", "disc_grasp", "cases"]
+__all__ = ["MUS", "PRECISION", "FLOOR", "SPATIAL_PRECISION", "BOX_MASS", "ClosedForm", "square_grasp", "disc_grasp", "cases", "box_grasp",
+           "spatial_cases"]
 
 MUS = (0.25, 0.5, 1.0)
 """Friction coefficients of the push along the faces."""
@@ -55,6 +75,12 @@ PRECISION = 1.01
 
 FLOOR = 1e-3
 """Smallest magnitude tested in the closed-form cases (``F0``)."""
+
+SPATIAL_PRECISION = 1.002
+"""Ratio of the bisection's final bracket in the spatial cases."""
+
+BOX_MASS = 0.3
+"""Mass of the spatial cases' box, kg."""
 
 
 @dataclass(frozen=True)
@@ -155,4 +181,57 @@ def cases(physics: Physics = Physics()) -> list[ClosedForm]:
     disc, three = disc_grasp()
     rows.append(_row("disc, 3 frictionless fingers: torque", "0", 0.0,
                      _measure(disc, three, 0.0, (0, 0, 1), physics), "F0 (torque / L)"))
+    return rows
+
+
+def box_grasp(mu: float = 0.5):
+    """The spatial cases' box (50 x 60 x 70 mm, :data:`BOX_MASS`) and the Franka hand's pads across
+    its 50 mm faces at their centres, opened to 60 mm: ``(SpatialObject, Jaw)``."""
+    import trimesh
+
+    from ...certify.meshes.gripper import load_gripper
+    from ...certify.meshes.mesh import mass_properties
+    from .spatial import Jaw, SpatialObject, convex_pieces
+
+    box = trimesh.creation.box((0.05, 0.06, 0.07))
+    obj = SpatialObject(tuple(convex_pieces(box)[0]), mass_properties(box, mass=BOX_MASS))
+    return obj, Jaw(np.eye(4), 0.06, load_gripper("franka_panda"), mu, (0.0, 0.0))
+
+
+def spatial_cases(physics=None) -> list[ClosedForm]:
+    """Every spatial closed-form case of the module notes, measured with ``physics``
+    (:class:`~qualgrasp.experiments.physics.spatial.SpatialPhysics`, default its defaults); needs
+    mujoco.
+
+    Examples
+    --------
+    >>> rows = spatial_cases()
+    >>> [r.case for r in rows][:2]
+    ['box: grip force', 'box: penetration']
+    """
+    from ...certify.meshes.task import G
+    from .spatial import SpatialPhysics, least_physical_grip, squeeze_forces, trial
+
+    physics = physics or SpatialPhysics()
+    obj, jaw = box_grasp()
+    grip = 5.0
+    forces, depth = squeeze_forces(obj, jaw, grip, physics)
+    rows = [_row("box: grip force", "F", grip, float(forces.mean()), "N"),
+            ClosedForm("box: penetration", "0", 0.0, 1000 * depth, 1000 * depth, "mm")]
+    for mu in MUS:
+        obj, jaw = box_grasp(mu)
+        exact = BOX_MASS * G / (2 * mu)
+        # a bracket whose log-midpoints never land on the closed form itself
+        measured = least_physical_grip(obj, jaw, exact / 3, exact * 3.7, physics, precision=SPATIAL_PRECISION)
+        rows.append(_row(f"box: least grip force, mu {mu:g}", "m g / (2 mu)", exact, measured, "N"))
+    obj, jaw = box_grasp(0.5)
+    T = np.eye(4)
+    T[:3, :3] = ((0, 0, 1), (0, 1, 0), (-1, 0, 0))  # the hand's closing axis x along -z
+    vertical = replace(jaw, T=T, width=0.08)
+    exact = BOX_MASS * G / 2
+    rows.append(_row("box: weight along the closing axis", "m g / 2", exact,
+                     least_physical_grip(obj, vertical, exact / 3, exact * 3.7, physics, precision=SPATIAL_PRECISION),
+                     "N"))
+    slip = trial(obj, jaw, 2 * BOX_MASS * G, physics, shake=False).slip
+    rows.append(ClosedForm("box: creep at 2 F*, mu 0.5", "0", 0.0, 1000 * slip, 1000 * slip, "mm"))
     return rows
