@@ -62,11 +62,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
                                   "images."),
     "bench": (_EXPERIMENTS, "Time every certification route on the same random grasps, with ratios to the batch "
                             "path."),
-    "validate": (_PHYSICS, "Do certified grasps hold in a physics engine? Planar trials (pymunk) of the "
-                           "qualitative, baseline and random grasps of every object, nominal and with placement "
-                           "errors inside and outside their certified regions; the simulator's error on "
-                           "closed-form cases. Exit code 2 on a refused option or output folder, or when pymunk "
-                           "is not installed."),
+    "validate": (_PHYSICS, "Do certified grasps hold in a physics engine? Planar and spatial trials against "
+                           "certified verdicts."),
 }
 
 

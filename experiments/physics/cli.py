@@ -55,8 +55,9 @@ def validate_command(
                                                               "(made-up meshes fill up to 20), certified to hold "
                                                               "their weight, executed in MuJoCo."),
 ) -> None:
-    """Do certified grasps hold in a physics engine? Planar trials (pymunk) of the qualitative, baseline
-    and random grasps of every object, nominal and with placement errors inside and outside their
+    """Do certified grasps hold in a physics engine? Planar and spatial trials against certified verdicts.
+
+    Planar trials (pymunk) of the qualitative, baseline and random grasps of every object, nominal and with placement errors inside and outside their
     certified regions; the simulator's error on closed-form cases. With --spatial, parallel-jaw
     grasps on meshes in MuJoCo against their certified least grip force. Exit code 2 on a refused
     option or output folder, or when pymunk (mujoco for --spatial) is not installed."""
