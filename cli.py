@@ -17,9 +17,8 @@ from __future__ import annotations
 import importlib
 from importlib import metadata
 
-import click
 import typer
-from typer.core import TyperGroup
+from typer.core import TyperCommand, TyperGroup
 
 __all__ = ["COMMANDS", "app", "main"]
 
@@ -67,7 +66,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
 }
 
 
-def registered_commands(module: str) -> dict[str, click.Command]:
+def registered_commands(module: str) -> dict[str, TyperCommand]:
     """The click commands that ``module``'s ``register`` adds, by name (imports the module)."""
     commands = typer.Typer()
     importlib.import_module(module).register(commands)
@@ -77,22 +76,22 @@ def registered_commands(module: str) -> dict[str, click.Command]:
 class _LazyGroup(TyperGroup):
     """The application's group: lists :data:`COMMANDS` from their summaries, loads one on use."""
 
-    def list_commands(self, ctx: click.Context) -> list[str]:
+    def list_commands(self, ctx: typer.Context) -> list[str]:
         return list(COMMANDS)
 
-    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+    def get_command(self, ctx: typer.Context, cmd_name: str) -> TyperCommand | None:
         # what the group's help lists: the summary only, the command's module left unloaded
         if cmd_name not in COMMANDS:
             return None
-        return click.Command(cmd_name, help=COMMANDS[cmd_name][1])
+        return TyperCommand(cmd_name, help=COMMANDS[cmd_name][1])
 
-    def load_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+    def load_command(self, ctx: typer.Context, cmd_name: str) -> TyperCommand | None:
         """The command itself, with its options (imports the module registering it)."""
         if cmd_name not in COMMANDS:
             return None
         return registered_commands(COMMANDS[cmd_name][0])[cmd_name]
 
-    def resolve_command(self, ctx: click.Context, args: list[str]):
+    def resolve_command(self, ctx: typer.Context, args: list[str]):
         name = args[0] if args else None
         if name not in COMMANDS:
             return super().resolve_command(ctx, args)

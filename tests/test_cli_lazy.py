@@ -13,7 +13,9 @@ import pytest
 import qualgrasp
 from qualgrasp.cli import COMMANDS, registered_commands
 
-HEAVY = ("numba", "numpy", "scipy", "cvxpy", "clarabel", "matplotlib", "pyarrow", "trimesh", "cv2", "shapely")
+# the numerical libraries, and click, which typer vendors and qualgrasp does not depend on
+HEAVY = ("numba", "numpy", "scipy", "cvxpy", "clarabel", "matplotlib", "pyarrow", "trimesh", "cv2", "shapely",
+         "click")
 
 
 def _loaded_after(code: str) -> list[str]:
