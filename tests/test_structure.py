@@ -21,7 +21,7 @@ ROOT = pathlib.Path(qualgrasp.__file__).parent
 #: (resource), and cvxpy's reference route (1.5 s to import; only ``make_solver("reference")``
 #: needs it).
 LAZY = {"distributed", "resource", "qualgrasp.certify.solvers.reference", "h5py", "embreex",
-        "trimesh.ray.ray_pyembree", "pymunk"}
+        "trimesh.ray.ray_pyembree", "pymunk", "mujoco", "coacd"}
 
 MODULES = import_graph.modules(ROOT)
 

@@ -18,6 +18,7 @@ from ...certify.cli.options import OptionError, count_in, output_folder
 from ..design import BUILTINS
 from ..silhouettes import available_silhouettes, available_wings
 from ..silhouettes import silhouettes as bundled
+from .spatial_study import validate_spatial
 from .study import VALIDATIONS, validate
 
 __all__ = ["register"]
@@ -98,8 +99,6 @@ def validate_command(
 
 def _spatial(out: Path, setting: str) -> None:
     """Run and print the spatial study (the same --setting)."""
-    from .spatial_study import validate_spatial
-
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                   console=console) as bar:
         task = bar.add_task("validate --spatial", total=None)

@@ -60,9 +60,14 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
+import trimesh
 from shapely.geometry import box
 
+from ...certify.meshes.gripper import load_gripper
+from ...certify.meshes.mesh import mass_properties
+from ...certify.meshes.task import G
 from .planar import Finger, Physics, PlanarObject, resistance, squeeze
+from .spatial import Jaw, SpatialObject, SpatialPhysics, convex_pieces, least_physical_grip, squeeze_forces, trial
 
 __all__ = ["MUS", "PRECISION", "FLOOR", "SPATIAL_PRECISION", "BOX_MASS", "ClosedForm", "square_grasp", "disc_grasp", "cases", "box_grasp",
            "spatial_cases"]
@@ -187,12 +192,6 @@ def cases(physics: Physics = Physics()) -> list[ClosedForm]:
 def box_grasp(mu: float = 0.5):
     """The spatial cases' box (50 x 60 x 70 mm, :data:`BOX_MASS`) and the Franka hand's pads across
     its 50 mm faces at their centres, opened to 60 mm: ``(SpatialObject, Jaw)``."""
-    import trimesh
-
-    from ...certify.meshes.gripper import load_gripper
-    from ...certify.meshes.mesh import mass_properties
-    from .spatial import Jaw, SpatialObject, convex_pieces
-
     box = trimesh.creation.box((0.05, 0.06, 0.07))
     obj = SpatialObject(tuple(convex_pieces(box)[0]), mass_properties(box, mass=BOX_MASS))
     return obj, Jaw(np.eye(4), 0.06, load_gripper("franka_panda"), mu, (0.0, 0.0))
@@ -209,9 +208,6 @@ def spatial_cases(physics=None) -> list[ClosedForm]:
     >>> [r.case for r in rows][:2]
     ['box: grip force', 'box: penetration']
     """
-    from ...certify.meshes.task import G
-    from .spatial import SpatialPhysics, least_physical_grip, squeeze_forces, trial
-
     physics = physics or SpatialPhysics()
     obj, jaw = box_grasp()
     grip = 5.0

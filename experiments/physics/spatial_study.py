@@ -33,6 +33,7 @@ reused by a later run in the same folder.
 
 from __future__ import annotations
 
+import csv
 import hashlib
 import math
 import time
@@ -51,6 +52,7 @@ from ...certify.meshes.rays import RayCaster
 from ...certify.meshes.sampling import sample_poses
 from ...certify.meshes.task import hold_verdict, least_grip
 from ..mesh_study import made_up_meshes, real_meshes
+from ..style import new_figure, save
 from . import closed_forms
 from .spatial import Jaw, SpatialObject, SpatialPhysics, convex_pieces, least_physical_grip, trial
 
@@ -372,13 +374,10 @@ def spatial_markdown(summary: dict, closed: dict, settings: SpatialValidation, m
 def plot_held_rate(out: Path, trials: list[dict]) -> Path:
     """``spatial-held-rate.png``: held rate against the grip force over ``F_min``, one thin line per
     mesh, the overall rate thick; the certified threshold (ratio 1) marked."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     main = [r for r in trials if r["setting"] == "default" and r["f_min"] is not None]
     ratios = sorted({r["ratio"] for r in main})
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    fig = new_figure(6.4, 4.2)
+    ax = fig.subplots()
     for mesh in dict.fromkeys(r["mesh"] for r in main):
         rate = [np.mean([r["held"] for r in main if r["mesh"] == mesh and r["ratio"] == x] or [np.nan])
                 for x in ratios]
@@ -400,16 +399,10 @@ def plot_held_rate(out: Path, trials: list[dict]) -> Path:
     ax.set_title(f"MuJoCo: {len({r['mesh'] for r in main})} meshes (thin: each mesh), poses with finite F_min",
                  fontsize=9)
     ax.legend(fontsize=8, loc="lower right")
-    fig.tight_layout()
-    path = out / "spatial-held-rate.png"
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
-    return path
+    return save(fig, out, "spatial-held-rate", ("png",))[0]
 
 
 def _write(path: Path, columns, rows) -> Path:
-    import csv
-
     with path.open("w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
         w.writerow(columns)
