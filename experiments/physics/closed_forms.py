@@ -27,8 +27,10 @@ Cases (:func:`cases`)
   pymunk circle, no facets): every contact force passes through the centre, so **no torque is
   resisted**, ``tau* = 0``, however small.
 
-Spatial cases (:func:`spatial_cases`, MuJoCo: :mod:`qualgrasp.experiments.physics.spatial`; SI units)
-------------------------------------------------------------------------------------------------
+Spatial cases
+-------------
+:func:`spatial_cases`, in MuJoCo (:mod:`qualgrasp.experiments.physics.spatial`), SI units:
+
 * **Box, grip force.** A box of 50 x 60 x 70 mm and mass :data:`BOX_MASS` squeezed by the two pads
   across its 50 mm faces, at their centres, without gravity: each pad's normal contact force is
   **the grip force ``F``** (5 N); also the deepest penetration.
