@@ -72,7 +72,7 @@ from .planar import Finger, Physics, PlanarObject, resistance, squeeze
 from .spatial import Jaw, SpatialObject, SpatialPhysics, convex_pieces, least_physical_grip, squeeze_forces, trial
 
 __all__ = ["MUS", "PRECISION", "FLOOR", "SPATIAL_PRECISION", "BOX_MASS", "ClosedForm", "square_grasp", "disc_grasp", "cases", "box_grasp",
-           "spatial_cases"]
+           "spatial_cases", "table_lines"]
 
 MUS = (0.25, 0.5, 1.0)
 """Friction coefficients of the push along the faces."""
@@ -139,6 +139,19 @@ def disc_grasp() -> tuple[PlanarObject, list[Finger]]:
 def _measure(obj, fingers, mu, direction, physics: Physics) -> float:
     ph = replace(physics, floor=FLOOR, precision=PRECISION)
     return resistance(obj, fingers, mu, ph, np.array([direction], dtype=float)).magnitude
+
+
+def table_lines(closed: dict[str, list[ClosedForm]], error_spec: str, *, units: bool) -> list[str]:
+    """Markdown table of the closed-form cases measured at several settings (``closed``: the
+    cases by setting name, in the same order): case, formula, exact value (with its unit when
+    ``units``), then the measured value and the error (formatted by ``error_spec``) per setting."""
+    lines = ["| case | closed form | exact | " + " | ".join(f"measured ({k}) | error ({k})" for k in closed) + " |",
+             "|---|---|---|" + "---|---|" * len(closed)]
+    for i, c in enumerate(next(iter(closed.values()))):
+        cells = " | ".join(f"{closed[k][i].measured:.4g} | {format(closed[k][i].error, error_spec)}" for k in closed)
+        exact = f"{c.exact:.4g} {c.unit}" if units else f"{c.exact:.4g}"
+        lines.append(f"| {c.case} | {c.formula} | {exact} | {cells} |")
+    return lines
 
 
 def _row(case, formula, exact, measured, unit) -> ClosedForm:

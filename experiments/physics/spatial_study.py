@@ -54,6 +54,7 @@ from ...certify.meshes.task import hold_verdict, least_grip
 from ..mesh_study import made_up_meshes, real_meshes
 from ..style import new_figure, save
 from . import closed_forms
+from .study import cell, confusion, rate
 from .spatial import Jaw, SpatialObject, SpatialPhysics, convex_pieces, least_physical_grip, trial
 
 __all__ = ["SETTLED", "SECOND", "TRIAL_COLUMNS", "POSE_COLUMNS", "SpatialValidation", "SPATIAL_VALIDATIONS", "study_meshes",
@@ -211,16 +212,8 @@ def validate_mesh(name: str, mesh, source: str, settings: SpatialValidation, *, 
     return trials, poses
 
 
-def _rate(num: int, den: int) -> float | None:
-    return num / den if den else None
-
-
 def _pr(rows: list[dict], outcome: str) -> dict:
-    tp = sum(1 for r in rows if r["certified"] and r[outcome])
-    fp = sum(1 for r in rows if r["certified"] and not r[outcome])
-    fn = sum(1 for r in rows if not r["certified"] and r[outcome])
-    return {"trials": len(rows), "certified": tp + fp, "held": tp + fn, "tp": tp, "fp": fp, "fn": fn,
-            "tn": len(rows) - tp - fp - fn, "precision": _rate(tp, tp + fp), "recall": _rate(tp, tp + fn)}
+    return {"trials": len(rows), **confusion(rows, "certified", outcome)}
 
 
 def summarise_spatial(trials: list[dict], poses: list[dict]) -> dict:
@@ -248,10 +241,10 @@ def summarise_spatial(trials: list[dict], poses: list[dict]) -> dict:
     for ratio in sorted({r["ratio"] for r in main}):
         sel = [r for r in main if r["ratio"] == ratio]
         sel_soft = [r for r in soft if r["ratio"] == ratio]
-        out["by_ratio"][ratio] = {"trials": len(sel), "held": _rate(sum(r["held"] for r in sel), len(sel)),
-                                  "held_shake": _rate(sum(r["held_shake"] for r in sel), len(sel)),
-                                  "held_soft": _rate(sum(r["held"] for r in sel_soft), len(sel_soft)),
-                                  "certified": _rate(sum(r["certified"] for r in sel), len(sel))}
+        out["by_ratio"][ratio] = {"trials": len(sel), "held": rate(sum(r["held"] for r in sel), len(sel)),
+                                  "held_shake": rate(sum(r["held_shake"] for r in sel), len(sel)),
+                                  "held_soft": rate(sum(r["held"] for r in sel_soft), len(sel_soft)),
+                                  "certified": rate(sum(r["certified"] for r in sel), len(sel))}
     for key, column in (("spearman", "f_phys"), ("spearman_soft", "f_phys_soft")):
         both = [p for p in poses if p["f_min"] is not None and p.get(column) is not None]
         rho = (float(spearmanr([p["f_min"] for p in both], [p[column] for p in both]).statistic)
@@ -281,10 +274,6 @@ def summarise_spatial(trials: list[dict], poses: list[dict]) -> dict:
     return out
 
 
-def _cell(v, spec=".3f") -> str:
-    return "-" if v is None else format(v, spec)
-
-
 def spatial_markdown(summary: dict, closed: dict, settings: SpatialValidation, meshes: dict, seconds: float) -> str:
     """The Markdown summary of a spatial run."""
     ph = settings.physics
@@ -300,13 +289,7 @@ def spatial_markdown(summary: dict, closed: dict, settings: SpatialValidation, m
              f"close, release under gravity for {ph.hold:g} s (**held**: slip at most {1000 * ph.slip:g} mm), "
              f"shake (peak {ph.shake_accel:.2f} m/s^2 along and {ph.shake_alpha:g} rad/s^2 about each axis of "
              f"the hand, {ph.shake_freq:g} Hz). Second setting: {settings.second.label()}.", "",
-             "## The simulator on closed-form cases", "",
-             "| case | closed form | exact | " + " | ".join(f"measured ({k}) | error ({k})" for k in closed) + " |",
-             "|---|---|---|" + "---|---|" * len(closed)]
-    first = next(iter(closed.values()))
-    for i, c in enumerate(first):
-        cells = " | ".join(f"{closed[k][i].measured:.4g} | {closed[k][i].error:+.4f}" for k in closed)
-        lines.append(f"| {c.case} | {c.formula} | {c.exact:.4g} {c.unit} | {cells} |")
+             "## The simulator on closed-form cases", "", *closed_forms.table_lines(closed, "+.4f", units=True)]
     lines += ["", "## Certified to hold at F against held in physics", "",
               "Outcomes: `held` (under gravity, point contacts: condim 3), `held_shake` (and after the shake), "
               "`soft` (held under gravity with condim 4: the certified soft contact's torsional friction).", "",
@@ -317,13 +300,13 @@ def spatial_markdown(summary: dict, closed: dict, settings: SpatialValidation, m
         for outcome in ("held", "held_shake", "soft"):
             s = c[outcome]
             lines.append(f"| {mesh} | {outcome} | {s['trials']} | {s['certified']} | {s['held']} | {s['tp']} | "
-                         f"{s['fp']} | {s['fn']} | {_cell(s['precision'])} | {_cell(s['recall'])} |")
+                         f"{s['fp']} | {s['fn']} | {cell(s['precision'])} | {cell(s['recall'])} |")
     lines += ["", "## Held rate against the grip force", "",
               "| F / F_min | trials | certified | held | held after the shake | held (soft, condim 4) |",
               "|---|---|---|---|---|---|"]
     for ratio, b in summary["by_ratio"].items():
-        lines.append(f"| {ratio:g} | {b['trials']} | {_cell(b['certified'])} | {_cell(b['held'])} | "
-                     f"{_cell(b['held_shake'])} | {_cell(b['held_soft'])} |")
+        lines.append(f"| {ratio:g} | {b['trials']} | {cell(b['certified'])} | {cell(b['held'])} | "
+                     f"{cell(b['held_shake'])} | {cell(b['held_soft'])} |")
     lines += ["", "## The smallest grip force that holds in physics", "",
               f"F_phys by bisection between F_min / 8 and 8 F_min (the mesh's median F_min when it is infinite), to "
               f"the ratio {settings.precision:g}.", "",
@@ -332,9 +315,9 @@ def spatial_markdown(summary: dict, closed: dict, settings: SpatialValidation, m
     for key, name in (("spearman", "condim 3"), ("spearman_soft", "condim 4 (soft)")):
         sp = summary[key]
         rng = sp["ratio_range"]
-        lines.append(f"| {name} | {sp['poses']} | {sp['finite']} | {sp['n']} | {_cell(sp['rho'], '+.3f')} | "
-                     f"{_cell(sp['ratio_median'])} | {_cell(rng[0] if rng else None)} to "
-                     f"{_cell(rng[1] if rng else None)} |")
+        lines.append(f"| {name} | {sp['poses']} | {sp['finite']} | {sp['n']} | {cell(sp['rho'], '+.3f')} | "
+                     f"{cell(sp['ratio_median'])} | {cell(rng[0] if rng else None)} to "
+                     f"{cell(rng[1] if rng else None)} |")
     lines.append("")
     lines += ["", "## Objects the squeeze re-seated", "",
               f"Trials in which closing the pads moved the object more than {1000 * SETTLED:g} mm (centre of mass "
@@ -349,7 +332,7 @@ def spatial_markdown(summary: dict, closed: dict, settings: SpatialValidation, m
               "precision | recall |", "|---|---|---|---|---|---|---|---|---|"]
     for label, c in summary["unmoved"].items():
         lines.append(f"| {label} | {c['trials']} | {c['certified']} | {c['held']} | {c['tp']} | {c['fp']} | {c['fn']} | "
-                     f"{_cell(c['precision'])} | {_cell(c['recall'])} |")
+                     f"{cell(c['precision'])} | {cell(c['recall'])} |")
     fps = summary["false_positives"]
     lines += ["", f"## Certified to hold, not held: {len(fps)} trials", ""]
     if fps:
@@ -360,14 +343,14 @@ def spatial_markdown(summary: dict, closed: dict, settings: SpatialValidation, m
                          f"{r['slip_mm']:.1f} | {r['dropped']} | {r.get('settle_mm', 0.0):.1f} |")
     lines.append("")
     med, p95 = summary["seconds"]
-    lines.append(f"Seconds per trial (close, release, shake): median {_cell(med)}, 95th percentile {_cell(p95)}.")
+    lines.append(f"Seconds per trial (close, release, shake): median {cell(med)}, 95th percentile {cell(p95)}.")
     sec = summary["second"]
     if sec["pairs"]:
         lines += ["", "## The second physics setting", "",
                   f"{sec['pairs']} trials run again at {settings.second.label()}: the held verdict agrees on "
-                  f"{sec['agree']}; precision/recall {_cell(sec['default']['precision'])}/"
-                  f"{_cell(sec['default']['recall'])} at the default setting, "
-                  f"{_cell(sec['second']['precision'])}/{_cell(sec['second']['recall'])} at the second."]
+                  f"{sec['agree']}; precision/recall {cell(sec['default']['precision'])}/"
+                  f"{cell(sec['default']['recall'])} at the default setting, "
+                  f"{cell(sec['second']['precision'])}/{cell(sec['second']['recall'])} at the second."]
     return "\n".join(lines) + "\n"
 
 

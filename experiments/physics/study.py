@@ -81,7 +81,7 @@ from .plots import plot_all, plot_filmstrip
 
 __all__ = ["COLUMNS", "FINE", "STIFF", "Validation", "QUICK_VALIDATION", "FULL_VALIDATION", "VALIDATIONS",
            "ValidationResult", "grasps_of", "placement", "validate_object", "explain", "summarise", "summary_markdown",
-           "read_trials", "read_closed_forms", "filmstrip", "report", "validate"]
+           "read_trials", "read_closed_forms", "filmstrip", "report", "validate", "rate", "confusion", "cell"]
 
 FINE = Physics(dt=5e-4, iterations=40, stiffness=1000.0)
 """The second physics setting: half the time step, twice the solver iterations, twice the
@@ -421,17 +421,23 @@ def validate_object(subject: Subject, settings: Validation = QUICK_VALIDATION, r
 # Summary
 
 
-def _rate(num: int, den: int) -> float | None:
+def rate(num: int, den: int) -> float | None:
+    """``num / den``, None when ``den`` is 0."""
     return num / den if den else None
 
 
+def confusion(rows: list[dict], predicted: str, outcome: str) -> dict:
+    """The certified verdict ``predicted`` against the physical ``outcome`` of ``rows`` (truth
+    values by key): ``certified``, ``held``, ``tp``, ``fp``, ``fn``, ``tn``, ``precision``, ``recall``."""
+    tp = sum(1 for r in rows if r[predicted] and r[outcome])
+    fp = sum(1 for r in rows if r[predicted] and not r[outcome])
+    fn = sum(1 for r in rows if not r[predicted] and r[outcome])
+    return {"certified": tp + fp, "held": tp + fn, "tp": tp, "fp": fp, "fn": fn, "tn": len(rows) - tp - fp - fn,
+            "precision": rate(tp, tp + fp), "recall": rate(tp, tp + fn)}
+
+
 def _confusion(rows: list[dict], verdict: str) -> dict:
-    tp = sum(1 for r in rows if r[verdict] and r["held"])
-    fp = sum(1 for r in rows if r[verdict] and not r["held"])
-    fn = sum(1 for r in rows if not r[verdict] and r["held"])
-    tn = sum(1 for r in rows if not r[verdict] and not r["held"])
-    return {"grasps": len(rows), "certified": tp + fp, "held": tp + fn, "tp": tp, "fp": fp, "fn": fn, "tn": tn,
-            "precision": _rate(tp, tp + fp), "recall": _rate(tp, tp + fn)}
+    return {"grasps": len(rows), **confusion(rows, verdict, "held")}
 
 
 def _spearman(x: Sequence[float], y: Sequence[float]) -> tuple[float | None, int]:
@@ -464,7 +470,7 @@ def summarise(rows: list[dict]) -> dict:
     for kind in ("inside", "outside"):
         sel = [r for r in rows if r["placement"] == kind]
         n_held = sum(1 for r in sel if r["held"])
-        placements[kind] = {"placements": len(sel), "held": n_held, "rate": _rate(n_held, len(sel))}
+        placements[kind] = {"placements": len(sel), "held": n_held, "rate": rate(n_held, len(sel))}
     exceptions = [r for r in rows if r["placement"] == "inside" and not r["held"]]
     return {"confusion": confusion, "spearman": spearman, "placements": placements, "exceptions": exceptions}
 
@@ -490,7 +496,8 @@ def _write_csv(path: Path, columns: Sequence[str], rows: Iterable[dict]) -> Path
     return path
 
 
-def _cell(v, spec=".3f") -> str:
+def cell(v, spec=".3f") -> str:
+    """A table cell: ``v`` formatted, ``-`` for None."""
     return "-" if v is None else format(v, spec)
 
 
@@ -504,30 +511,24 @@ def summary_markdown(summary: dict, closed: dict, settings: Validation, objects:
              f"slip tolerance {ph.slip:g} of the size, floor {ph.floor:g} F0, {settings.directions} directions). "
              "A grasp **held** when it resisted the floor disturbance in every direction; **resisted** is the largest "
              "disturbance resisted in every direction (F0, torques over the object's radius).", "",
-             "## The simulator on closed-form cases", "",
-             "| case | closed form | exact | " + " | ".join(f"measured ({k}) | error ({k})" for k in closed) + " |",
-             "|---|---|---|" + "---|---|" * len(closed)]
-    first = next(iter(closed.values()))
-    for i, c in enumerate(first):
-        cells = " | ".join(f"{closed[k][i].measured:.4g} | {closed[k][i].error:+.3f}" for k in closed)
-        lines.append(f"| {c.case} | {c.formula} | {c.exact:.4g} | {cells} |")
+             "## The simulator on closed-form cases", "", *closed_forms.table_lines(closed, "+.3f", units=False)]
     lines += ["", "## Certified verdict against the physical outcome (nominal placement)", "",
               "| verdict | grasps | certified | held | certified and held | certified, not held | "
               "held, not certified | precision | recall |", "|---|---|---|---|---|---|---|---|---|"]
     for (verdict, source), c in summary["confusion"].items():
         name = {"certified": "as planned", "certified_true": "on the true object"}[verdict]
         lines.append(f"| {source}, {name} | {c['grasps']} | {c['certified']} | {c['held']} | {c['tp']} | {c['fp']} | "
-                     f"{c['fn']} | {_cell(c['precision'])} | {_cell(c['recall'])} |")
+                     f"{c['fn']} | {cell(c['precision'])} | {cell(c['recall'])} |")
     lines += ["", "## Rank correlation with the largest resisted disturbance (certified grasps that held)", "",
               "| route | Spearman eps (n) | Spearman eps on the true object (n) | Spearman tolerance (n) |",
               "|---|---|---|---|"]
     for route, s in summary["spearman"].items():
-        cells = " | ".join(f"{_cell(v, '+.2f')} ({n})" for v, n in (s["eps"], s["eps_true"], s["tolerance"]))
+        cells = " | ".join(f"{cell(v, '+.2f')} ({n})" for v, n in (s["eps"], s["eps_true"], s["tolerance"]))
         lines.append(f"| {route} | {cells} |")
     lines += ["", "## Placements inside and outside the certified regions", "",
               "| placements | trials | held | held rate |", "|---|---|---|---|"]
     for kind, p in summary["placements"].items():
-        lines.append(f"| {kind} | {p['placements']} | {p['held']} | {_cell(p['rate'])} |")
+        lines.append(f"| {kind} | {p['placements']} | {p['held']} | {cell(p['rate'])} |")
     exc = summary["exceptions"]
     lines += ["", f"Placements inside that did not hold: {len(exc)}."]
     if exc:
@@ -543,8 +544,8 @@ def summary_markdown(summary: dict, closed: dict, settings: Validation, objects:
         ratio = [b["resisted"] / a["resisted"] for a, b in pairs if a["resisted"] and b["resisted"]]
         lines += ["", "## The second physics setting", "",
                   f"{len(pairs)} nominal trials run again at {FINE.label()}: the held verdict agrees on {agree}; "
-                  f"resisted (fine / default) median {_cell(float(np.median(ratio)) if ratio else None)}, "
-                  f"range {_cell(min(ratio) if ratio else None)} to {_cell(max(ratio) if ratio else None)}."]
+                  f"resisted (fine / default) median {cell(float(np.median(ratio)) if ratio else None)}, "
+                  f"range {cell(min(ratio) if ratio else None)} to {cell(max(ratio) if ratio else None)}."]
     return "\n".join(lines) + "\n"
 
 
