@@ -19,8 +19,10 @@ Planar rows whose generator matrix is numerically rank deficient (normals throug
 antipodal grasps of discs, squares grasped through the centre; repeated or collinear contacts) are
 decided by the per-grasp rules on the arrays (:func:`_planar_thin`: the dual direction's Farkas
 certificate, clarabel where the enumeration has no dual direction, the exact rank in integers or
-proved in floats), each certificate's exact re-check decided without Fractions; a certificate the
-per-grasp path states but its exact re-check refuses is stated the same, unverified.
+proved in floats), each certificate's exact re-check decided without Fractions. Where the dual
+direction is orthogonal to nearly parallel generators only in floats, both routes state the
+exact normal of their span instead (:func:`qualgrasp.certify.core.closure.exact_farkas`), here
+from integers (:func:`_projected_normal`).
 
 Every row these rules do not settle (invalid input, near-degenerate problems, certificates the
 float re-check cannot decide, spatial rows that need the epsilon) goes through the per-grasp
@@ -57,7 +59,7 @@ from ..solvers.squeeze import squeeze_farkas
 from ..files.reader import rows_to_table
 from ._arrow import assemble, group_table
 from .. import models as registry
-from ..core.exact import dyadic_integers
+from ..core.exact import dyadic_integers, unit_direction
 from ..core.wrench import (force_column_errors, force_columns, generator_columns, generator_layout,
                            planar_generator_rank, planar_pair_normal)
 
@@ -235,10 +237,10 @@ def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
         planar_generators(P[i], N[i], mu[i], width[i], c[i], L[i], owner, offset, friction, W[r], E[r])
     if k < 3:  # the kernel's float proof of its null direction failed: decided exactly
         for i in rows if k == 2 else ():
-            ok = _pair_orthogonal(planar_pair_normal(P[i], N[i], mu[i], width[i], c[i], L[i], owner, offset,
-                                                     friction), y[i])
-            if ok is not None:
-                code[i], verified[i] = 3, ok
+            z = planar_pair_normal(P[i], N[i], mu[i], width[i], c[i], L[i], owner, offset, friction)
+            yi = y[i] if _pair_orthogonal(z, y[i]) else _projected_normal(z, y[i])
+            if yi is not None and _pair_orthogonal(z, yi):
+                code[i], y[i] = 3, yi
         return (code, t, lam, basis, y), tight_rows, verified
     U, sv, _ = np.linalg.svd(W, full_matrices=False) if len(rows) else (None, np.ones((0, 1)), None)
     thin_rows = np.flatnonzero(sv[:, -1] <= tol.rank * sv[:, 0])
@@ -254,9 +256,9 @@ def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
     code[at[strict & proved]] = 2
     y[at[strict & proved]] = yf[strict & proved]
     code[at[has_y & ~ok & full]] = 5  # no certificate from the dual direction, exact rank 3
-    # every generator tight, exact rank 3: nothing is left once projected, the checker refuses it
+    # every generator tight, exact rank 3: nothing is left once projected, the rank decides
     refused = has_y & ok & tight.all(axis=1) & full
-    code[at[refused]], y[at[refused]], verified[at[refused]] = 3, yf[refused], False
+    code[at[refused]] = 5
     cone, first, ones = _ray_blocks(k)
     arrays = (cone, first, ones, np.zeros((k, 2)), np.zeros(k), np.zeros(k))
     solver = make_solver("fast")
@@ -267,9 +269,15 @@ def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
         yp = np.where(ok[pair][:, None], yf[pair], U[thin_rows[pair], :, -1])
         state = pair_null_rows(np.ascontiguousarray(W[thin_rows[pair]]), np.ascontiguousarray(E[thin_rows[pair]]),
                                np.ascontiguousarray(yp))
-        done = state >= 0
+        for q, i in zip(np.flatnonzero(state == 0), at[pair][state == 0]):  # refuted: the span's exact normal
+            z = _span_normal(lambda cols, i=i: planar_pair_normal(
+                P[i], N[i], mu[i], width[i], c[i], L[i], owner[cols], offset[cols], friction[cols]), range(k))
+            yq = None if z is None else _projected_normal(z, yp[q])
+            if yq is not None and _pair_orthogonal(z, yq):
+                yp[q], state[q] = yq, 1
+        done = state == 1
         sel = at[pair][done]
-        code[sel], y[sel], verified[sel] = 3, yp[done], state[done] == 1
+        code[sel], y[sel] = 3, yp[done]
         pair[np.flatnonzero(pair)[~done]] = False
     for q in np.flatnonzero((~has_y | (ok & ~strict & ~refused) | (~ok & ~full)) & ~pair):
         r, i = thin_rows[q], at[q]
@@ -300,13 +308,22 @@ def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
             if verify_farkas_general(W[r], E[r], *arrays, yc, mask, 0.0):
                 code[i], y[i] = 2, yc
             continue
-        proof, shift = _orthogonal(W[r], E[r], np.flatnonzero(mask), exact_rank, pair_normal, yc)
+        cols = np.flatnonzero(mask)
+        proof, shift = _orthogonal(W[r], E[r], cols, exact_rank, pair_normal, yc)
+        if proof is False:  # as exact_farkas: the exact normal of the tight generators' span, if rank 2
+            if exact_rank(cols) == 3:
+                code[i] = 5  # nothing is left once projected; the exact rank of all is 3 as well
+                continue
+            z = _span_normal(pair_normal, cols) if exact_rank(cols) == 2 else None
+            yc = None if z is None else _projected_normal(z, yc)
+            proof = None if yc is None or not _pair_orthogonal(z, yc) else True
+            shift = 0.5e-6 * np.sqrt(yc @ yc) * (1 + 8 * U_ROUND) if proof else np.inf
         if proof and not mask.all():
             proof = None if not verify_farkas_general(W[r], E[r], *arrays, yc, mask, shift) else proof
-        if proof is not None:
-            code[i], y[i], verified[i] = (3 if mask.all() else 4), yc, proof
+        if proof:
+            code[i], y[i] = (3 if mask.all() else 4), yc
             if not mask.all():
-                tight_rows[int(i)] = np.flatnonzero(mask)
+                tight_rows[int(i)] = cols
     return (code, t, lam, basis, y), tight_rows, verified
 
 
@@ -336,6 +353,28 @@ def _orthogonal(C, E, cols, exact_rank, pair_normal, y):
                 return True, bound
             break
     return (False if _refuted(C, E, cols, y) else None), np.inf
+
+
+def _span_normal(pair_normal, cols) -> tuple[int, ...] | None:
+    """The exact normal direction (integers) of the span of the generators ``cols``, known to have
+    exact rank 2: that of the first two of them that are not parallel (``pair_normal(pair)``,
+    :func:`qualgrasp.certify.core.wrench.planar_pair_normal`); None when every pair is."""
+    for pair in combinations(cols, 2):
+        z = pair_normal(list(pair))
+        if any(z):
+            return tuple(z)
+    return None
+
+
+def _projected_normal(z, y) -> np.ndarray | None:
+    """The exact projection of ``y`` off a plane with exact normal ``z`` (integers), rounded as
+    :func:`qualgrasp.certify.core.closure.exact_farkas` rounds it: ``sign(y . z) z`` as a unit
+    vector; None when ``y . z`` is exactly 0 or ``z`` is zero."""
+    Y = dyadic_integers(y)[0]
+    s = sum(a * b for a, b in zip(Y, z))
+    if s == 0 or not any(z):
+        return None
+    return np.array(unit_direction([v if s > 0 else -v for v in z]))
 
 
 def _pair_orthogonal(z, y) -> bool | None:

@@ -6,10 +6,14 @@ Every verdict follows the same steps on the closure programme of :mod:`qualgrasp
    Otherwise, if the dual direction separates (strictly on every contact, or exactly orthogonal
    to contacts that carry no force and strictly on the rest): ``no_closure`` with a Farkas
    certificate, whatever the rank and even when ``t* = 0``: a separating direction is a proof.
+   A direction with tight contacts is checked exactly (:func:`exact_farkas`): orthogonal in
+   floats to nearly parallel wrenches (an antipodal pair) is not always orthogonal to their exact
+   span, and the exact projection off that span is stated instead, or nothing.
 2. Rank. If the columns' smallest to largest singular value ratio is below ``tol.rank``, the exact
    rank (rational arithmetic on the float data) decides: deficient gives ``no_closure`` with a
-   null-space Farkas direction, full gives ``degenerate`` (reason ``rank``): such a grasp could
-   resist some wrench only with unbounded forces, and rounding decides which.
+   null-space Farkas direction (exactly orthogonal, by :func:`exact_farkas`), full gives
+   ``degenerate`` (reason ``rank``): such a grasp could resist some wrench only with unbounded
+   forces, and rounding decides which.
 3. Otherwise ``degenerate`` (reason ``margin``): ``t*`` is below ``tol.margin`` and no exact
    separating direction exists. A degenerate verdict is never turned into a guess.
 
@@ -18,24 +22,25 @@ The margin reported is ``t*`` for closure and 0 otherwise.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from . import exact as ex
-from .certificates import Certificate, Tolerances
+from .certificates import Certificate, Tolerances, verify_system
 from .. import models as registry
 from ..errors import ArgumentError, SolverError
 from .arguments import require
 from .grasp import Grasp
 from .._kernels.cones import farkas_direction
 from .._kernels.linalg import null_direction, pivot_basis
+from .wrench import to_exact
 from .problem import (ClosureProblem, block_arrays, grasp_problem, grasp_system, span_problem, span_system,
                       span_vectors)
 from ..solvers import Method, make_solver
 
-__all__ = ["Verdict", "force_closure", "form_closure", "positive_span", "decide", "farkas_certificate",
-           "farkas_from_arrays"]
+__all__ = ["Verdict", "force_closure", "form_closure", "positive_span", "decide", "exact_farkas",
+           "farkas_certificate", "farkas_from_arrays"]
 
 
 @dataclass(frozen=True)
@@ -91,19 +96,53 @@ def decide(problem: ClosureProblem, exact_columns, solver,
         return Verdict("closure", float(sol.t), cert)
     if sol is not None and sol.y is not None and sol.t < tol.margin:
         cert = farkas_certificate(C, blocks, layout, sol.y)
+        if cert is not None and cert.tight:
+            cert = exact_farkas(exact_columns(), blocks, cert)
         if cert is not None:
             return Verdict("no_closure", 0.0, cert)
     if thin:
-        if k < d or ex.rank([list(r) for r in exact_columns()]) < d:
+        Cx = exact_columns()
+        if k < d or ex.rank([list(r) for r in Cx]) < d:
             y = null_direction(np.ascontiguousarray(C)) if d == 3 and k < d else U[:, -1]
             cert = Certificate("farkas", layout, y=_floats(y),
                                tight=tuple(range(len(blocks))), null_space=True)
-            return Verdict("no_closure", 0.0, cert)
+            for axis in np.eye(d):  # the exact projection of y vanishes only by accident
+                if (found := exact_farkas(Cx, blocks, cert)) is not None:
+                    return Verdict("no_closure", 0.0, found)
+                cert = replace(cert, y=_floats(axis))
         return Verdict("degenerate", 0.0, Certificate("degenerate", layout, reason="rank"))
     values = None if sol.x is None else _floats(problem.values(sol.x))
     y = None if sol.y is None else _floats(sol.y / np.linalg.norm(sol.y))
     return Verdict("degenerate", 0.0,
                    Certificate("degenerate", layout, values, y=y, reason="margin"))
+
+
+def exact_farkas(Cx, blocks, cert: Certificate) -> Certificate | None:
+    """``cert`` if the exact checker accepts it against the exact columns ``Cx``; else the same
+    tight blocks with ``y`` replaced by its exact projection off their columns, rounded
+    (:func:`qualgrasp.certify.core.exact.unit_direction`), with either sign, if accepted; else
+    None.
+
+    A direction orthogonal in floats to nearly parallel generators (antipodal contacts, normals
+    through one point) need not be orthogonal to their exact span, which contains a direction
+    set by their rounding; the exact projection is. The tight blocks allow either sign, and the
+    other blocks decide which (the projection's own first). Compiled counterpart for planar
+    batches: :func:`qualgrasp.certify.batch.fastpath` (its thin rows).
+    """
+    layout = cert.layout
+    if verify_system(Cx, blocks, layout, cert):
+        return cert
+    d = Cx.shape[0]
+    cols = [j for b in cert.tight for j in blocks[b].cols]
+    yp = ex.project_out(list(to_exact(cert.y)), [[Cx[i, j] for j in cols] for i in range(d)])
+    if not cols or not any(yp):
+        return None
+    u = np.array(ex.unit_direction(yp))
+    for y in (u, -u):
+        found = replace(cert, y=_floats(y))
+        if verify_system(Cx, blocks, layout, found):
+            return found
+    return None
 
 
 def farkas_certificate(C: np.ndarray, blocks, layout: str, y: np.ndarray,

@@ -13,7 +13,7 @@ import math
 from fractions import Fraction
 from typing import Sequence
 
-__all__ = ["row_echelon", "rank", "solve", "independent_columns", "project_out", "dyadic_integers"]
+__all__ = ["row_echelon", "rank", "solve", "independent_columns", "project_out", "dyadic_integers", "unit_direction"]
 
 Matrix = Sequence[Sequence[Fraction]]
 
@@ -119,3 +119,25 @@ def project_out(y: Sequence[Fraction], A: Matrix) -> list[Fraction]:
     c = solve(BtB, Bty)
     assert c is not None  # B has independent columns, so B'B is invertible
     return [y[r] - sum(B[r][i] * c[i] for i in range(k)) for r in range(len(B))]
+
+
+def unit_direction(v: Sequence[Fraction | int]) -> tuple[float, ...]:
+    """The exact non-zero vector ``v`` rounded to a float unit vector: each component divided
+    exactly by the largest magnitude, rounded once, then normalised in floats. Depends only on the
+    direction of ``v`` (any positive multiple gives the same floats), so that two routes reaching
+    the same exact direction by different scalings state the same certificate.
+
+    Examples
+    --------
+    >>> unit_direction([3, 0, -4])
+    (0.6, 0.0, -0.8)
+    >>> unit_direction([Fraction(3, 7), 0, Fraction(-4, 7)])
+    (0.6, 0.0, -0.8)
+    """
+    m = max(abs(Fraction(a)) for a in v)
+    if m == 0:
+        raise ValueError("the zero vector has no direction")
+    u = [float(Fraction(a) / m) for a in v]
+    n = math.sqrt(math.fsum(a * a for a in u))
+    return tuple(a / n for a in u)
+
