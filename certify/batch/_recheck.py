@@ -103,7 +103,7 @@ def _group_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, tol: Tole
     force_flag = res.column("force_closure").to_pylist()
     form_flag = res.column("form_closure").to_pylist()
     proved = np.ones(len(rows), dtype=bool)
-    polyhedral = dim == 2 or all(name == "frictionless" for name in models)
+    polyhedral = dim == 2 or all(registry.get(name).is_frictionless for name in models)
     planar_W = None
     for key, fl, st, mg, flags in (("force", False, status, margin, [force_flag[r] for r in rows]),
                                    ("form", True, form_status, form_margin, [form_flag[r] for r in rows])):
@@ -264,12 +264,13 @@ def generator_errors(P, N, params, models, variants, c, L, *, frictionless: bool
         k = len(owner)
         W = np.empty((B, 3, k))
         E = np.empty((B, 3, k))
+        width = registry.offset_lengths(models, params)
         for i in range(B):
-            planar_generators(P[i], N[i], params["mu"][i], params["width"][i], c[i], L[i], owner,
+            planar_generators(P[i], N[i], params["mu"][i], width[i], c[i], L[i], owner,
                               offset, friction, W[i], E[i])
         return W, E
     W, _ = generator_columns(P, N, params["mu"], models, c, L, frictionless=True, variants=(0,) * m)
-    return np.ascontiguousarray(W), force_column_errors(P, N, ("frictionless",) * m, c, L)
+    return np.ascontiguousarray(W), force_column_errors(P, N, registry.frictionless_names(models), c, L)
 
 
 def recheck_table(cols: GraspColumns, results: pa.Table, lines, slow, tol: Tolerances = Tolerances()):

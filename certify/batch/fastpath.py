@@ -163,7 +163,7 @@ def planar_screen(P, N, mu, center, length, *, quality: bool = True,
     if B == 0:
         empty = np.zeros(0)
         return PlanarScreen(empty.astype(bool), empty.astype(bool), empty, empty, empty)
-    models = tuple("point" if f else "frictionless" for f in pattern[0])
+    models = tuple(registry.POINT.name if f else registry.FRICTIONLESS.name for f in pattern[0])
     code, t, *_, eps = _planar_kernel(P, N, mu, np.zeros((B, m)), center, length, models, (0,) * m,
                                       tol, quality)
     closure = code == 1
@@ -180,7 +180,7 @@ def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances
         # the per-grasp fast route solves these by the barrier method: both routes give its rows
         return np.zeros(len(rows), dtype=bool), {}
     P, N, params = cols.contacts(rows)
-    P, N, mu, width = P[:, :, :2], N[:, :, :2], params["mu"], params["width"]
+    P, N, mu, width = P[:, :, :2], N[:, :, :2], params["mu"], registry.offset_lengths(models, params)
     c, L = cols.center[rows, :2], cols.length[rows]
     (code, t, lam, basis, y, code_f, t_f, lam_f, basis_f, y_f, _) = _planar_kernel(
         P, N, mu, width, c, L, models, variants, tol, False)
@@ -500,7 +500,7 @@ def _polyhedral(P, N, c, L, options, tol: Tolerances):
     columnar. Rows near the boundary, thin, or with certificates not proved this way are decided
     row by row. Returns ``(code, t, lam, basis, y)`` and the tight blocks of code-4 rows."""
     B, m, d = P.shape
-    models = ("frictionless",) * m
+    models = (registry.FRICTIONLESS.name,) * m
     zeros = np.zeros((B, m))
     W, _ = generator_columns(P, N, zeros, models, c, L, frictionless=True, variants=(0,) * m)
     W = np.ascontiguousarray(W)  # (B, 6, m): one ray per contact, as barrier_arrays lays it out
@@ -565,7 +565,7 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
     P, N, params = cols.contacts(rows)
     mu, c, L = params["mu"], cols.center[rows], cols.length[rows]
     B = len(rows)
-    if all(name == "frictionless" for name in models):  # force closure is form closure
+    if all(registry.get(name).is_frictionless for name in models):  # force closure is form closure
         form, tight = _polyhedral(P, N, c, L, options, tol)
         return form[0] > 0, {"force": form, "form": form, "tight": tight, "form_tight": tight}
     # force closure: the barrier method on the solver columns
@@ -659,7 +659,7 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
     # form closure: frictionless generators
     Wf, _ = generator_columns(P, N, mu, models, c, L, frictionless=True, variants=(0,) * m)
     Wf = np.ascontiguousarray(Wf)
-    Ef = force_column_errors(P, N, ("frictionless",) * m, c, L)
+    Ef = force_column_errors(P, N, registry.frictionless_names(models), c, L)
     code_f = np.zeros(B, dtype=np.int64)
     t_f = np.zeros(B)
     lam_f = np.zeros((B, m))

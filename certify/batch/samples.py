@@ -11,7 +11,7 @@ import pyarrow.parquet as pq
 from .. import models as registry
 from ..core.grasp import Contact, Grasp
 from ..files.outputs import atomic_output
-from ..files.reader import CONTACT, GRASP_SCHEMA, is_parquet
+from ..files.reader import contact_type, grasp_schema, is_parquet
 
 __all__ = ["RANGES", "DEGENERATE", "random_grasp", "random_grasps", "textbook_grasps", "random_grasp_table",
            "degenerate_geometry", "write_random_grasp_file"]
@@ -205,7 +205,7 @@ def random_grasp_table(seed: int, count: int, *, dim: int = 2, n_contacts: int =
                        torsion: tuple[float, float] = RANGES["torsion"],
                        width: tuple[float, float] = RANGES["width"], spread: float = 0.7,
                        start: int = 0, degenerate: str | None = None):
-    """An Arrow grasp table (:data:`qualgrasp.certify.files.reader.GRASP_SCHEMA`) of ``count`` random grasps drawn
+    """An Arrow grasp table (:func:`qualgrasp.certify.files.reader.grasp_schema`) of ``count`` random grasps drawn
     like :func:`random_grasp` (same distribution, vectorised; not the same draws), ids
     ``r{start}, r{start+1}, ...``; ``center`` and ``length`` left to their defaults.
     ``degenerate``: a kind of :data:`DEGENERATE` (planar only), whose contact points and normals
@@ -231,11 +231,11 @@ def random_grasp_table(seed: int, count: int, *, dim: int = 2, n_contacts: int =
     for par in registry.get(model).params:
         fields[par.name] = pa.array(rng.uniform(*ranges[par.name], size=total))
     contacts = pa.StructArray.from_arrays(
-        [fields.get(f.name, pa.nulls(total, f.type)) for f in CONTACT], fields=list(CONTACT))
+        [fields.get(f.name, pa.nulls(total, f.type)) for f in contact_type()], fields=list(contact_type()))
     per_row = pa.ListArray.from_arrays(pa.array(np.arange(0, total + 1, m, dtype=np.int32)), contacts)
     ids = pa.array([f"r{i}" for i in range(start, start + count)])
     return pa.table({"id": ids, "contacts": per_row, "center": pa.nulls(count, pa.list_(pa.float64())),
-                     "length": pa.nulls(count, pa.float64())}, schema=GRASP_SCHEMA)
+                     "length": pa.nulls(count, pa.float64())}, schema=grasp_schema())
 
 
 def write_random_grasp_file(path, count: int, *, seed: int = 0, chunk: int = 500_000, **kwargs) -> int:
@@ -251,7 +251,7 @@ def write_random_grasp_file(path, count: int, *, seed: int = 0, chunk: int = 500
     """
     written = 0
     with atomic_output(path, "OUT") as tmp:
-        writer = pq.ParquetWriter(tmp, GRASP_SCHEMA) if is_parquet(path) else None
+        writer = pq.ParquetWriter(tmp, grasp_schema()) if is_parquet(path) else None
         fh = None if writer else open(tmp, "w", encoding="utf-8")
         try:
             for start in range(0, count, chunk):

@@ -237,7 +237,7 @@ class Grasp:
     @property
     def frictionless(self) -> bool:
         """True when every contact is frictionless (form and force closure coincide)."""
-        return all(c.model == "frictionless" for c in self.contacts)
+        return all(c.contact_model.is_frictionless for c in self.contacts)
 
 
 def grasps_from_checked(checked: CheckedGrasps, rows, ids=None, meta=None) -> list[Grasp]:

@@ -259,7 +259,7 @@ def grasp_system(grasp: Grasp, *, frictionless: bool = False, socp: bool = False
     models = tuple(contact.model for contact in grasp.contacts)
     if is_polyhedral(grasp, frictionless, socp):
         C, owner = generator_columns(P, N, mu, models, c, L, frictionless=frictionless,
-                                     width=params["width"], variants=variants_of(grasp))
+                                     width=registry.offset_lengths(models, params), variants=variants_of(grasp))
         return System(C, tuple(Block("ray", (j,), contact=int(owner[j])) for j in range(C.shape[1])),
                       "generators")
     C, owner = force_columns(P, N, models, c, L)

@@ -263,7 +263,7 @@ def check_contacts(data: ContactData) -> Checked:
     model = data.model.copy()
     given = data.given
     model[model == ABSENT] = np.where(given.get("mu", np.zeros(k, bool))[model == ABSENT],
-                                      registry.get("point").code, registry.get("frictionless").code)
+                                      registry.POINT.code, registry.FRICTIONLESS.code)
     names = registry.names()
     fail(model == UNKNOWN, lambda j: f"model: unknown contact model {show(_plain(data.names[j]))}; use "
                                      f"one of {', '.join(map(repr, names))}")

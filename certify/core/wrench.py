@@ -136,6 +136,16 @@ def generator_layout(models: Sequence[str], variants: Sequence[int], dim: int, *
             np.array(friction, dtype=float))
 
 
+def _first_variant(model, mu: float, offset_length: float) -> int:
+    """The variant of a contact of ``model`` with friction ``mu`` and offset length
+    ``offset_length`` (its other parameters 0)."""
+    values = {name: np.zeros(1) for name in model.param_names}
+    values["mu"] = np.array([mu])
+    if model.offset_param is not None:
+        values[model.offset_param] = np.array([offset_length])
+    return int(model.variant(values)[0])
+
+
 def generator_columns(P, N, mu, models, center, length, *, frictionless: bool = False,
                       width=None, variants: Sequence[int] | None = None):
     """Generator wrenches of a polyhedral grasp wrench cone, as columns.
@@ -158,7 +168,8 @@ def generator_columns(P, N, mu, models, center, length, *, frictionless: bool = 
     center : array, shape (..., dim)
     length : scalar or array, shape (...)
     width : array, shape (..., m), optional
-        Pad widths (zeros by default).
+        Offset lengths (:func:`qualgrasp.certify.models.offset_lengths`: a pad's width; zeros
+        by default).
     variants : sequence of int, optional
         Model variant of each contact (shared by the batch); default: from the first grasp's
         ``mu`` and ``width``.
@@ -174,10 +185,8 @@ def generator_columns(P, N, mu, models, center, length, *, frictionless: bool = 
     width = np.zeros(np.shape(mu)) if width is None else width
     if variants is None:
         first = (0,) * (np.ndim(mu) - 1)
-        variants = [int(registry.get(name).variant({"mu": np.array([float(np.asarray(mu)[first + (i,)])]),
-                                                     "width": np.array([float(np.asarray(width)[first + (i,)])]),
-                                                     "torsion": np.zeros(1)})[0])
-                    for i, name in enumerate(models)]
+        variants = [_first_variant(registry.get(name), float(np.asarray(mu)[first + (i,)]),
+                                   float(np.asarray(width)[first + (i,)])) for i, name in enumerate(models)]
     owner, offset, friction = generator_layout(models, variants, P.shape[-1], frictionless=frictionless)
     conv = to_exact if exact else (lambda a: a)
     Nk = N[..., owner, :]

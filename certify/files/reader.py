@@ -36,19 +36,30 @@ from .outputs import file_kind
 from .results import RESULT_SCHEMA
 from ..core.validation import param_names
 
-__all__ = ["CONTACT", "GRASP_SCHEMA", "MAX_LINE_BYTES", "READ_ERROR", "SNIFF_BYTES", "is_parquet", "input_format",
+__all__ = ["CONTACT", "GRASP_SCHEMA", "contact_type", "grasp_schema", "MAX_LINE_BYTES", "READ_ERROR", "SNIFF_BYTES", "is_parquet", "input_format",
            "column_problem", "json_lines", "Chunk",
            "iter_chunks", "count_grasps", "parse_line", "grasps_table", "rows_to_table", "table_to_rows",
            "carried_array", "json_text", "JSON_TEXT", "unified_schema", "conform", "chunk_values", "table_values",
            "read_results"]
 
-CONTACT = pa.struct([("p", pa.list_(pa.float64())), ("n", pa.list_(pa.float64())), ("model", pa.string())]
-                    + [(name, pa.float64()) for name in param_names()])
-"""A contact as an Arrow struct: ``p``, ``n``, ``model`` and every registered model parameter."""
-GRASP_SCHEMA = pa.schema([
-    ("id", pa.string()), ("contacts", pa.list_(CONTACT)), ("center", pa.list_(pa.float64())),
-    ("length", pa.float64()),
-])
+def contact_type() -> pa.StructType:
+    """A contact as an Arrow struct: ``p``, ``n``, ``model`` and every model parameter registered
+    now (a model registered after import adds its parameters)."""
+    return pa.struct([("p", pa.list_(pa.float64())), ("n", pa.list_(pa.float64())), ("model", pa.string())]
+                     + [(name, pa.float64()) for name in param_names()])
+
+
+def grasp_schema() -> pa.Schema:
+    """The Arrow schema of a grasp table: ``id``, ``contacts`` (:func:`contact_type`), ``center``,
+    ``length``."""
+    return pa.schema([("id", pa.string()), ("contacts", pa.list_(contact_type())),
+                      ("center", pa.list_(pa.float64())), ("length", pa.float64())])
+
+
+CONTACT = contact_type()
+"""The contact struct of the built-in models (:func:`contact_type` for the registered ones)."""
+GRASP_SCHEMA = grasp_schema()
+"""The grasp schema of the built-in models (:func:`grasp_schema` for the registered ones)."""
 
 
 def is_parquet(path: str | Path) -> bool:
@@ -438,7 +449,7 @@ def grasps_table(dicts: list[dict]) -> pa.Table:
         gid = d.get("id")
         rows.append({"id": None if gid is None else str(gid), "contacts": contacts,
                      "center": d.get("center"), "length": d.get("length")})
-    return pa.Table.from_pylist(rows, schema=GRASP_SCHEMA)
+    return pa.Table.from_pylist(rows, schema=grasp_schema())
 
 
 def rows_to_table(rows: list[dict]) -> pa.Table:

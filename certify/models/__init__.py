@@ -15,12 +15,14 @@ Generator(offset=0.5, friction=1.0)
 
 from typing import Literal
 
-from .base import (MAX_LENGTH, MAX_MU, MIN_LENGTH, ContactModel, Generator, Param, get, models,
-                   names, register)
+from .base import (MAX_LENGTH, MAX_MU, MIN_LENGTH, ContactModel, Generator, Param, frictionless_names, get,
+                   models, names, offset_lengths, register)
 from . import frictionless, point, soft, pad  # noqa: E402,F401  (registration, in code order)
+from .frictionless import FRICTIONLESS
+from .point import POINT
 
 __all__ = ["ModelName", "ContactModel", "Param", "Generator", "register", "get", "names", "models",
-           "MAX_MU", "MAX_LENGTH", "MIN_LENGTH"]
+           "offset_lengths", "frictionless_names", "FRICTIONLESS", "POINT", "MAX_MU", "MAX_LENGTH", "MIN_LENGTH"]
 
 #: The name of a built-in contact model, as validation accepts it (a model registered later with
 #: :func:`register` is accepted too, by its name).

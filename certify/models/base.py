@@ -42,13 +42,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import ClassVar, Mapping
+from typing import ClassVar, Mapping, Sequence
 
 import numpy as np
 
 from ..errors import ArgumentError
 
-__all__ = ["Param", "Generator", "ContactModel", "register", "get", "names", "models",
+__all__ = ["Param", "Generator", "ContactModel", "register", "get", "names", "models", "offset_lengths",
+           "frictionless_names",
            "MAX_MU", "MAX_LENGTH", "MIN_LENGTH"]
 
 #: Largest friction coefficient accepted (documented limit: larger values only overflow).
@@ -160,6 +161,20 @@ class ContactModel:
         (form closure)."""
         return "frictionless", {}, 0
 
+    @property
+    def is_frictionless(self) -> bool:
+        """True when ignoring friction leaves the model as it is (it can only push along ``n``)."""
+        name, overrides, _ = self.frictionless()
+        return name == self.name and not overrides
+
+    def offset_length(self, values: Mapping[str, np.ndarray]) -> np.ndarray:
+        """The length its generators' offsets are in units of (the ``offset_param`` values: a
+        pad's ``width``), from its parameter ``values`` (arrays of one shape); 0 without one."""
+        if self.offset_param is None:
+            shape = next(iter(values.values())).shape if values else ()
+            return np.zeros(shape)
+        return np.asarray(values[self.offset_param])
+
     def columns(self, dim: int) -> int:
         """Number of certificate columns of a contact in the conic form."""
         if self.forces is None:
@@ -187,6 +202,31 @@ def get(name_or_code) -> ContactModel:
     if isinstance(name_or_code, (int, np.integer)):
         return models()[int(name_or_code)]
     return _REGISTRY[name_or_code]
+
+
+def offset_lengths(names_: Sequence[str], params: Mapping[str, np.ndarray]) -> np.ndarray:
+    """Each contact's generator offset length (:meth:`ContactModel.offset_length`), shape
+    ``(..., m)``, from the parameter arrays ``params`` (shape ``(..., m)`` each, keyed by name)
+    of contacts of the models ``names_`` (length ``m``); exact (object) arrays stay exact.
+
+    Examples
+    --------
+    >>> offset_lengths(("pad", "point"), {"mu": np.array([0.5, 0.5]), "width": np.array([0.2, 0.0])})
+    array([0.2, 0. ])
+    """
+    arrays = [np.asarray(v) for v in params.values()]
+    shape = arrays[0].shape if arrays else (len(names_),)
+    out = np.zeros(shape, dtype=object if any(a.dtype == object for a in arrays) else float)
+    for i, name in enumerate(names_):
+        model = get(name)
+        if model.offset_param is not None:
+            out[..., i] = model.offset_length({k: np.asarray(v)[..., i] for k, v in params.items()})
+    return out
+
+
+def frictionless_names(names_: Sequence[str]) -> tuple[str, ...]:
+    """The model each of ``names_`` becomes with friction ignored (:meth:`ContactModel.frictionless`)."""
+    return tuple(get(name).frictionless()[0] for name in names_)
 
 
 def names() -> tuple[str, ...]:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from .base import ContactModel, Generator, register
 
-__all__ = ["Frictionless"]
+__all__ = ["Frictionless", "FRICTIONLESS"]
 
 
 class Frictionless(ContactModel):

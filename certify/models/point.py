@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from .base import MAX_MU, ContactModel, Generator, Param, register
 
-__all__ = ["Point", "MU"]
+__all__ = ["Point", "POINT", "MU"]
 
 #: The friction coefficient parameter, shared by the models with Coulomb friction.
 MU = Param("mu", "friction coefficient", high=MAX_MU, length=False)

@@ -24,6 +24,7 @@ from typing import Sequence
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
+from .. import models as registry
 from .._kernels.planar import planar_generators
 from ..core import cones
 from ..core.grasp import Grasp
@@ -96,7 +97,7 @@ def planar_generator_arrays(grasp: Grasp):
     owner, offset, friction = generator_layout(models, variants_of(grasp), 2)
     W = np.empty((3, len(owner)))
     E = np.empty((3, len(owner)))
-    planar_generators(P, N, mu, params["width"], c, float(L), owner, offset, friction, W, E)
+    planar_generators(P, N, mu, registry.offset_lengths(models, params), c, float(L), owner, offset, friction, W, E)
     return W, E, owner
 
 

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import models as registry
 from ..errors import GraspError
 from ..core.grasp import Contact, Grasp
 from .bounds import epsilon, epsilon_of_points
@@ -104,8 +105,8 @@ def boundary_contacts(vertices, spacing: float, *, model: str = "point",
     that edge's normal (the limit of its interior points), so a vertex appears once per adjacent
     edge."""
     points, normals, _, _ = edge_samples(vertices, spacing)
-    if model == "frictionless":
-        return [Contact(p, n) for p, n in zip(points, normals)]
+    if registry.get(model).is_frictionless:
+        return [Contact(p, n, model) for p, n in zip(points, normals)]
     return [Contact(p, n, model, mu) for p, n in zip(points, normals)]
 
 

@@ -215,7 +215,7 @@ def _stretch(r, j0: int, j1: int, tol: float):
 def _generators(region):
     gens = registry.get(region.model).generators(2, region_variant(region))
     fm = np.array([g.friction * region.mu for g in gens])
-    ow = np.array([g.offset * region.width for g in gens])
+    ow = np.array([g.offset * region.offset_length for g in gens])
     return fm, ow
 
 

@@ -104,7 +104,7 @@ def _generator_terms(r, cx, cy, num, one):
     ax, ay = num(r.a[0]), num(r.a[1])
     bx, by = num(r.b[0]), num(r.b[1])
     nx, ny = num(r.n[0]), num(r.n[1])
-    mu, w = num(r.mu), num(r.width)
+    mu, w = num(r.mu), num(r.offset_length)
     out = []
     for g in gens:
         fr, off = num(g.friction), num(g.offset)

@@ -53,7 +53,7 @@ from .. import models as registry
 from ..errors import GraspError
 from ..core.grasp import Contact
 from ..models import MAX_LENGTH, MIN_LENGTH
-from ..core.validation import check_contacts, contact_data, number, numbers, show
+from ..core.validation import check_contacts, contact_data, number, numbers, param_names, show
 
 __all__ = ["MAX_NORMAL_TOL", "MAX_TURN", "MAX_REGIONS", "MAX_POINTS", "StraightRegion", "CurvedRegion",
            "Region", "RegionTuple", "region_from_dict", "region_to_dict", "tuple_from_dict",
@@ -112,7 +112,7 @@ def _params_of(prefix: str, d: Mapping[str, Any]) -> dict[str, Any]:
     model = d.get("model")
     if model is not None:
         out["model"] = model
-    for name in ("mu", "width", "torsion"):
+    for name in param_names():
         if d.get(name) is not None:
             out[name] = d[name]
     return out
@@ -132,6 +132,13 @@ class _ModelParams:
     def width(self) -> float:
         """Pad width (0 unless a pad)."""
         return float(dict(self.params).get("width", 0.0))
+
+    @property
+    def offset_length(self) -> float:
+        """The length the model's generator offsets are in units of
+        (:meth:`qualgrasp.certify.models.ContactModel.offset_length`: a pad's width), 0 without."""
+        values = {name: np.array(value) for name, value in self.params}
+        return float(registry.get(self.model).offset_length(values)) if values else 0.0
 
 
 def _set_model(region: Any, checked) -> None:

@@ -16,6 +16,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from ....certify import models as registry
 from ..candidates import Candidates
 
 __all__ = ["SearchInput", "Procedure", "register", "get", "procedures", "names", "for_fingers"]
@@ -103,7 +104,7 @@ class Procedure:
     @property
     def friction(self) -> bool:
         """True when the procedure's contacts have friction (it takes ``mu``)."""
-        return self.model != "frictionless"
+        return not registry.get(self.model).is_frictionless
 
     def label(self, mu: float | None = None) -> str:
         """Label for plots: ``'2 fingers, mu = 0.5 (ForceGrasp)'``."""
