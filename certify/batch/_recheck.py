@@ -28,9 +28,9 @@ from .._kernels.planar import planar_generators
 from .._kernels.recheck import null_rows, verify_farkas_general, verify_interior_general
 from ..core.certificates import Tolerances, margin_of, margin_tolerance
 from ..files.columns import GraspColumns
-from ..core.cones import CONES, cone_code
+from ..core.cones import CONES
 from ..quality.evidence import EPS_COLUMNS, Evidence, verify_bounds
-from ..core.problem import Block
+from ..core.problem import Block, conic_block_arrays, ray_block_arrays
 from ..report import GEOMETRY_TOL
 from ..files.results import RESULT_SCHEMA
 from ..core.wrench import force_column_errors, force_columns, generator_columns, generator_layout
@@ -111,7 +111,7 @@ def _group_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, tol: Tole
         if polyhedral or fl:
             C, E = generator_errors(P, N, params, models, variants, c, L, frictionless=fl)
             k = C.shape[2]
-            cone, first, width = np.zeros(k, dtype=np.int64), np.arange(k), np.ones(k, dtype=np.int64)
+            cone, first, width = ray_block_arrays(k)
             nb = np.zeros((len(rows), k, dim))
             mub = np.zeros((len(rows), k))
             gb = np.zeros((len(rows), k))
@@ -122,14 +122,7 @@ def _group_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, tol: Tole
             C = np.ascontiguousarray(C)
             k = C.shape[2]
             E = force_column_errors(P, N, models, c, L)
-            cone = np.array([cone_code(registry.get(name).cone) for name in models], dtype=np.int64)
-            width = np.array([registry.get(name).columns(dim) for name in models], dtype=np.int64)
-            first = np.concatenate([[0], np.cumsum(width)[:-1]]).astype(np.int64)
-            gb = np.zeros((len(rows), m))
-            for i, name in enumerate(models):
-                if registry.get(name).extra:
-                    gb[:, i] = params[registry.get(name).extra[0]][:, i]
-            nb, mub = N, mu
+            cone, first, width, nb, mub, gb = conic_block_arrays(models, N, mu, params, dim)
             layout = "forces"
             blocks = m
         d = C.shape[1]

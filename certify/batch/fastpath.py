@@ -48,9 +48,10 @@ from ..core.certificates import Tolerances, verify
 from ..core.closure import decide, farkas_from_arrays
 from ..errors import SolverError
 from ..files.columns import GraspColumns, grasp_columns
-from ..core.cones import LORENTZ, cone_code
+from ..core.cones import LORENTZ
 from ..core.grasp import Contact, Grasp
-from ..core.problem import Block, ClosureProblem, System, conic_columns, grasp_problem, grasp_system
+from ..core.problem import (Block, ClosureProblem, System, conic_block_arrays, conic_columns, grasp_problem,
+                            grasp_system, ray_block_arrays)
 from ..quality.bounds import planar_epsilons
 from ..solvers import BARRIER_NEAR_ZERO, FastSolver, make_solver
 from ..solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
@@ -259,7 +260,7 @@ def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
     # every generator tight, exact rank 3: nothing is left once projected, the rank decides
     refused = has_y & ok & tight.all(axis=1) & full
     code[at[refused]] = 5
-    cone, first, ones = _ray_blocks(k)
+    cone, first, ones = ray_block_arrays(k)
     arrays = (cone, first, ones, np.zeros((k, 2)), np.zeros(k), np.zeros(k))
     solver = make_solver("fast")
     # rank at most 2 (parallel normals, two distinct contacts): the all-tight direction, or the last singular vector
@@ -448,11 +449,6 @@ def _planar_quality(cols, rows, closure, P, N, mu, width, c, L, models, variants
     return vals[:, 0], vals[:, 1], vals[:, 2], vals[:, 3], limited, evidence
 
 
-def _ray_blocks(m: int):
-    """``(cone, first, width)`` block arrays of ``m`` rays (generator columns)."""
-    return (np.zeros(m, dtype=np.int64), np.arange(m), np.ones(m, dtype=np.int64))
-
-
 def _polyhedral_rows(P, N, c, L, W, E, options, tol: Tolerances):
     """Form closure of spatial grasps (also the force closure of frictionless ones) whose LP has
     too many bases for a columnar rule: decided row by row exactly as the per-grasp path decides
@@ -463,7 +459,7 @@ def _polyhedral_rows(P, N, c, L, W, E, options, tol: Tolerances):
     code-4 rows."""
     B, m, d = P.shape
     zeros = np.zeros((B, m))
-    cone, first, width = _ray_blocks(m)
+    cone, first, width = ray_block_arrays(m)
     code = np.zeros(B, dtype=np.int64)
     t, lam = np.zeros(B), np.zeros((B, m))
     basis, y = np.zeros((B, 2 * d), dtype=np.int64), np.zeros((B, 2 * d))
@@ -518,7 +514,7 @@ def _polyhedral(P, N, c, L, options, tol: Tolerances):
     values = world_values(np.ascontiguousarray(np.broadcast_to(np.eye(m), (B, m, m))), xn)
     with np.errstate(invalid="ignore", divide="ignore"):
         yn = np.nan_to_num(y / np.sqrt(np.sum(y * y, axis=1, keepdims=True)))
-    cone, first, width = _ray_blocks(m)
+    cone, first, width = ray_block_arrays(m)
     code, basis = certify_rows(W, E, cone, first, width, np.ascontiguousarray(N), zeros, zeros,
                                values, yn, closure, farkas, np.abs(W).max(axis=(1, 2)), tol.residual)
     out = [code, np.where(code == 1, t, 0.0), values, basis, yn]
@@ -531,20 +527,6 @@ def _polyhedral(P, N, c, L, options, tol: Tolerances):
             arr[rest] = part
         tight = {int(rest[r]): v for r, v in sub_tight.items()}
     return tuple(out), tight
-
-
-def _block_arrays_of(models, N, mu, params):
-    """Per-row cone block arrays of the conic form of a group sharing ``models``: ``(cone,
-    first, width)`` shared, and the per-row normals, friction and moment lengths."""
-    cone = np.array([cone_code(registry.get(name).cone) for name in models], dtype=np.int64)
-    width = np.array([registry.get(name).columns(3) for name in models], dtype=np.int64)
-    first = np.concatenate([[0], np.cumsum(width)[:-1]]).astype(np.int64)
-    g = np.zeros(mu.shape)
-    for i, name in enumerate(models):
-        extra = registry.get(name).extra
-        if extra:
-            g[:, i] = params[extra[0]][:, i]
-    return cone, first, width, np.ascontiguousarray(N), np.ascontiguousarray(mu), g
 
 
 SPATIAL_CONTACTS = 16
@@ -590,7 +572,7 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
     C, owner = force_columns(P, N, models, c, L)
     C = np.ascontiguousarray(C)
     E = force_column_errors(P, N, models, c, L)
-    cone, first, width, Nc, mu, g = _block_arrays_of(models, N, mu, params)
+    cone, first, width, Nc, mu, g = conic_block_arrays(models, N, mu, params, 3)
     sv = np.linalg.svd(C, compute_uv=False)
     thin = sv[:, -1] <= 1e-6 * sv[:, 0]
     near = (status == 2) | ((status == 0) & (np.abs(t) < BARRIER_NEAR_ZERO))

@@ -33,7 +33,7 @@ from .cones import cone_code
 from .wrench import (contact_frame, force_columns, generator_columns, grasp_arrays, tangent,
                      to_exact, variants_of, wrench)
 
-__all__ = ["Block", "block_arrays", "System", "ClosureProblem", "grasp_problem", "span_problem", "grasp_system",
+__all__ = ["Block", "block_arrays", "ray_block_arrays", "conic_block_arrays", "System", "ClosureProblem", "grasp_problem", "span_problem", "grasp_system",
            "span_system", "span_vectors", "is_polyhedral"]
 
 
@@ -61,6 +61,27 @@ def block_arrays(blocks: Sequence[Block], dim: int):
     mu = np.array([float(b.mu) for b in blocks])
     g = np.array([float(b.g) for b in blocks])
     return cone, first, width, n, mu, g
+
+
+def ray_block_arrays(k: int):
+    """``(cone, first, width)`` block arrays of ``k`` rays, one per column (generator columns)."""
+    return np.zeros(k, dtype=np.int64), np.arange(k, dtype=np.int64), np.ones(k, dtype=np.int64)
+
+
+def conic_block_arrays(models: Sequence[str], N: np.ndarray, mu: np.ndarray, params, dim: int):
+    """Block arrays ``(cone, first, width, n, mu, g)`` of the conic form (:func:`force_columns`'
+    layout) of a batch of grasps sharing ``models``: ``cone``, ``first``, ``width`` shared, the
+    normals ``N`` (B, m, dim), friction ``mu`` (B, m) and each model's moment length ``g`` (its
+    first ``extra`` parameter, 0 without) per row, as :func:`block_arrays` gives one grasp's."""
+    cone = np.array([cone_code(registry.get(name).cone) for name in models], dtype=np.int64)
+    width = np.array([registry.get(name).columns(dim) for name in models], dtype=np.int64)
+    first = np.concatenate([[0], np.cumsum(width)[:-1]]).astype(np.int64)
+    g = np.zeros(np.shape(mu))
+    for i, name in enumerate(models):
+        extra = registry.get(name).extra
+        if extra:
+            g[:, i] = params[extra[0]][:, i]
+    return cone, first, width, np.ascontiguousarray(N), np.ascontiguousarray(mu), g
 
 
 class System(NamedTuple):
