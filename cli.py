@@ -15,6 +15,7 @@ docstring.
 from __future__ import annotations
 
 import importlib
+import inspect
 from importlib import metadata
 
 import typer
@@ -67,10 +68,29 @@ COMMANDS: dict[str, tuple[str, str]] = {
 
 
 def registered_commands(module: str) -> dict[str, TyperCommand]:
-    """The click commands that ``module``'s ``register`` adds, by name (imports the module)."""
+    """The click commands that ``module``'s ``register`` adds, by name (imports the module), each
+    help text reflowed (:func:`reflow`)."""
     commands = typer.Typer()
     importlib.import_module(module).register(commands)
-    return dict(typer.main.get_group(commands).commands)
+    out = dict(typer.main.get_group(commands).commands)
+    for command in out.values():
+        command.help = reflow(command.help or "")
+    return out
+
+
+def reflow(text: str) -> str:
+    """``text`` (a docstring) with each paragraph's source line breaks joined: ``--help`` prints
+    a paragraph's lines as they are, and rich wraps them again to the terminal. A paragraph
+    whose later lines are items or indented (``- ``, ``* ``, ``| ``, a space) keeps its lines.
+
+    Examples
+    --------
+    >>> reflow("Summary.\n\nOne paragraph\nin two lines.\n\n- an item\n- another")
+    'Summary.\n\nOne paragraph in two lines.\n\n- an item\n- another'
+    """
+    paragraphs = inspect.cleandoc(text).split("\n\n")
+    keep = lambda p: any(line[:1] == " " or line[:2] in ("- ", "* ", "| ") for line in p.split("\n")[1:])  # noqa: E731
+    return "\n\n".join(p if keep(p) else " ".join(line.strip() for line in p.split("\n")) for p in paragraphs)
 
 
 class _LazyGroup(TyperGroup):

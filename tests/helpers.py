@@ -51,3 +51,24 @@ def signal_after(proc, count_parts, count: int, sig=signal.SIGKILL) -> bool:
             return True
         os.killpg(proc.pid, signal.SIGCONT)
         time.sleep(0.005)
+
+
+def columnar_and_per_grasp(table, options):
+    """Results rows of a grasp table by the columnar path and by the per-grasp path, and the
+    rows the columnar path handed to the per-grasp path (imports inside: this module stays
+    light for the tests that only need the geometry)."""
+    from qualgrasp.certify.batch import certify_table
+    from qualgrasp.certify.batch.chunk import certify_values
+    from qualgrasp.certify.files import rows_to_table, table_to_rows, table_values
+
+    lines = list(range(1, table.num_rows + 1))
+    values = table_values(table)
+    ref = table_to_rows(rows_to_table(list(certify_values(values, lines, options))))
+    slow_rows = []
+
+    def slow(idx):
+        slow_rows.extend(idx)
+        return list(certify_values([values[i] for i in idx], [lines[i] for i in idx], options))
+
+    fast = table_to_rows(certify_table(table, lines, options, slow=slow))
+    return fast, ref, slow_rows

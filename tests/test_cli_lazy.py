@@ -69,3 +69,15 @@ def test_unknown_command_is_refused(tmp_path):
 
     result = CliRunner().invoke(app, ["nosuch"])
     assert result.exit_code == 2 and "No such command" in result.output
+
+
+def test_help_paragraphs_are_not_broken_where_the_source_breaks():
+    """A command's help prints each paragraph as one text that rich wraps to the terminal, not
+    with the docstring's own line breaks (the sample command's source breaks after 'With')."""
+    from typer.testing import CliRunner
+
+    from qualgrasp.cli import app
+
+    result = CliRunner().invoke(app, ["sample", "--help"], env={"COLUMNS": "400"}, terminal_width=400)
+    assert result.exit_code == 0
+    assert "in closure. With --degenerate KIND, the contacts are placed" in result.output

@@ -10,16 +10,16 @@ from typer.testing import CliRunner
 
 from qualgrasp.cli import app
 from qualgrasp.certify.batch import certify_file, verify_file
-from qualgrasp.certify.batch.chunk import Options, certify_values
-from qualgrasp.certify.batch.fastpath import certify_table
+from qualgrasp.certify.batch.chunk import Options
 from qualgrasp.certify.batch.samples import DEGENERATE, random_grasp_table
 from qualgrasp.certify.core import exact as ex
 from qualgrasp.certify.core.certificates import verify
 from qualgrasp.certify.core.closure import force_closure, form_closure
 from qualgrasp.certify.core.problem import grasp_system
 from qualgrasp.certify.core.wrench import generator_layout, planar_generator_rank
-from qualgrasp.certify.files import table_to_rows, table_values, rows_to_table
 from qualgrasp.certify.files.columns import grasp_columns
+
+from helpers import columnar_and_per_grasp
 
 # (kind, model, contacts): every kind, with the planar models
 SETS = [("antipodal-disc", "pad", 2), ("centre-disc", "point", 3), ("centre-disc", "frictionless", 4),
@@ -29,26 +29,10 @@ SETS = [("antipodal-disc", "pad", 2), ("centre-disc", "point", 3), ("centre-disc
         ("antipodal-disc", "frictionless", 2), ("antipodal-disc", "point", 3), ("centre-square", "frictionless", 4)]
 
 
-def _both(table, options):
-    """Rows of the columnar path and of the per-grasp path, and the rows the columnar path
-    handed to the per-grasp path."""
-    lines = list(range(1, table.num_rows + 1))
-    values = table_values(table)
-    ref = table_to_rows(rows_to_table(list(certify_values(values, lines, options))))
-    slow_rows = []
-
-    def slow(idx):
-        slow_rows.extend(idx)
-        return list(certify_values([values[i] for i in idx], [lines[i] for i in idx], options))
-
-    fast = table_to_rows(certify_table(table, lines, options, slow=slow))
-    return fast, ref, slow_rows
-
-
 @pytest.mark.parametrize("kind,model,m", SETS)
 def test_degenerate_rows_equal_per_grasp_rows(kind, model, m):
     table = random_grasp_table(7, 120, n_contacts=m, model=model, degenerate=kind)
-    fast, ref, slow = _both(table, Options(quality=kind == "mixed"))
+    fast, ref, slow = columnar_and_per_grasp(table, Options(quality=kind == "mixed"))
     assert len(fast) == len(ref) == table.num_rows
     for a, b in zip(fast, ref):
         assert a == b, (a["id"], {k: (a[k], b[k]) for k in a if a[k] != b[k]})
@@ -62,7 +46,7 @@ def test_degenerate_kinds_cover_every_outcome():
     """The columnar rules give every outcome of the thin rule: strict, tight and null-space
     Farkas and degenerate rank."""
     table = random_grasp_table(3, 400, n_contacts=4, model="frictionless", degenerate="mixed")
-    fast, _, slow = _both(table, Options(quality=False))
+    fast, _, slow = columnar_and_per_grasp(table, Options(quality=False))
     kinds = {(r["status"], r["certificate"]["force"]["kind"], r["certificate"]["force"].get("null_space"))
              for i, r in enumerate(fast) if i not in set(slow)}
     assert {("degenerate", "degenerate", None), ("no_closure", "farkas", True),

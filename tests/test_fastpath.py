@@ -5,26 +5,13 @@ import pytest
 
 from qualgrasp.certify import Contact, Grasp
 from qualgrasp.certify.batch import verify_file
-from qualgrasp.certify.batch.chunk import Options, certify_values
-from qualgrasp.certify.files import table_values
+from qualgrasp.certify.batch.chunk import Options
 from qualgrasp.certify.batch import certify_table
 from qualgrasp.certify.core import grasp_to_dict
 from qualgrasp.certify.batch import random_grasp_table, random_grasps, textbook_grasps
 from qualgrasp.certify.files import grasps_table, rows_to_table, table_to_rows
 
-
-def _both(table, options):
-    lines = list(range(1, table.num_rows + 1))
-    values = table_values(table)
-    ref = table_to_rows(rows_to_table(list(certify_values(values, lines, options))))
-    slow_rows = []
-
-    def slow(idx):
-        slow_rows.extend(idx)
-        return list(certify_values([values[i] for i in idx], [lines[i] for i in idx], options))
-
-    fast = table_to_rows(certify_table(table, lines, options, slow=slow))
-    return fast, ref, slow_rows
+from helpers import columnar_and_per_grasp
 
 
 def _dicts():
@@ -59,7 +46,7 @@ def _dicts():
 @pytest.mark.parametrize("quality", [False, True])
 def test_columnar_rows_equal_per_grasp_rows(quality):
     table = grasps_table(_dicts())
-    fast, ref, slow = _both(table, Options(quality=quality))
+    fast, ref, slow = columnar_and_per_grasp(table, Options(quality=quality))
     assert len(fast) == len(ref) == table.num_rows
     for a, b in zip(fast, ref):
         assert a == b, (a["id"], {k: (a[k], b[k]) for k in a if a[k] != b[k]})
@@ -142,7 +129,7 @@ def test_spatial_columnar_rows_equal_per_grasp_rows():
     method from nine contacts on, else row by row, with float-proved certificates) give the
     per-grasp rows exactly."""
     table = grasps_table(_spatial_dicts())
-    fast, ref, slow = _both(table, Options(quality=False))
+    fast, ref, slow = columnar_and_per_grasp(table, Options(quality=False))
     assert len(fast) == len(ref) == table.num_rows
     for a, b in zip(fast, ref):
         assert a == b, (a["id"], {k: (a[k], b[k]) for k in a if a[k] != b[k]})

@@ -17,12 +17,14 @@ from scipy.optimize import linprog
 from qualgrasp.certify import Contact, Grasp, GraspError, certify_grasp, force_closure, form_closure, verify
 from qualgrasp.certify import models
 from qualgrasp.experiments.bench import compare_routes
-from qualgrasp.certify.batch.chunk import Options, certify_values
+from qualgrasp.certify.batch.chunk import Options
 from qualgrasp.certify.batch import certify_table
 from qualgrasp.certify.core import grasp_from_dict, grasp_to_dict
 from qualgrasp.certify.batch import random_grasp_table, random_grasps
-from qualgrasp.certify.files import grasps_table, rows_to_table, table_to_rows, table_values
+from qualgrasp.certify.files import grasps_table, table_to_rows, table_values
 from qualgrasp.experiments.baseline import screen_grasps
+
+from helpers import columnar_and_per_grasp
 
 
 def test_registry_order_codes_and_declarations():
@@ -165,16 +167,6 @@ def test_pad_certificates_are_checked_exactly_and_tampering_fails():
     assert not verify(narrow, v.certificate, status="closure")
 
 
-def _both(table, options):
-    lines = list(range(1, table.num_rows + 1))
-    values = table_values(table)
-    ref = table_to_rows(rows_to_table(certify_values(values, lines, options)))
-    fast = table_to_rows(certify_table(table, lines, options,
-                                       slow=lambda idx: certify_values([values[i] for i in idx],
-                                                                       [lines[i] for i in idx], options)))
-    return fast, ref
-
-
 @pytest.mark.parametrize("quality", [False, True])
 def test_pad_rows_columnar_equal_per_grasp(quality):
     """Also 3 friction pads (12 generators, 220 bases) and 21 point contacts (42 generators,
@@ -184,7 +176,7 @@ def test_pad_rows_columnar_equal_per_grasp(quality):
     dicts += [grasp_to_dict(g) for g in random_grasps(7, 60, dim=2, n_contacts=3, model="pad", mu=(0.1, 0.8))]
     dicts += [grasp_to_dict(g) for g in random_grasps(8, 20, dim=2, n_contacts=21, model="point")]
     dicts += [grasp_to_dict(_pads(0.5)), grasp_to_dict(_pads(0.0))]
-    fast, ref = _both(grasps_table(dicts), Options(quality=quality))
+    fast, ref, _ = columnar_and_per_grasp(grasps_table(dicts), Options(quality=quality))
     assert len(fast) == len(ref) == len(dicts)
     for a, b in zip(fast, ref):
         assert a == b, a["id"]

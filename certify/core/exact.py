@@ -33,17 +33,27 @@ def dyadic_integers(values) -> tuple[list[int], int]:
     return [num << (s - den.bit_length() + 1) for num, den in ratios], s
 
 
-def row_echelon(A: Matrix) -> tuple[list[list[Fraction]], list[int]]:
-    """Reduced row echelon form of ``A`` and its pivot columns."""
-    R = [list(row) for row in A]
-    pivots: list[int] = []
+def _pivots(R: list[list]):
+    """Walk the columns of ``R`` (modified in place) for Gaussian elimination: for each column
+    with a non-zero entry at or below the next pivot row ``r``, swap that row up to ``r`` and
+    yield ``(r, c)``; the caller eliminates before the walk goes on."""
     r = 0
-    ncols = len(R[0]) if R else 0
-    for c in range(ncols):
+    for c in range(len(R[0]) if R else 0):
         p = next((i for i in range(r, len(R)) if R[i][c] != 0), None)
         if p is None:
             continue
         R[r], R[p] = R[p], R[r]
+        yield r, c
+        r += 1
+        if r == len(R):
+            return
+
+
+def row_echelon(A: Matrix) -> tuple[list[list[Fraction]], list[int]]:
+    """Reduced row echelon form of ``A`` and its pivot columns."""
+    R = [list(row) for row in A]
+    pivots: list[int] = []
+    for r, c in _pivots(R):
         inv = 1 / R[r][c]
         R[r] = [v * inv for v in R[r]]
         for i in range(len(R)):
@@ -51,9 +61,6 @@ def row_echelon(A: Matrix) -> tuple[list[list[Fraction]], list[int]]:
                 f = R[i][c]
                 R[i] = [a - f * b for a, b in zip(R[i], R[r])]
         pivots.append(c)
-        r += 1
-        if r == len(R):
-            break
     return R, pivots
 
 
@@ -74,22 +81,15 @@ def rank(A: Matrix) -> int:
     for row in A:
         den = math.lcm(*(getattr(v, "denominator", 1) for v in row)) if len(row) else 1
         R.append([int(v * den) for v in row])
-    r = 0
-    ncols = len(R[0]) if R else 0
-    for c in range(ncols):
-        p = next((i for i in range(r, len(R)) if R[i][c] != 0), None)
-        if p is None:
-            continue
-        R[r], R[p] = R[p], R[r]
+    found = 0
+    for r, c in _pivots(R):
         g = R[r][c]
         for i in range(r + 1, len(R)):
             f = R[i][c]
             if f != 0:
                 R[i] = [a * g - b * f for a, b in zip(R[i], R[r])]
-        r += 1
-        if r == len(R):
-            break
-    return r
+        found = r + 1
+    return found
 
 
 def solve(A: Matrix, b: Sequence[Fraction]) -> list[Fraction] | None:

@@ -493,7 +493,7 @@ def carried_array(values: list) -> pa.Array:
     try:
         array = pa.array(values)
     except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError, OverflowError):
-        return json_text([None if v is None else v for v in values])
+        return json_text(values)
     if array.type == pa.large_string():  # that type means JSON text here
         return json_text(values)
     return array
