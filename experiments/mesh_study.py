@@ -131,10 +131,24 @@ def _msh(path: Path) -> tuple[np.ndarray, np.ndarray]:
 
 def named_meshes(model: Path) -> list[tuple[Path, tuple | None]]:
     """The mesh files a MuJoCo XML or URDF model names, in the model's order (a URDF's visual
-    mesh, then its collision mesh), each with the model's scale ``(sx, sy, sz)`` for it (None:
-    unscaled); raises ValueError when it names none. A path is taken from the model's folder, or
-    else from the nearest folder above it that holds the file (a MuJoCo include's paths are
-    relative to the model that includes it).
+    mesh, then its collision mesh), each with the model's scale for it.
+
+    Parameters
+    ----------
+    model : Path
+        A MuJoCo XML (model or include) or URDF file.
+
+    Returns
+    -------
+    list of (Path, tuple or None)
+        Each named mesh file and its scale ``(sx, sy, sz)`` (None: unscaled). A path is taken from
+        the model's folder, or else from the nearest folder above it that holds the file (a MuJoCo
+        include's paths are relative to the model that includes it).
+
+    Raises
+    ------
+    ValueError
+        The model names no mesh.
 
     Examples
     --------
