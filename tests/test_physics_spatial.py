@@ -15,7 +15,7 @@ from qualgrasp.experiments.physics.spatial import (  # noqa: E402
     SpatialPhysics, convex_pieces, least_physical_grip, squeeze_forces, trial, world_xml)
 
 #: The measured error of the box's least grip force (closed-forms table, both settings of
-#: SPATIAL.md: at most 0.3 %), with the bisection's own bracket on top.
+#: docs/spatial-validation.md: at most 0.3 %), with the bisection's own bracket on top.
 TOLERANCE = 0.005 + (SPATIAL_PRECISION - 1)
 
 

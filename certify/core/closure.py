@@ -96,7 +96,7 @@ def decide(problem: ClosureProblem, exact_columns, solver,
         return Verdict("closure", float(sol.t), cert)
     if sol is not None and sol.y is not None and sol.t < tol.margin:
         cert = farkas_certificate(C, blocks, layout, sol.y)
-        if cert is not None and cert.tight:
+        if cert is not None and _ill_conditioned(C, blocks, cert.tight):
             cert = exact_farkas(exact_columns(), blocks, cert)
         if cert is not None:
             return Verdict("no_closure", 0.0, cert)
@@ -115,6 +115,18 @@ def decide(problem: ClosureProblem, exact_columns, solver,
     y = None if sol.y is None else _floats(sol.y / np.linalg.norm(sol.y))
     return Verdict("degenerate", 0.0,
                    Certificate("degenerate", layout, values, y=y, reason="margin"))
+
+
+def _ill_conditioned(C: np.ndarray, blocks, tight) -> bool:
+    """Are the columns of the ``tight`` blocks of ``C`` far from independent (singular value
+    ratio at most 1e-6, or more columns than rows)? Only then can a direction orthogonal to them
+    in floats (to rounding, after the kernel's projection) fail the exact check's ``1e-6 |y|``:
+    otherwise the exact projection moves it by about ``1e-16`` times their condition number."""
+    cols = [j for b in tight for j in blocks[b].cols]
+    if not cols:
+        return False
+    sv = np.linalg.svd(C[:, cols], compute_uv=False)
+    return len(cols) > C.shape[0] or not sv[-1] > 1e-6 * sv[0]
 
 
 def exact_farkas(Cx, blocks, cert: Certificate) -> Certificate | None:
