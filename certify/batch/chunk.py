@@ -2,9 +2,10 @@
 
 A chunk (:class:`qualgrasp.certify.files.reader.Chunk`) holds JSON Lines text or an Arrow table. Either
 is read into checked columns (:mod:`qualgrasp.certify.files.columns`: one validation, the same rules and
-messages for both). An Arrow chunk goes through the columnar path
-(:func:`qualgrasp.certify.batch.fastpath.certify_table`); every row it does not settle, like every row
-of a JSON chunk, goes through the per-grasp path (:func:`certify_rows`). A bad row becomes an
+messages for both). Either goes through the columnar path
+(:func:`qualgrasp.certify.batch.fastpath.certify_table`; :func:`certify_parsed` for parsed JSON values
+and a source's grasps); every row it does not settle goes through the per-grasp path
+(:func:`certify_rows`, which :func:`certify_values` applies to every row). A bad row becomes an
 ``error`` row naming its line, the field and the problem: a chunk always gives exactly one
 results row per input row, in order. A grasp's extra top-level fields are carried through
 (:func:`qualgrasp.certify.files.results.carried_name`).
@@ -21,7 +22,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Sequence
 
 import numpy as np
@@ -40,7 +41,7 @@ from ..core.arguments import choice, count_in, number_in, require
 from ..core.validation import show_repr
 from ..files.reader import Chunk, chunk_values, column_problem, table_to_rows
 
-__all__ = ["Options", "RowFailure", "Quality", "certify_rows", "certify_values", "certify_chunk_results", "certify_arrow",
+__all__ = ["Options", "RowFailure", "Quality", "certify_rows", "certify_values", "certify_parsed", "certify_chunk_results", "certify_arrow",
            "verify_rows", "verify_chunk", "status_counts", "STATUSES"]
 
 
@@ -140,13 +141,36 @@ def certify_values(values: Sequence[Any], lines: Sequence[int], options: Options
     return certify_rows(cols, range(len(values)), lines, options, tol)
 
 
+def certify_parsed(values: Sequence[Any], lines: Sequence[int], options: Options = Options(),
+                   tol: Tolerances = Tolerances()) -> list[dict]:
+    """The rows :func:`certify_values` gives, by the columnar path where its rules settle a row
+    (:func:`qualgrasp.certify.batch.fastpath.certify_table`: row for row the per-grasp results)
+    and grasp by grasp for the others, fields carried from the input included."""
+    cols = value_columns(values)
+    carried = [_carried(cols.meta[i] if cols.meta else None) for i in range(len(values))]
+    refused = np.array([message is not None for _, message in carried], dtype=bool)
+    if refused.any():  # the per-grasp path states why their fields cannot be carried
+        cols = replace(cols, ok=cols.ok & ~refused)
+
+    def slow(rows):  # the results columns only: the carried fields join every row below
+        out = certify_rows(cols, rows, [lines[i] for i in rows], options, tol)
+        return [{k: v for k, v in row.items() if k in NAMES} for row in out]
+
+    rows = table_to_rows(certify_table(pa.table({}), lines, options, tol, slow=slow, columns=cols))
+    for i, (row, (fields, message)) in enumerate(zip(rows, carried)):
+        row["id"] = cols.id_of(i)  # as read: an Arrow table holds ids as strings
+        if message is None:
+            row.update(fields)
+    return rows
+
+
 def certify_chunk_results(chunk: Chunk, options: Options, tol: Tolerances = Tolerances()):
-    """Results of ``chunk``: an Arrow table for an Arrow chunk (columnar path), a list of rows
-    for JSON Lines or for a run with a source (per-grasp path)."""
+    """Results of ``chunk``: an Arrow table for an Arrow chunk, a list of rows for JSON Lines or
+    for a run with a source; the columnar path settles what it can in every case."""
     if options.source is not None:
         return _certify_sourced(options.source.grasp_values(chunk), chunk.lines, options, tol)
     if not isinstance(chunk.rows, pa.Table):
-        return certify_values(chunk_values(chunk), chunk.lines, options, tol)
+        return certify_parsed(chunk_values(chunk), chunk.lines, options, tol)
     return _certify_arrow_rows(chunk.rows, chunk.lines, options, tol)
 
 
@@ -155,7 +179,7 @@ def _certify_sourced(values: Sequence[Any], lines: Sequence[int], options: Optio
     row with its fields, in order."""
     grasps = [k for k, v in enumerate(values) if not isinstance(v, RowFailure)]
     rows: list[dict | None] = [None] * len(values)
-    certified = certify_values([values[k] for k in grasps], [lines[k] for k in grasps], options, tol)
+    certified = certify_parsed([values[k] for k in grasps], [lines[k] for k in grasps], options, tol)
     for k, row in zip(grasps, certified):
         rows[k] = row
     for k, v in enumerate(values):
