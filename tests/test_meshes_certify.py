@@ -129,8 +129,30 @@ def test_interrupted_run_resumes_and_refuses_another_mesh(scene, tmp_path):
     assert ids == [f"p{i}" for i in range(11)] + ["narrow", "far", "bad"]
 
 
+def test_hold_in_one_run_equals_contacts_hold(scene):
+    """certify --mesh --hold writes each grasp's weight-holding columns as contacts --hold does,
+    next to its closure verdict."""
+    mesh, poses = scene / "box.stl", scene / "poses.jsonl"
+    hold = ["--hold", "30", "--gravity", "0,0,-1", "--units", "mm", "--mass", "0.3"]
+    res = runner.invoke(app, ["certify", str(poses), "--mesh", str(mesh), *hold, "--no-quality",
+                              "-o", str(scene / "hold.jsonl"), "--workers", "1"])
+    assert res.exit_code == 1, res.output
+    res = runner.invoke(app, ["contacts", str(mesh), str(poses), *hold, "-o", str(scene / "hold-c.jsonl")])
+    assert res.exit_code == 1, res.output
+    one, two = _rows(scene / "hold.jsonl"), {r["id"]: r for r in _rows(scene / "hold-c.jsonl")}
+    keys = ("hold_status", "hold_budget", "grip_lo", "grip_hi", "hold_verified", "hold_note", "hold_certificate")
+    certified = [r for r in one if r["status"] != "error"]
+    assert len(certified) == 11 and {r["hold_status"] for r in certified} >= {"holds", "slips"}
+    for r in certified:
+        assert {k: r[k] for k in keys} == {k: two[r["id"]][k] for k in keys} and r["hold_verified"]
+
+
 @pytest.mark.parametrize("args, message", [
     (["--gripper", "robotiq_2f85"], "--gripper needs --mesh"),
+    (["--hold", "2"], "--hold needs --mesh"),
+    (["--mesh", "MESH", "--gravity", "all"], "--gravity needs --hold"),
+    (["--mesh", "MESH", "--hold", "0"], "--hold must be"),
+    (["--mesh", "MESH", "--hold", "2", "--level", "7"], "--level must be between 0 and 4"),
     (["--mesh", "MESH", "--model", "elliptic"], "--model must be soft or point"),
     (["--mesh", "missing.stl"], "missing.stl"),
     (["--mesh", "MESH", "--units", "mm", "-o", "MESH"], "never overwritten"),

@@ -62,6 +62,13 @@ def certify_command(
     mass: float = typer.Option(None, help="With --mesh: mass of the object, kg (default: density 1000 kg/m^3)."),
     points: bool = typer.Option(None, "--points/--no-points", help="With --mesh: write each patch's points "
                                 "(default: written)."),
+    hold: float = typer.Option(None, help="With --mesh: certify whether each grasp holds the object's weight with "
+                                          "a grip force of at most this many newtons (the hold_* and grip_* "
+                                          "columns, as 'qualgrasp contacts --hold' writes them)."),
+    gravity: str = typer.Option(None, help="With --mesh --hold: 'all' (every direction, the default) or one "
+                                           "direction x,y,z (object frame)."),
+    level: int = typer.Option(None, help="With --mesh --hold and --gravity all: icosphere level of the direction "
+                                         "polytope, 0 to 4 (default 1)."),
 ) -> None:
     """Certify form and force closure of every grasp, one results line per grasp line.
 
@@ -82,7 +89,10 @@ def certify_command(
     if chunk_size < 1:
         fail(f"--chunk-size must be at least 1 grasp, got {chunk_size}")
     mesh_options = {k: v for k, v in dict(gripper=gripper, convention=convention, units=units, mu=mu, model=model,
-                                          mass=mass, points=points).items() if v is not None}
+                                          mass=mass, points=points, hold=hold, gravity=gravity,
+                                          level=level).items() if v is not None}
+    if hold is None and (gravity is not None or level is not None):
+        fail(f"--{'gravity' if gravity is not None else 'level'} needs --hold")
     if mesh is None and mesh_options:
         fail(f"--{next(iter(mesh_options))} needs --mesh")
     source = None

@@ -8,12 +8,10 @@
 from __future__ import annotations
 
 import json
-import math
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import typer
@@ -33,7 +31,7 @@ from .poses import error_row, read_poses
 from .rays import ENGINES, RayCaster
 from .source import check_contact_options, pose_grasps
 from .sampling import sample_poses
-from .task import check_bound, check_every_direction, every_direction, hold_verdict, least_grip
+from .task import hold_fields, parse_gravity
 
 __all__ = ["register", "contacts_file", "ContactsSummary", "write_rows"]
 
@@ -72,40 +70,6 @@ def write_rows(path: Path, rows: list[dict], grasps: bool) -> None:
     pq.write_table(table, path)
 
 
-def _parse_gravity(text: str) -> np.ndarray | None:
-    """``all`` (None) or one direction ``x,y,z`` (normalised)."""
-    if text == "all":
-        return None
-    try:
-        d = np.array([float(v) for v in text.split(",")])
-    except ValueError:
-        d = np.zeros(0)
-    if d.shape != (3,) or not np.isfinite(d).all() or np.linalg.norm(d) == 0:
-        raise OptionError(f"--gravity must be 'all' or a direction x,y,z (three numbers, not all 0), got {text!r}")
-    return d / np.linalg.norm(d)
-
-
-def _hold_fields(grasp, props, budget: float, gravity: np.ndarray | None, level: int) -> dict:
-    """The hold columns of one grasp. Both ends are re-checked here once more; should that fail,
-    neither end is stated (``undecided``) and ``hold_note`` gives the reason."""
-    if gravity is None:
-        e = every_direction(grasp, props.mass, props.com, level=level)
-        ok = check_every_direction(grasp, props.mass, props.com, e)
-        lo, hi, note = e.lo, e.hi, e.note
-        cert = {"level": e.level, "radius": e.radius, "worst": e.worst.to_json(),
-                "vertices": [v.to_json() for v in e.vertices]}
-    else:
-        b = least_grip(grasp, props.mass, props.com, gravity)
-        ok = check_bound(grasp, props.mass, props.com, b)
-        lo, hi, note, cert = b.lo, b.hi, b.note, b.to_json()
-    if not ok:
-        lo, hi, note = 0.0, math.inf, f"no bound stated: the re-check failed ({ok.reason})"
-    status = hold_verdict(lo, hi, budget)
-    return {"hold_status": status, "hold_budget": budget, "grip_lo": None if math.isinf(lo) else lo,
-            "grip_hi": None if math.isinf(hi) else hi,
-            "hold_verified": bool(ok), "hold_note": note or None, "hold_certificate": json.dumps(cert)}
-
-
 def contacts_file(mesh_path: Path, poses_path: Path, output: Path, *, gripper: str = "franka_panda",
                   convention: str = "qualgrasp", units: str = "m", repair: bool = False, mu: float | None = None,
                   model: str = "soft", tolerance: float = TOLERANCE, resolution: int = RESOLUTION,
@@ -124,7 +88,7 @@ def contacts_file(mesh_path: Path, poses_path: Path, output: Path, *, gripper: s
     check_contact_options(convention, model, tolerance, resolution, mu)
     if hold is not None:
         number_in(hold, "--hold", 0, 1e9, unit="N", low_open=True)
-    grav = _parse_gravity(gravity)
+    grav = parse_gravity(gravity)
     output = output_file(output, "--output", reads=(mesh_path, poses_path))
     errors = output_file(errors or output.with_name(output.name.split(".")[0] + ".errors.jsonl"), "--errors",
                          reads=(mesh_path, poses_path, output))
@@ -142,7 +106,7 @@ def contacts_file(mesh_path: Path, poses_path: Path, output: Path, *, gripper: s
                 bad.append(error_row(r, row.fields["reason"], str(row)))
                 continue
             if hold is not None:
-                row.update(_hold_fields(grasp_from_dict(row), props, hold, grav, level))
+                row.update(hold_fields(grasp_from_dict(row), props, hold, grav, level))
                 summary.holds[row["hold_status"]] += 1
             rows.append(row)
     summary.grasps = len(rows)

@@ -34,6 +34,8 @@ from .mesh import MassProperties, load_mesh, mass_properties
 from .errors import PoseFileError
 from .poses import HDF5_MAGIC, PoseRow, chunk_poses, contact_row, grasp_of
 from .rays import RayCaster
+from .task import hold_fields, parse_gravity
+from ..core.grasp import grasp_from_dict
 
 __all__ = ["MODELS", "PoseSource", "check_contact_options", "check_pose_file", "pose_grasps", "file_digest"]
 
@@ -145,6 +147,10 @@ class PoseSource:
         friction coefficient (None: the gripper's), the patch model, the penetration tolerance (m),
         the pad grid, density (kg/m^3) or mass (kg), the ray engine, and whether rows keep the
         patches' points.
+    hold, gravity, level
+        The weight-holding certificate of every grasp (:func:`~qualgrasp.certify.meshes.task.hold_fields`):
+        the grip force budget (N; None: not computed), ``all`` or a direction ``x,y,z``, and the
+        icosphere level for ``all``.
     """
 
     mesh: str
@@ -161,6 +167,9 @@ class PoseSource:
     mass: float | None = None
     engine: str = "auto"
     points: bool = True
+    hold: float | None = None
+    gravity: str = "all"
+    level: int = 1
 
     @classmethod
     def of(cls, mesh: str | Path, **options: Any) -> "PoseSource":
@@ -170,6 +179,11 @@ class PoseSource:
         check_contact_options(options.get("convention", "qualgrasp"), options.get("model", "soft"),
                               options.get("tolerance", TOLERANCE), options.get("resolution", RESOLUTION),
                               options.get("mu"))
+        if options.get("hold") is not None:
+            number_in(options["hold"], "--hold", 0, 1e9, unit="N", low_open=True, error=OptionError)
+        parse_gravity(options.get("gravity", "all"))
+        if not 0 <= options.get("level", 1) <= 4:
+            raise OptionError(f"--level must be between 0 and 4, got {options['level']}")
         source = cls(str(Path(mesh).resolve()), "", **options)
         source.load()  # the mesh's own errors (missing, unreadable, not closed) first
         return replace(source, digest=file_digest(mesh))
@@ -188,6 +202,12 @@ class PoseSource:
         """The grasp rows (or failures) of a chunk of the pose file, in order."""
         mesh, gripper, caster, props = self.load()
         rows = chunk_poses(chunk, gripper, self.convention)
-        return pose_grasps(rows, mesh, gripper, caster, props, mu=gripper.mu if self.mu is None else self.mu,
-                           model=self.model, tolerance=self.tolerance, resolution=self.resolution,
-                           points=self.points)
+        out = pose_grasps(rows, mesh, gripper, caster, props, mu=gripper.mu if self.mu is None else self.mu,
+                          model=self.model, tolerance=self.tolerance, resolution=self.resolution,
+                          points=self.points)
+        if self.hold is not None:
+            gravity = parse_gravity(self.gravity)
+            for row in out:
+                if isinstance(row, dict):
+                    row.update(hold_fields(grasp_from_dict(row), props, self.hold, gravity, self.level))
+        return out

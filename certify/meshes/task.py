@@ -73,6 +73,7 @@ with friction ``mu`` on the line through its centre, gravity along the faces, ne
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
 from fractions import Fraction
@@ -91,11 +92,12 @@ from ..core.grasp import Grasp
 from ..core.problem import Block, grasp_system
 from ..solvers.clarabel_direct import settings
 from ..core.wrench import to_exact, wrench
+from ..errors import OptionError
 
 __all__ = ["G", "GripBound", "SlipCertificate", "EveryDirection", "gravity_wrench", "least_grip",
            "check_holds", "check_slips", "check_bound", "direction_polytope", "every_direction",
            "check_every_direction",
-           "hold_verdict"]
+           "hold_verdict", "parse_gravity", "hold_fields"]
 
 #: Standard gravity, m/s^2.
 G = 9.80665
@@ -684,3 +686,49 @@ def hold_verdict(lo: float, hi: float, budget: float) -> str:
     if lo > budget:
         return "slips"
     return "undecided"
+
+
+def parse_gravity(text: str) -> np.ndarray | None:
+    """The ``--gravity`` option: ``all`` (None: every direction) or one direction ``x,y,z``
+    (normalised); an :class:`~qualgrasp.certify.errors.OptionError` naming it otherwise.
+
+    Examples
+    --------
+    >>> parse_gravity("all") is None, parse_gravity("0,0,-2").tolist()
+    (True, [0.0, 0.0, -1.0])
+    """
+    if text == "all":
+        return None
+    try:
+        d = np.array([float(v) for v in text.split(",")])
+    except ValueError:
+        d = np.zeros(0)
+    if d.shape != (3,) or not np.isfinite(d).all() or np.linalg.norm(d) == 0:
+        raise OptionError(f"--gravity must be 'all' or a direction x,y,z (three numbers, not all 0), got {text!r}")
+    return d / np.linalg.norm(d)
+
+
+def hold_fields(grasp: Grasp, props, budget: float, gravity: np.ndarray | None, level: int) -> dict:
+    """The hold columns of one grasp (``hold_status``, ``hold_budget``, ``grip_lo``, ``grip_hi``,
+    ``hold_verified``, ``hold_note``, ``hold_certificate``) for the grip force ``budget`` (N):
+    :func:`least_grip` along ``gravity``, or :func:`every_direction` at icosphere ``level`` when
+    ``gravity`` is None, with ``props`` the object's mass properties. Both ends are re-checked
+    here once more; should that fail, neither end is stated (``undecided``) and ``hold_note``
+    gives the reason."""
+    if gravity is None:
+        e = every_direction(grasp, props.mass, props.com, level=level)
+        ok = check_every_direction(grasp, props.mass, props.com, e)
+        lo, hi, note = e.lo, e.hi, e.note
+        cert = {"level": e.level, "radius": e.radius, "worst": e.worst.to_json(),
+                "vertices": [v.to_json() for v in e.vertices]}
+    else:
+        b = least_grip(grasp, props.mass, props.com, gravity)
+        ok = check_bound(grasp, props.mass, props.com, b)
+        lo, hi, note, cert = b.lo, b.hi, b.note, b.to_json()
+    if not ok:
+        lo, hi, note = 0.0, math.inf, f"no bound stated: the re-check failed ({ok.reason})"
+    status = hold_verdict(lo, hi, budget)
+    return {"hold_status": status, "hold_budget": budget, "grip_lo": None if math.isinf(lo) else lo,
+            "grip_hi": None if math.isinf(hi) else hi,
+            "hold_verified": bool(ok), "hold_note": note or None, "hold_certificate": json.dumps(cert)}
+
