@@ -140,3 +140,31 @@ def test_spatial_columnar_rows_equal_per_grasp_rows():
     assert (9, "closure") in forms and (9, "no_closure") in forms
     # two point contacts squeezing, decided by the closed-form squeeze direction on both routes
     assert sum(1 for r in fast if r["dim"] == 3 and r["certificate"]["force"].get("tight")) >= 3
+
+
+def test_parsed_json_values_columnar_equal_per_grasp():
+    """certify_parsed (JSON Lines chunks, certify --mesh) gives exactly the rows of the per-grasp
+    route: ids of every JSON type as read, carried fields, bad values and unreadable lines."""
+    import json
+
+    from qualgrasp.certify.batch.chunk import certify_parsed, certify_values
+    from qualgrasp.certify.errors import GraspFileError
+
+    values = []
+    for dim, m, model in ((2, 3, "point"), (2, 4, "frictionless"), (3, 3, "point"), (3, 2, "soft")):
+        values += [grasp_to_dict(g) for g in random_grasps(5, 40, dim=dim, n_contacts=m, model=model)]
+    for i, v in enumerate(values):
+        v["id"] = [i, str(i), None, 1.5, True][i % 5]
+        if i % 7 == 0:
+            v["note"] = {"k": [i, "x"]}
+    values[3]["contacts"][0]["mu"] = -1
+    values[4]["contacts"] = "x"
+    values[6]["extra"] = float("nan")  # cannot be carried: an error row saying so
+    values.append(GraspFileError("malformed JSON"))
+    lines = list(range(1, len(values) + 1))
+    fast, ref = certify_parsed(values, lines, Options()), certify_values(values, lines, Options())
+    assert [json.dumps(r) for r in fast] == [json.dumps(r) for r in ref]
+    errors = {i for i, r in enumerate(ref) if r["status"] == "error"}
+    assert {3, 4, 6, len(values) - 1} <= errors
+    kept = [r["id"] for i, r in enumerate(ref) if i not in errors]
+    assert {type(v) for v in kept} == {int, str, type(None)} and len(kept) >= 90
