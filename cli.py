@@ -79,7 +79,7 @@ def registered_commands(module: str) -> dict[str, TyperCommand]:
 
 
 def reflow(text: str) -> str:
-    """``text`` (a docstring) with each paragraph's source line breaks joined: ``--help`` prints
+    r"""``text`` (a docstring) with each paragraph's source line breaks joined: ``--help`` prints
     a paragraph's lines as they are, and rich wraps them again to the terminal. A paragraph
     whose later lines are items or indented (``- ``, ``* ``, ``| ``, a space) keeps its lines.
 
@@ -89,7 +89,10 @@ def reflow(text: str) -> str:
     'Summary.\n\nOne paragraph in two lines.\n\n- an item\n- another'
     """
     paragraphs = inspect.cleandoc(text).split("\n\n")
-    keep = lambda p: any(line[:1] == " " or line[:2] in ("- ", "* ", "| ") for line in p.split("\n")[1:])  # noqa: E731
+
+    def keep(p: str) -> bool:
+        return any(line[:1] == " " or line[:2] in ("- ", "* ", "| ") for line in p.split("\n")[1:])
+
     return "\n\n".join(p if keep(p) else " ".join(line.strip() for line in p.split("\n")) for p in paragraphs)
 
 

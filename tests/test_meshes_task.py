@@ -22,7 +22,7 @@ import trimesh
 
 def box_grasp(mu, model="point", offset=(0.0, 0.0), torsion=0.004, a=0.05):
     """Two contacts on opposite faces x = +-a of a box centred at the origin."""
-    kw = {"torsion": torsion} if model == "soft" else {}
+    kw = {"torsion": torsion} if model == "soft" else {"radius": 1.5 * torsion} if model == "patch" else {}
     y, z = offset
     return Grasp((Contact((a, y, z), (-1, 0, 0), model, mu, **kw), Contact((-a, y, z), (1, 0, 0), model, mu, **kw)),
                  center=(0, 0, 0), length=0.1)
@@ -42,7 +42,7 @@ def certified(grasp, m, d, budget):
 
 @pytest.mark.parametrize("mu", [0.2, 0.5, 1.0])
 @pytest.mark.parametrize("m", [0.1, 1.3])
-@pytest.mark.parametrize("model", ["point", "soft"])
+@pytest.mark.parametrize("model", ["point", "soft", "patch"])
 def test_box_across_faces_holds_iff_mu_F_at_least_half_its_weight(mu, m, model):
     grasp = box_grasp(mu, model)
     need = m * G / (2 * mu)
@@ -77,6 +77,10 @@ def test_point_contacts_cannot_hold_a_weight_off_their_line_at_any_grip_force_so
     need = G / (2 * 0.5) * math.sqrt(1 + (0.01 / 0.005) ** 2)
     assert b.lo <= need <= b.hi
     assert check_holds(soft, 1.0, (0, 0, 0), (0, 1, 0), b.hi * (1 + 1e-12), b.forces)
+    # a patch of radius a resists torsion as a soft finger of torsion 2 a / 3 (uniform pressure)
+    patch = box_grasp(0.5, "patch", offset=(0.0, 0.01), torsion=0.005)
+    b = least_grip(patch, 1.0, (0, 0, 0), (0, 1, 0))
+    assert patch.contacts[0].param("radius") == pytest.approx(0.0075) and b.lo <= need <= b.hi
 
 
 def test_tampered_certificates_are_refused():

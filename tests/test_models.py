@@ -28,8 +28,8 @@ from helpers import columnar_and_per_grasp
 
 
 def test_registry_order_codes_and_declarations():
-    assert models.names() == ("frictionless", "point", "soft", "pad")
-    assert [m.code for m in models.models()] == [0, 1, 2, 3]
+    assert models.names() == ("frictionless", "point", "soft", "pad", "patch")
+    assert [m.code for m in models.models()] == [0, 1, 2, 3, 4]
     pad = models.get("pad")
     assert pad is models.get(3) and pad.dims == (2,) and pad.param_names == ("mu", "width")
     assert len(pad.generators(2, 1)) == 4 and len(pad.generators(2, 0)) == 2
@@ -215,3 +215,49 @@ def test_the_baseline_screen_certifies_pads_as_pads():
     reports = [certify_grasp(g) for g in grasps]
     assert certified.tolist() == [r.certified for r in reports] and any(certified)
     assert eps.tolist() == [r.eps_l1 for r in reports]
+
+
+def _as_patches(grasp):
+    """The same grasp with every soft contact a patch of radius 3 torsion / 2 (torsional length
+    2 radius / 3: the same cone)."""
+    out = [Contact(c.p, c.n, "patch", c.mu, radius=1.5 * c.param("torsion")) if c.model == "soft" else c
+           for c in grasp.contacts]
+    return Grasp(tuple(out), center=grasp.center, length=grasp.length)
+
+
+def test_patch_is_the_soft_finger_of_its_disc():
+    """A patch of radius a is a soft finger of torsion 2 a / 3 (uniform pressure on a disc):
+    same verdicts and margins, certificates the exact checker accepts, on random spatial grasps;
+    an exact Fraction radius gives the exact two thirds."""
+    from fractions import Fraction
+
+    patch = models.get("patch")
+    assert patch.moment_lengths({"mu": 0.5, "radius": Fraction(3, 10)}) == (Fraction(1, 5),)
+    assert not patch.exact_in_floats and models.get("soft").exact_in_floats
+    assert Contact((0, 0, 0), (1, 0, 0), "patch", mu=0.0, radius=0.1).model == "frictionless"
+    with pytest.raises(GraspError, match="radius"):
+        Contact((0, 0, 0), (1, 0, 0), "patch", mu=0.5, radius=0.0)
+    for g in random_grasps(4, 150, dim=3, n_contacts=3, model="soft"):
+        p = _as_patches(g)
+        a, b = certify_grasp(g, quality=False), certify_grasp(p, quality=False)
+        assert (a.force.status, a.form.status) == (b.force.status, b.form.status)
+        assert a.force.margin == pytest.approx(b.force.margin, rel=1e-5, abs=1e-9)  # the solvers' accuracy
+        assert b.verified and verify(p, b.force.certificate, status=b.force.status)
+
+
+def test_patch_rows_round_trip_and_verify(tmp_path):
+    """Patch grasps through a Parquet grasp set: certify (their rows are proved by the exact
+    checker, not the float kernels) and verify accept every row."""
+    import pyarrow.parquet as pq
+
+    from qualgrasp.certify.batch import certify_file, verify_file
+
+    dicts = [grasp_to_dict(_as_patches(g)) for g in random_grasps(6, 60, dim=3, n_contacts=3, model="soft")]
+    src, res = tmp_path / "g.parquet", tmp_path / "r.parquet"
+    pq.write_table(grasps_table(dicts), src)
+    summary = certify_file(src, res, quality=False, workers=1)
+    rows = pq.read_table(res).to_pylist()
+    assert len(rows) == 60 and all(r["verified"] for r in rows) and summary.rows == 60
+    assert {r["status"] for r in rows} >= {"closure", "no_closure"}
+    assert not verify_file(res, src, workers=1).failures
+

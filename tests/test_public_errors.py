@@ -188,8 +188,9 @@ def test_literal_types_name_what_is_validated():
 
     assert set(get_args(models.ModelName)) == set(models.names())
     for name in get_args(models.ModelName):
-        params = {"point": {"mu": 0.5}, "soft": {"mu": 0.5, "torsion": 0.1}, "pad": {"mu": 0.5, "width": 0.1}}
-        p, n = ((1, 0, 0), (-1, 0, 0)) if name == "soft" else ((1, 0), (-1, 0))
+        params = {"point": {"mu": 0.5}, "soft": {"mu": 0.5, "torsion": 0.1}, "pad": {"mu": 0.5, "width": 0.1},
+                  "patch": {"mu": 0.5, "radius": 0.1}}
+        p, n = ((1, 0, 0), (-1, 0, 0)) if name in ("soft", "patch") else ((1, 0), (-1, 0))
         assert qg.Contact(p, n, name, **params.get(name, {})).model == name
     for method in METHODS:
         assert make_solver(method) is not None

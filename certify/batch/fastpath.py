@@ -541,9 +541,9 @@ def _spatial_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerance
     or needing the spatial epsilon) are left to the per-grasp path, and so are grasps of more
     than :data:`SPATIAL_CONTACTS` contacts (the batch arrays grow with their square)."""
     m = int(cols.count[rows[0]])
-    if m > SPATIAL_CONTACTS:
-        return np.zeros(len(rows), dtype=bool), {}
     models = cols.models_of(rows[0])
+    if m > SPATIAL_CONTACTS or not all(registry.get(name).exact_in_floats for name in models):
+        return np.zeros(len(rows), dtype=bool), {}
     P, N, params = cols.contacts(rows)
     mu, c, L = params["mu"], cols.center[rows], cols.length[rows]
     B = len(rows)

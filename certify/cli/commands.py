@@ -58,7 +58,8 @@ def certify_command(
     convention: str = typer.Option(None, help="With --mesh: pose convention (default qualgrasp)."),
     units: str = typer.Option(None, help="With --mesh: unit the mesh is drawn in (default m)."),
     mu: float = typer.Option(None, help="With --mesh: friction coefficient (default: the gripper file's)."),
-    model: str = typer.Option(None, help="With --mesh: contact model of the patches, soft or point (default soft)."),
+    model: str = typer.Option(None, help="With --mesh: contact model of the patches, soft, patch or point "
+                                                  "(default soft)."),
     mass: float = typer.Option(None, help="With --mesh: mass of the object, kg (default: density 1000 kg/m^3)."),
     points: bool = typer.Option(None, "--points/--no-points", help="With --mesh: write each patch's points "
                                 "(default: written)."),

@@ -78,9 +78,9 @@ def conic_block_arrays(models: Sequence[str], N: np.ndarray, mu: np.ndarray, par
     first = np.concatenate([[0], np.cumsum(width)[:-1]]).astype(np.int64)
     g = np.zeros(np.shape(mu))
     for i, name in enumerate(models):
-        extra = registry.get(name).extra
-        if extra:
-            g[:, i] = params[extra[0]][:, i]
+        model = registry.get(name)
+        if model.extra:
+            g[:, i] = model.moment_lengths({p: params[p][:, i] for p in model.param_names})[0]
     return cone, first, width, np.ascontiguousarray(N), np.ascontiguousarray(mu), g
 
 
@@ -243,8 +243,9 @@ def conic_columns(P, N, params, models, center, length):
             frame_x = np.zeros(batch + (size, size))
             frame_x[..., :dim, :dim] = frame
             L_ = np.asarray(length)[..., None]
-            for q, extra in enumerate(model.extra):
-                g = params[extra][..., i]
+            lengths = model.moment_lengths({name: params[name][..., i] for name in model.param_names})
+            for q, g in enumerate(lengths):
+                g = np.asarray(g, dtype=float)
                 cols.append(np.concatenate([np.zeros(batch + (dim,)), g[..., None] * N[..., i, :] / L_], axis=-1))
                 frame_x[..., dim + q, dim + q] = g
             frame = frame_x
@@ -290,7 +291,7 @@ def grasp_system(grasp: Grasp, *, frictionless: bool = False, socp: bool = False
     for i, contact in enumerate(grasp.contacts):
         model = contact.contact_model
         cols = tuple(int(j) for j in np.flatnonzero(owner == i))
-        g = num(contact.param(model.extra[0])) if model.extra else 0
+        g = model.moment_lengths({p: num(contact.param(p)) for p in model.param_names})[0] if model.extra else 0
         blocks.append(Block(model.cone, cols, tuple(conv(np.array(contact.n))), num(contact.mu), g, i))
     return System(C, tuple(blocks), "forces")
 

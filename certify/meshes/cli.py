@@ -126,7 +126,8 @@ def contacts_command(
     units: str = typer.Option("m", help="Unit the mesh is drawn in: " + ", ".join(UNITS) + "."),
     repair: bool = typer.Option(False, "--repair", help="Apply trimesh's standard repairs first (reported)."),
     mu: float = typer.Option(None, help="Friction coefficient (default: the gripper file's)."),
-    model: str = typer.Option("soft", help="Contact model of the patches: soft (torsion from the patch) or point."),
+    model: str = typer.Option("soft", help="Contact model of the patches: soft (torsion from the patch's points), "
+                                           "patch (the disc of its area under uniform pressure) or point."),
     tolerance: float = typer.Option(TOLERANCE, help="Penetration tolerance of the patches, m."),
     resolution: int = typer.Option(RESOLUTION, help="Pad grid cells per side."),
     density: float = typer.Option(None, help="Density, kg/m^3 (default 1000 unless --mass)."),

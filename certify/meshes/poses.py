@@ -30,6 +30,7 @@ contacts is an error row, written to the error file: ``id``, ``pose_id``, ``line
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterator
@@ -199,8 +200,9 @@ def _hdf5_poses(path: Path, gripper: Gripper, chunk_size: int) -> Iterator[list[
 def grasp_of(outcome: Outcome, mu: float, model: str, props: MassProperties, gid: Any = None,
              meta: dict | None = None) -> Grasp:
     """certify's :class:`~qualgrasp.certify.Grasp` of a pose's patches: ``soft`` contacts (patch
-    centroid, area-weighted normal, torsion from the patch) or ``point`` contacts, torques about
-    the centre of mass with the object's radius as length.
+    centroid, area-weighted normal, torsion from the patch), ``patch`` contacts (radius of the
+    disc of the patch's area) or ``point`` contacts (a fingertip's one-point patch is a ``point``
+    for every model), torques about the centre of mass with the object's radius as length.
 
     Examples
     --------
@@ -218,6 +220,9 @@ def grasp_of(outcome: Outcome, mu: float, model: str, props: MassProperties, gid
     for p in outcome.patches:
         if model == "soft" and p.torsion > 0:
             contacts.append(Contact(tuple(p.centroid), tuple(p.normal), "soft", mu, torsion=p.torsion))
+        elif model == "patch" and p.area > 0:  # the disc of the patch's area
+            contacts.append(Contact(tuple(p.centroid), tuple(p.normal), "patch", mu,
+                                    radius=math.sqrt(p.area / math.pi)))
         else:
             contacts.append(Contact(tuple(p.centroid), tuple(p.normal), "point", mu))
     return Grasp(tuple(contacts), center=props.com, length=props.radius, id=gid, meta=meta or {})

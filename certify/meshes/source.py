@@ -40,7 +40,7 @@ from ..core.grasp import grasp_from_dict
 __all__ = ["MODELS", "PoseSource", "check_contact_options", "check_pose_file", "pose_grasps", "file_digest"]
 
 #: Contact models of the patches a pose's contacts become.
-MODELS = ("soft", "point")
+MODELS = ("soft", "point", "patch")
 
 
 def check_contact_options(convention: str, model: str, tolerance: float, resolution: int,
@@ -54,7 +54,7 @@ def check_contact_options(convention: str, model: str, tolerance: float, resolut
     >>> check_contact_options("qualgrasp", "elliptic", 0.0005, 21, None)
     Traceback (most recent call last):
     ...
-    qualgrasp.certify.errors.OptionError: --model must be soft or point, got 'elliptic'
+    qualgrasp.certify.errors.OptionError: --model must be soft or point or patch, got 'elliptic'
     """
     if convention not in CONVENTIONS:
         raise OptionError(f"--convention must be one of {', '.join(CONVENTIONS)}, got {convention!r}")

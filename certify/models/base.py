@@ -33,6 +33,9 @@ the model's declaration, never re-stated elsewhere:
     the cone tests themselves are written once per shape, in :mod:`qualgrasp.certify.core.cones`.
 ``frictionless``
     The model a contact becomes when friction is ignored (form closure).
+``moment_lengths``
+    The cone weight of each moment column, from the parameters (:meth:`ContactModel.moment_lengths`:
+    the ``extra`` parameters themselves, or a length derived from them, as the patch's ``2 a / 3``).
 
 A new model is one new module declaring a subclass, plus its import in
 :mod:`qualgrasp.certify.models`.
@@ -42,7 +45,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import ClassVar, Mapping, Sequence
+from typing import Any, ClassVar, Mapping, Sequence
 
 import numpy as np
 
@@ -174,6 +177,19 @@ class ContactModel:
             shape = next(iter(values.values())).shape if values else ()
             return np.zeros(shape)
         return np.asarray(values[self.offset_param])
+
+    def moment_lengths(self, values: Mapping[str, Any]) -> tuple:
+        """The cone weight ``g`` of each moment column (one per name in ``extra``), from the
+        contact's parameter ``values`` (floats, arrays or exact Fractions; exact stays exact):
+        by default those parameters themselves (a soft finger's ``torsion``)."""
+        return tuple(values[name] for name in self.extra)
+
+    @property
+    def exact_in_floats(self) -> bool:
+        """True when the moment lengths are parameters as given, so that the compiled kernels'
+        float cone weights are the exact ones; a derived length (the patch's ``2 a / 3``) is
+        rounded in floats, and the batch path leaves such grasps to the exact checker."""
+        return type(self).moment_lengths is ContactModel.moment_lengths
 
     def columns(self, dim: int) -> int:
         """Number of certificate columns of a contact in the conic form."""
