@@ -30,7 +30,7 @@ from ..core.grasp import Grasp
 from ..core.problem import grasp_system
 from ..core.wrench import force_column_errors, generator_layout, grasp_arrays, to_exact, variants_of
 
-__all__ = ["SHRINK", "surface_faces", "orient_faces", "generalised_cross", "face_distances",
+__all__ = ["SHRINK", "surface_faces", "surfaces_faces", "orient_faces", "generalised_cross", "face_distances",
            "planar_generator_arrays", "sum_errors", "planar_support_choice", "planar_support_vertices",
            "sum_rows", "sqrt_bounds", "vertex_scale", "ConicSupport"]
 
@@ -43,11 +43,36 @@ def surface_faces(points: np.ndarray) -> np.ndarray | None:
     """Faces of the hull of ``points`` (n, d) from qhull, each ordered so that its float
     determinant ``det(v_1, ..., v_d)`` is positive (outward about an interior origin); None when
     qhull fails."""
-    try:
-        hull = ConvexHull(points)
-    except (QhullError, ValueError):
-        return None
-    return orient_faces(points, hull.simplices)
+    return surfaces_faces([points])[0]
+
+
+def surfaces_faces(point_sets) -> list[np.ndarray | None]:
+    """:func:`surface_faces` of each of ``point_sets`` (arrays (n_i, d) of one ``d``): qhull
+    runs once per set, the orientation once for all (the determinant of each face is computed
+    as for a single set, so the faces are the same)."""
+    hulls, offset, points, starts = [], 0, [], []
+    for pts in point_sets:
+        try:
+            hulls.append(np.asarray(ConvexHull(pts).simplices, dtype=np.int64) + offset)
+        except (QhullError, ValueError):
+            hulls.append(None)
+            continue
+        points.append(pts)
+        offset += len(pts)
+    if not points:
+        return hulls
+    done = [h for h in hulls if h is not None]
+    faces = orient_faces(np.concatenate(points), np.concatenate(done))
+    starts = np.cumsum([0] + [len(h) for h in done])
+    out, q, offset = [], 0, 0
+    for h, pts in zip(hulls, point_sets):
+        if h is None:
+            out.append(None)
+            continue
+        out.append(faces[starts[q]:starts[q + 1]] - offset)
+        offset += len(pts)
+        q += 1
+    return out
 
 
 def orient_faces(points: np.ndarray, simplices: np.ndarray) -> np.ndarray:
