@@ -1,6 +1,7 @@
 """Planar epsilon evidence of many grasps at once, compiled (numba): the generator wrenches of a
 batch, the sums of one point per contact polytope (the vertices of ``sums`` evidence) and the
-rigorous float checks of many inscribed surfaces.
+rigorous float checks of many inscribed surfaces; and the vertices of ``support`` evidence
+along many directions.
 
 The arithmetic is that of the per-grasp route (:mod:`qualgrasp.certify.quality.bounds`), so the
 floats are the same: the generators by :func:`~.planar.planar_generators`, each sum added
@@ -15,10 +16,11 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import kernel
+from .linalg import ETA, gamma
 from .planar import planar_generators
 from .surface import cycle_code, face_bounds
 
-__all__ = ["generator_rows", "minkowski_sums", "surface_rows"]
+__all__ = ["generator_rows", "minkowski_sums", "surface_rows", "support_choices", "vertex_sums"]
 
 
 @kernel
@@ -113,3 +115,75 @@ def surface_rows(V, EV, vstart, faces, fstart, perms, psign, tight):
         decided[s] = True
         d2_lo[s], d2_hi[s] = least, top
     return decided, d2_lo, d2_hi
+
+
+@kernel
+def support_choices(W, owner, m, dirs):
+    """The vertex of planar ``support`` evidence along each row of ``dirs`` (n, 3): for each
+    contact the first of its generators (columns of ``W`` (3, k), ``owner`` sorted) with the
+    largest ``v . g``, or -1 (the origin) when that is not positive, as
+    :func:`qualgrasp.certify.quality.gws.planar_support_choice` states it. Returns the choices
+    (n, m) and whether each row is sure: its dot products are computed here in one order, and
+    any order of the three products and two sums (fused or not) is within ``gamma_3`` of the
+    sum of their magnitudes of the exact value, so a row is sure when every contact's largest
+    value beats the others, and zero, by more than both errors (a tie, or a value at zero, is
+    never sure)."""
+    n, k = dirs.shape[0], W.shape[1]
+    R = np.full((n, m), -1, dtype=np.int64)
+    sure = np.ones(n, dtype=np.bool_)
+    vals = np.empty(k)
+    errs = np.empty(k)
+    g = 2.0 * gamma(4)
+    for q in range(n):
+        v0, v1, v2 = dirs[q, 0], dirs[q, 1], dirs[q, 2]
+        for j in range(k):
+            a, b, c = v0 * W[0, j], v1 * W[1, j], v2 * W[2, j]
+            vals[j] = a + b + c
+            errs[j] = g * (abs(a) + abs(b) + abs(c)) + 8 * ETA
+        j0 = 0
+        while j0 < k:
+            i = owner[j0]
+            j1 = j0
+            best = j0
+            while j1 < k and owner[j1] == i:
+                if vals[j1] > vals[best]:
+                    best = j1
+                j1 += 1
+            top = vals[best] - errs[best]  # below every value the best can take
+            clear = True
+            high = -np.inf  # above every value of the contact
+            for j in range(j0, j1):
+                high = max(high, vals[j] + errs[j])
+                if j != best and not vals[j] + errs[j] < top:
+                    clear = False
+            if high < 0.0:
+                R[q, i] = -1  # every value of the contact is negative
+            elif clear and top > 0.0:
+                R[q, i] = best
+            else:
+                sure[q] = False
+            j0 = j1
+    return R, sure
+
+
+@kernel
+def vertex_sums(W, E, R):
+    """Sums of generators: for each row of ``R`` (n, m; -1 picks none) the sum of the columns
+    of ``W`` (3, k) it picks, added in order from zero, and the bound on its error of
+    :func:`minkowski_sums`. Returns ``(V, EV)``, both (n, 3)."""
+    n, m = R.shape
+    V = np.zeros((n, 3))
+    EV = np.zeros((n, 3))
+    factor = 2 * (m + 1) * 2.0**-53
+    for q in range(n):
+        for r in range(3):
+            s, e, a = 0.0, 0.0, 0.0
+            for i in range(m):
+                j = R[q, i]
+                if j >= 0:
+                    s = s + W[r, j]
+                    e = e + E[r, j]
+                    a = a + abs(W[r, j])
+            V[q, r] = s
+            EV[q, r] = e + factor * a
+    return V, EV

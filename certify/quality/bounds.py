@@ -86,8 +86,8 @@ from ..core.arguments import count_in, number_in, require
 from ..errors import ArgumentError
 from ..core.closure import Verdict, force_closure
 from .evidence import EPS_TOL, Evidence, stated_lo, surface_minimum
-from .gws import (ConicSupport, planar_generator_arrays, planar_support_vertices, surface_faces,
-                  surfaces_faces)
+from .gws import (ConicSupport, planar_generator_arrays, planar_support_choices, planar_support_vertices,
+                  surface_faces, surfaces_faces)
 from ..core.grasp import Grasp
 from ..core.problem import System, grasp_system
 from ..solvers.clarabel_direct import settings
@@ -565,7 +565,7 @@ def _planar_support(W, E, owner, m, eps, u, deadline, gens):
 
     def fresh(rows):
         out = []
-        for v, r in zip(rows, planar_support_vertices(W, E, owner, m, np.array(rows))[2]):
+        for v, r in zip(rows, planar_support_choices(W, owner, m, np.array(rows))):
             key = tuple(r)
             if key not in seen:
                 seen.add(key)
@@ -575,12 +575,12 @@ def _planar_support(W, E, owner, m, eps, u, deadline, gens):
     dirs = fresh(dirs)
     hull, done, limited = None, 0, False
     while True:
-        pts = planar_support_vertices(W, E, owner, m, np.array(dirs))[0]
+        pts = planar_support_vertices(W, E, owner, m, np.array(dirs[done:]))[0]  # the new vertices
         try:
             if hull is None:
                 hull = ConvexHull(pts, incremental=True)
             else:
-                hull.add_points(pts[done:])
+                hull.add_points(pts)
             done = len(dirs)
         except (QhullError, ValueError):
             return None, limited
