@@ -62,6 +62,13 @@ result.
 
 Epsilon is 0 for grasps not in closure (and for degenerate ones): the closure verdict is decided
 first, so flat hulls and rank-deficient sets never reach qhull.
+
+Many planar grasps sharing one generator layout (the columnar batch path):
+:func:`planar_epsilon_rows` gives, row for row, what :func:`planar_epsilons` gives, with the
+epsilons, the sums and the rigorous float checks of every surface compiled for the whole batch
+(:mod:`qualgrasp.certify._kernels.evidence`); qhull (whose faces the evidence states) and the
+``support`` refinement run per row, and a row whose surfaces need exact arithmetic takes
+:func:`planar_epsilons` itself.
 """
 
 from __future__ import annotations
@@ -78,7 +85,7 @@ from scipy.spatial import ConvexHull, QhullError
 
 from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .._kernels.epsilon import planar_epsilon as epsilon_kernel
-from .._kernels.evidence import minkowski_sums, surface_rows
+from .._kernels.evidence import minkowski_sums, support_choices, surface_rows, vertex_sums
 from .._kernels.jit import BOOL, F1, F2, FLOAT, I1, I2, INT, precompile
 from .._kernels.planar import planar_generators
 from .._kernels.surface import cycle_code, face_bounds, leibniz_tables
@@ -128,6 +135,8 @@ _PLANAR_KERNELS = _SURFACE_KERNELS + (
     (support_rows, (F2, I1, INT, F2, BOOL)),
     (planar_edges, (F2, I1)),
     (linf_sweep, (F2, I1, INT, F2, INT, INT, F1, F2)),
+    (support_choices, (F2, I1, INT, F2)),  # the support refinement's vertices
+    (vertex_sums, (F2, F2, I2)),
 )
 
 
@@ -391,8 +400,9 @@ def planar_epsilon_rows(W, E, owner, m: int, *, time_limit: float | None = None,
     m : int
         Number of contacts.
     time_limit : float, optional
-        Seconds of the L-infinity sweep and ``support`` refinement per row (``deadline`` of
-        :func:`planar_epsilons`, started when the row's own work starts).
+        Seconds of the ``support`` refinement per row (the ``deadline`` of
+        :func:`planar_epsilons`, started when that row's refinement starts: the batch's
+        compiled work is not counted) and of the rows taking :func:`planar_epsilons`.
     exact : callable, optional
         ``exact(b)`` returns the exact generators (3, k) of row ``b`` (Fractions), asked for only
         on the per-grasp route.
