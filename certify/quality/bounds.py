@@ -499,11 +499,7 @@ def _linf_rows(W, E, owner, m, rows, slow, l1, time_limit, exact):
     eps, arg = epsilon_kernel(W[todo], owner, m, True)
     n = _sum_count(owner, m)
     if n > SUMS_MAX:
-        for b, e, u in zip(todo, eps, arg):
-            deadline = None if time_limit is None else time.perf_counter() + time_limit
-            out[b] = _support_row(W[b], E[b], owner, m, float(e), u, l1[b][0], deadline,
-                                  _exact_once(None if exact is None else (lambda b=b: exact(b))))
-        return out
+        return _support_rows(W, E, owner, m, todo, eps, arg, l1, time_limit, exact)
     step = max(1, (1 << 20) // n)  # rows of sums held at once
     for a in range(0, len(todo), step):
         part = todo[a:a + step]
@@ -538,6 +534,36 @@ def _linf_rows(W, E, owner, m, rows, slow, l1, time_limit, exact):
     return out
 
 
+def _support_rows(W, E, owner, m, todo, eps, arg, l1, time_limit, exact):
+    """The L-infinity part of :func:`planar_epsilon_rows` beyond :data:`SUMS_MAX` sums: each
+    row's ``support`` surface refined on its own (:func:`_support_surface`), then the hulls'
+    faces oriented and their float checks run for all rows at once; a surface those cannot
+    settle is proved as :func:`_planar_support` proves it."""
+    refined = []
+    for b, e, u in zip(todo, eps, arg):
+        deadline = None if time_limit is None else time.perf_counter() + time_limit
+        refined.append(_support_surface(W[b], E[b], owner, m, float(e), np.asarray(u, dtype=float), deadline))
+    have = [q for q, (surface, _) in enumerate(refined) if surface is not None]
+    faces = dict(zip(have, surfaces_faces([refined[q][0][1] for q in have])))
+    done = [q for q in have if faces[q] is not None]
+    proved = dict(zip(done, _checked([refined[q][0][1] for q in done], [refined[q][0][2] for q in done],
+                                     [faces[q] for q in done])))
+    out = {}
+    for q, (b, e, u) in enumerate(zip(todo, eps, arg)):
+        surface, limited = refined[q]
+        found = None
+        if surface is not None:
+            dirs, V, EV, R = surface
+            bounds = proved.get(q)
+            if bounds is None:  # exact arithmetic needed, or no hull: as the per-grasp route
+                gens = _exact_once(None if exact is None else (lambda b=b: exact(b)))
+                bounds = _prove(V, EV, faces[q], _support_vertex(R, gens))
+            lo = _lower(float(e), bounds)
+            found = None if lo is None else (lo, dirs)
+        out[b] = _support_result(float(e), u, l1[b][0], found, limited)
+    return out
+
+
 def _exact_once(exact):
     """``exact()`` called once and kept (the exact generators), or :class:`_NoExact` raised when
     there is no ``exact``."""
@@ -556,8 +582,14 @@ def _exact_once(exact):
 def _support_row(W, E, owner, m, eps, u, l1_lo, deadline, gens):
     """Planar L-infinity bounds ``(lo, hi, direction, evidence, limited)`` by ``support``
     evidence (:func:`_planar_support`), or by the L1 evidence when that proves more."""
-    direction = tuple(float(v) for v in u)
     found, limited = _planar_support(W, E, owner, m, eps, np.asarray(u, dtype=float), deadline, gens)
+    return _support_result(eps, u, l1_lo, found, limited)
+
+
+def _support_result(eps, u, l1_lo, found, limited):
+    """The L-infinity bounds of :func:`_support_row` from what the ``support`` surface proved
+    (``found``: ``(lo, directions)`` or None)."""
+    direction = tuple(float(v) for v in u)
     if found is not None and found[0] >= l1_lo:
         lo, dirs = found
         return lo, eps, direction, Evidence("support", direction, points=tuple(float(x) for x in dirs.ravel())), limited
@@ -565,11 +597,34 @@ def _support_row(W, E, owner, m, eps, u, l1_lo, deadline, gens):
 
 
 def _planar_support(W, E, owner, m, eps, u, deadline, gens):
-    """Planar L-infinity lower bound by ``support`` evidence: the hull of support points along
-    the coordinate directions and ``u``, refined along the normals of its faces nearest the
-    origin (each cut adds a vertex of the GWS beyond the face) until the surface proves ``eps``
-    or ``4 MAX_VERTICES`` directions are used, or the ``deadline`` passes. Returns ``((lo,
-    directions) or None, limited)``, ``limited`` when the deadline stopped the refinement."""
+    """Planar L-infinity lower bound by ``support`` evidence (:func:`_support_surface`, proved
+    by :func:`_prove`). Returns ``((lo, directions) or None, limited)``, ``limited`` when the
+    deadline stopped the refinement."""
+    surface, limited = _support_surface(W, E, owner, m, eps, u, deadline)
+    if surface is None:
+        return None, limited
+    dirs, V, EV, R = surface
+    lo = _lower(eps, _prove(V, EV, surface_faces(V), _support_vertex(R, gens)))
+    return (None if lo is None else (lo, dirs)), limited
+
+
+def _support_vertex(R, gens):
+    """Exact coordinates of the vertex ``i`` of ``support`` evidence with the generator choices
+    ``R``, for :func:`_prove`."""
+
+    def vertex(i):
+        C = gens()
+        return [sum((C[r, j] for j in R[i] if j >= 0), 0) for r in range(3)]
+
+    return vertex
+
+
+def _support_surface(W, E, owner, m, eps, u, deadline):
+    """The vertices of ``support`` evidence: the hull of support points along the coordinate
+    directions and ``u``, refined along the normals of its faces nearest the origin (each cut
+    adds a vertex of the GWS beyond the face) until qhull's hull reaches ``eps`` or ``4
+    MAX_VERTICES`` directions are used, or the ``deadline`` passes. Returns ``((directions,
+    vertices, their error bounds, generator choices) or None when qhull fails, limited)``."""
     dirs = [np.array(v, dtype=float) for v in np.vstack([np.eye(3), -np.eye(3), u[None]])]
     seen = set()
 
@@ -606,14 +661,7 @@ def _planar_support(W, E, owner, m, eps, u, deadline, gens):
         dirs += new
     hull.close()
     dirs = np.array(dirs)
-    V, EV, R = planar_support_vertices(W, E, owner, m, dirs)
-
-    def vertex(i):
-        C = gens()
-        return [sum((C[r, j] for j in R[i] if j >= 0), 0) for r in range(3)]
-
-    lo = _lower(eps, _prove(V, EV, surface_faces(V), vertex))
-    return (None if lo is None else (lo, dirs)), limited
+    return (dirs,) + planar_support_vertices(W, E, owner, m, dirs), limited
 
 
 def _sweep(W, owner, m, deadline):
