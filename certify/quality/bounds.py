@@ -93,8 +93,8 @@ from ..core.arguments import count_in, number_in, require
 from ..errors import ArgumentError
 from ..core.closure import Verdict, force_closure
 from .evidence import EPS_TOL, Evidence, stated_lo, surface_minimum
-from .gws import (ConicSupport, planar_generator_arrays, planar_support_choices, planar_support_vertices,
-                  surface_faces, surfaces_faces)
+from .gws import (ConicSupport, planar_generator_arrays, planar_support_choices,
+                  sum_rows, surface_faces, surfaces_faces)
 from ..core.grasp import Grasp
 from ..core.problem import System, grasp_system
 from ..solvers.clarabel_direct import settings
@@ -627,6 +627,7 @@ def _support_surface(W, E, owner, m, eps, u, deadline):
     vertices, their error bounds, generator choices) or None when qhull fails, limited)``."""
     dirs = [np.array(v, dtype=float) for v in np.vstack([np.eye(3), -np.eye(3), u[None]])]
     seen = set()
+    picks = []  # the generator choices of each direction kept
 
     def fresh(rows):
         out = []
@@ -635,12 +636,14 @@ def _support_surface(W, E, owner, m, eps, u, deadline):
             if key not in seen:
                 seen.add(key)
                 out.append(v)
+                picks.append(r)
         return out
 
     dirs = fresh(dirs)
     hull, done, limited = None, 0, False
     while True:
-        pts = planar_support_vertices(W, E, owner, m, np.array(dirs[done:]))[0]  # the new vertices
+        # the new vertices, as planar_support_vertices gives them (each depends on its own row)
+        pts = sum_rows(W, E, np.array(picks[done:]))[0]
         try:
             if hull is None:
                 hull = ConvexHull(pts, incremental=True)
@@ -660,8 +663,8 @@ def _support_surface(W, E, owner, m, eps, u, deadline):
             break
         dirs += new
     hull.close()
-    dirs = np.array(dirs)
-    return (dirs,) + planar_support_vertices(W, E, owner, m, dirs), limited
+    R = np.array(picks)
+    return (np.array(dirs),) + sum_rows(W, E, R) + (R,), limited
 
 
 def _sweep(W, owner, m, deadline):
