@@ -86,7 +86,7 @@ from scipy.spatial import ConvexHull, QhullError
 from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .._kernels.epsilon import planar_epsilon as epsilon_kernel
 from .._kernels.evidence import minkowski_sums, support_choices, surface_rows, vertex_sums
-from .._kernels.jit import BOOL, F1, F2, FLOAT, I1, I2, INT, precompile
+from .._kernels.jit import BOOL, F1, F2, F3, FLOAT, I1, I2, INT, precompile
 from .._kernels.planar import planar_generators
 from .._kernels.surface import cycle_code, face_bounds, leibniz_tables
 from ..core.arguments import count_in, number_in, require
@@ -135,7 +135,8 @@ _PLANAR_KERNELS = _SURFACE_KERNELS + (
     (support_rows, (F2, I1, INT, F2, BOOL)),
     (planar_edges, (F2, I1)),
     (linf_sweep, (F2, I1, INT, F2, INT, INT, F1, F2)),
-    (support_choices, (F2, I1, INT, F2)),  # the support refinement's vertices
+    (minkowski_sums, (F3, F3, I1, INT)),  # the vertices of sums and support evidence
+    (support_choices, (F2, I1, INT, F2)),
     (vertex_sums, (F2, F2, I2)),
 )
 
