@@ -100,8 +100,8 @@ from ..core.problem import System, grasp_system
 from ..solvers.clarabel_direct import settings
 
 __all__ = ["Norm", "NORMS", "Epsilon", "epsilon", "epsilons", "planar_epsilon", "planar_epsilons",
-           "planar_epsilon_rows", "epsilon_of_points", "check_norm", "L1_ENUMERATION_MAX", "LINF_ENUMERATION_MAX",
-           "SUMS_MAX", "MAX_VERTICES", "SOCP_COST"]
+           "planar_epsilon_rows", "epsilon_of_points", "check_norm", "L1_ENUMERATION_MAX",
+           "LINF_ENUMERATION_MAX", "SUMS_MAX", "MAX_VERTICES", "SOCP_COST"]
 
 #: A norm of the grasp wrench space.
 Norm = Literal["L1", "Linf"]
@@ -593,7 +593,8 @@ def _support_result(eps, u, l1_lo, found, limited):
     direction = tuple(float(v) for v in u)
     if found is not None and found[0] >= l1_lo:
         lo, dirs = found
-        return lo, eps, direction, Evidence("support", direction, points=tuple(float(x) for x in dirs.ravel())), limited
+        points = tuple(float(x) for x in dirs.ravel())
+        return lo, eps, direction, Evidence("support", direction, points=points), limited
     return min(l1_lo, eps), eps, direction, Evidence("l1", direction), limited
 
 
