@@ -461,3 +461,38 @@ def test_compiled_surface_checks_are_surface_minimum():
     for s in range(len(V) - 1):
         reason, d2_lo, d2_hi = surface_minimum(V[s], EV[s], F[s], no_exact)
         assert reason is None and (float(d2_lo), float(d2_hi)) == (lo[s], hi[s])
+
+
+def test_epsilon_rows_are_planar_epsilons_also_where_floats_cannot_decide(monkeypatch):
+    """The batch route gives each row what :func:`planar_epsilons` gives (sums, support and
+    generators evidence), and still does when the compiled float checks settle no surface at
+    all, or none but the L1 ones (checked first): every such surface is then proved exactly,
+    as the per-grasp route proves it."""
+    from qualgrasp.certify.core.problem import grasp_system
+    from qualgrasp.certify.core.wrench import generator_layout, variants_of
+    from qualgrasp.certify.quality.bounds import planar_epsilon_rows
+
+    real, kinds, calls = quality_module.surface_rows, set(), []
+
+    def undecided(*args):
+        decided, lo, hi = real(*args)
+        calls.append(1)
+        return (decided if keep_first and len(calls) == 1 else np.zeros_like(decided)), lo, hi
+
+    for kw in (dict(n_contacts=3, model="point"), dict(n_contacts=10, model="point"),
+               dict(n_contacts=3, model="pad")):
+        grasps = _closure(random_grasps(16, 12, dim=2, spread=0.4, **kw))[:6]
+        owner = generator_layout(tuple(c.model for c in grasps[0].contacts), variants_of(grasps[0]), 2)[0]
+        arrays = [planar_generator_arrays(g) for g in grasps]
+        W, E = np.stack([a[0] for a in arrays]), np.stack([a[1] for a in arrays])
+        m = len(grasps[0].contacts)
+        exact = lambda b: grasp_system(grasps[b], exact=True).columns  # noqa: E731
+        ref = [planar_epsilons(W[b], E[b], owner, m, exact=lambda b=b: exact(b)) for b in range(len(grasps))]
+        assert planar_epsilon_rows(W, E, owner, m, exact=exact) == ref
+        monkeypatch.setattr(quality_module, "surface_rows", undecided)
+        for keep_first in (False, True):
+            calls.clear()
+            assert planar_epsilon_rows(W, E, owner, m, exact=exact) == ref
+        monkeypatch.undo()
+        kinds |= {r["Linf"][3].kind for r in ref}
+    assert {"sums", "support"} <= kinds
