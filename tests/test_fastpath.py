@@ -168,3 +168,82 @@ def test_parsed_json_values_columnar_equal_per_grasp():
     assert {3, 4, 6, len(values) - 1} <= errors
     kept = [r["id"] for i, r in enumerate(ref) if i not in errors]
     assert {type(v) for v in kept} == {int, str, type(None)} and len(kept) >= 90
+
+
+_EPSILON_GROUPS = ((3, "point"), (5, "point"), (3, "pad"), (5, "pad"), (10, "point"), (2, "point"))
+
+
+def _epsilon_table(count):
+    """Random planar grasps of the epsilon groups (3 and 5 contacts, point and pad models, and
+    a few of 10 and 2 contacts), ``count`` in all; about half are in force closure."""
+    import pyarrow as pa
+
+    from qualgrasp.certify.batch.samples import random_grasp_table
+
+    sizes = [count * 3 // 10] * 2 + [count // 10] * 2 + [count // 20] * 2
+    sizes[0] += count - sum(sizes)
+    return pa.concat_tables([random_grasp_table(40 + i, n, n_contacts=m, model=model, spread=0.4,
+                                                start=sum(sizes[:i]))
+                             for i, ((m, model), n) in enumerate(zip(_EPSILON_GROUPS, sizes))])
+
+
+def _epsilon_rows_agree(count, monkeypatch, tmp_path):
+    """The columnar epsilon columns and evidence equal the per-grasp route's on ``count`` grasps,
+    are re-checked by ``verify``, and were computed for the whole group (the per-grasp
+    function :func:`planar_epsilons` was called for few closure rows)."""
+    import pyarrow.parquet as pq
+
+    from qualgrasp.certify.batch import fastpath
+    from qualgrasp.certify.batch.chunk import certify_values
+    from qualgrasp.certify.files import table_values
+    from qualgrasp.certify.quality import bounds
+
+    table = _epsilon_table(count)
+    options = Options(quality=True)
+    lines = list(range(1, table.num_rows + 1))
+    values = table_values(table)
+    ref = table_to_rows(rows_to_table(list(certify_values(values, lines, options))))
+    calls, inside_slow = [], []
+    real = bounds.planar_epsilons
+
+    def counted(*args, **kwargs):
+        if not inside_slow:
+            calls.append(1)
+        return real(*args, **kwargs)
+
+    def slow(idx):
+        inside_slow.append(1)
+        try:
+            return list(certify_values([values[i] for i in idx], [lines[i] for i in idx], options))
+        finally:
+            inside_slow.pop()
+
+    monkeypatch.setattr(bounds, "planar_epsilons", counted)
+    monkeypatch.setattr(fastpath, "planar_epsilons", counted, raising=False)  # wherever it is called from
+    res = certify_table(table, lines, options, slow=slow)
+    fast = table_to_rows(res)
+    assert len(fast) == len(ref) == table.num_rows
+    for a, b in zip(fast, ref):
+        assert a == b, (a["id"], {k: (a[k], b[k]) for k in a if a[k] != b[k]})
+    closure = [r for r in fast if r["status"] == "closure"]
+    kinds = {(r["n_contacts"], r["eps_evidence"]["linf"]["kind"]) for r in closure}
+    assert {(3, "sums"), (5, "sums"), (10, "support")} <= kinds
+    assert len(closure) > 0.3 * count and len(calls) <= 0.02 * len(closure)
+    grasps, results = tmp_path / "g.parquet", tmp_path / "r.parquet"
+    pq.write_table(table, grasps)
+    pq.write_table(res, results)
+    summary = verify_file(results, grasps, workers=2)
+    assert summary.rows == count and not summary.failures
+
+
+def test_columnar_epsilon_evidence_equals_per_grasp(monkeypatch, tmp_path):
+    """Planar epsilon bounds and evidence compiled for a whole group: the per-grasp rows exactly
+    (3 and 5 contacts, point and pad models; ``sums``, ``support`` and ``generators`` evidence),
+    and ``verify`` accepts them."""
+    _epsilon_rows_agree(1000, monkeypatch, tmp_path)
+
+
+@pytest.mark.slow
+def test_columnar_epsilon_evidence_equals_per_grasp_10000(monkeypatch, tmp_path):
+    """The same on 10,000 grasps."""
+    _epsilon_rows_agree(10000, monkeypatch, tmp_path)

@@ -355,3 +355,144 @@ def test_default_time_limit_is_never_hit_on_small_grasps():
         for g in _closure(random_grasps(16, 20, **kwargs))[:2]:
             row = certify_grasp(g, eps_time=Options().eps_time).row(line=1)
             assert row["eps_limited"] is False
+
+
+def test_compiled_sums_are_every_sum_within_their_bounds():
+    """Brute force against the exact generators: the compiled sums of sums evidence are every
+    sum of one point per contact polytope, in order (the first contact's choice slowest), each
+    the float sum in contact order, and within its stated bound of the exact sum; the sums of
+    support evidence (:func:`sum_rows`) are the same sums."""
+    from fractions import Fraction
+
+    from qualgrasp.certify._kernels.evidence import minkowski_sums
+    from qualgrasp.certify.core.problem import grasp_system
+    from qualgrasp.certify.quality.gws import sum_rows
+
+    for kw in (dict(n_contacts=3, model="point"), dict(n_contacts=2, model="pad"),
+               dict(n_contacts=4, model="frictionless")):
+        for g in random_grasps(13, 6, dim=2, **kw):
+            W, E, owner = planar_generator_arrays(g)
+            m, k = len(g.contacts), W.shape[1]
+            X = grasp_system(g, exact=True).columns
+            pts, err, choice = minkowski_sums(W[None], E[None], owner, m)
+            options = [[-1] + [j for j in range(k) if owner[j] == i] for i in range(m)]
+            assert choice.tolist() == [list(c) for c in product(*options)]
+            V, EV = sum_rows(W, E, choice)
+            assert np.array_equal(V, pts[0]) and np.array_equal(EV, err[0])
+            for p, c in enumerate(choice):
+                for r in range(3):
+                    s = 0.0
+                    for j in c:
+                        s = s + (W[r, j] if j >= 0 else 0.0)
+                    assert pts[0, p, r] == s
+                    exact = sum((X[r, j] for j in c if j >= 0), Fraction(0))
+                    assert abs(Fraction(s) - exact) <= Fraction(err[0, p, r])
+
+
+def test_compiled_support_choices_are_planar_support_choice():
+    """Where the compiled choice states itself sure it is :func:`planar_support_choice`'s (the
+    largest value per contact, the first of ties, -1 when not positive); ties are never sure, so
+    they take that function."""
+    from qualgrasp.certify._kernels.evidence import support_choices
+    from qualgrasp.certify.quality.gws import planar_support_choice, planar_support_choices
+
+    rng = np.random.default_rng(3)
+    sure_seen = unsure_seen = 0
+    for kw in (dict(n_contacts=10, model="point"), dict(n_contacts=3, model="pad")):
+        for g in random_grasps(14, 20, dim=2, **kw):
+            W, E, owner = planar_generator_arrays(g)
+            m = len(g.contacts)
+            dirs = np.vstack([np.eye(3), -np.eye(3), rng.normal(size=(20, 3))])
+            R, sure = support_choices(W, owner, m, dirs)
+            ref = np.array([planar_support_choice(W, owner, m, v) for v in dirs])
+            assert np.array_equal(R[sure], ref[sure])
+            assert np.array_equal(planar_support_choices(W, owner, m, dirs), ref)
+            sure_seen += int(sure.sum())
+            unsure_seen += int((~sure).sum())
+    assert sure_seen > 500 and unsure_seen > 0  # the pads' equal forces tie along the force axes
+    W = np.array([[1.0, 1.0], [0.0, 0.0], [2.0, -2.0]])  # one contact, a tie along (1, 0, 0)
+    R, sure = support_choices(W, np.zeros(2, dtype=np.int64), 1, np.array([[1.0, 0, 0], [0, 0, 1.0]]))
+    assert not sure[0] and sure[1] and R[1, 0] == 0
+
+
+def test_surfaces_faces_are_surface_faces():
+    """Orienting the faces of many hulls at once gives each hull's own faces; a flat set gives
+    None in its place."""
+    from qualgrasp.certify.quality.gws import surface_faces, surfaces_faces
+
+    rng = np.random.default_rng(4)
+    sets = [rng.normal(size=(n, 3)) for n in (4, 9, 30)]
+    sets.insert(1, np.c_[rng.normal(size=(6, 2)), np.zeros(6)])
+    out = surfaces_faces(sets)
+    assert out[1] is None and surface_faces(sets[1]) is None
+    for pts, faces in zip(sets, out):
+        if faces is not None:
+            assert np.array_equal(faces, surface_faces(pts))
+
+
+def test_compiled_surface_checks_are_surface_minimum():
+    """The float checks of many surfaces at once bound each surface's smallest face distance
+    as :func:`surface_minimum` does, and leave undecided what needs the exact vertices (here: a
+    face turned the wrong way)."""
+    from qualgrasp.certify._kernels.evidence import surface_rows
+    from qualgrasp.certify._kernels.surface import leibniz_tables
+    from qualgrasp.certify.quality.evidence import EPS_TOL, surface_minimum
+    from qualgrasp.certify.quality.gws import surface_faces
+
+    V, EV, F = [], [], []
+    for g in _closure(random_grasps(15, 20, dim=2, n_contacts=3, model="point"))[:8]:
+        W, E, owner = planar_generator_arrays(g)
+        V.append(np.ascontiguousarray(W.T))
+        EV.append(np.ascontiguousarray(E.T))
+        F.append(surface_faces(W.T))
+    bad = F[0].copy()
+    bad[0, [0, 1]] = bad[0, [1, 0]]  # wrong orientation: not a closed oriented cycle
+    V.append(V[0]), EV.append(EV[0]), F.append(bad)
+    vstart = np.cumsum([0] + [len(v) for v in V])
+    fstart = np.cumsum([0] + [len(f) for f in F])
+    perms, signs = leibniz_tables(2)
+    decided, lo, hi = surface_rows(np.concatenate(V), np.concatenate(EV), vstart, np.concatenate(F),
+                                   fstart, perms, signs, EPS_TOL / 8)
+    assert decided[:-1].all() and not decided[-1]
+
+    def no_exact(i):
+        raise AssertionError("the float checks settle these surfaces")
+
+    for s in range(len(V) - 1):
+        reason, d2_lo, d2_hi = surface_minimum(V[s], EV[s], F[s], no_exact)
+        assert reason is None and (float(d2_lo), float(d2_hi)) == (lo[s], hi[s])
+
+
+def test_epsilon_rows_are_planar_epsilons_also_where_floats_cannot_decide(monkeypatch):
+    """The batch route gives each row what :func:`planar_epsilons` gives (sums, support and
+    generators evidence), and still does when the compiled float checks settle no surface at
+    all, or none but the L1 ones (checked first): every such surface is then proved exactly,
+    as the per-grasp route proves it."""
+    from qualgrasp.certify.core.problem import grasp_system
+    from qualgrasp.certify.core.wrench import generator_layout, variants_of
+    from qualgrasp.certify.quality.bounds import planar_epsilon_rows
+
+    real, kinds, calls = quality_module.surface_rows, set(), []
+
+    def undecided(*args):
+        decided, lo, hi = real(*args)
+        calls.append(1)
+        return (decided if keep_first and len(calls) == 1 else np.zeros_like(decided)), lo, hi
+
+    for kw in (dict(n_contacts=3, model="point"), dict(n_contacts=10, model="point"),
+               dict(n_contacts=3, model="pad")):
+        grasps = _closure(random_grasps(16, 12, dim=2, spread=0.4, **kw))[:6]
+        owner = generator_layout(tuple(c.model for c in grasps[0].contacts), variants_of(grasps[0]), 2)[0]
+        arrays = [planar_generator_arrays(g) for g in grasps]
+        W, E = np.stack([a[0] for a in arrays]), np.stack([a[1] for a in arrays])
+        m = len(grasps[0].contacts)
+        exact = lambda b: grasp_system(grasps[b], exact=True).columns  # noqa: E731
+        ref = [planar_epsilons(W[b], E[b], owner, m, exact=lambda b=b: exact(b)) for b in range(len(grasps))]
+        assert planar_epsilon_rows(W, E, owner, m, exact=exact) == ref
+        monkeypatch.setattr(quality_module, "surface_rows", undecided)
+        for keep_first in (False, True):
+            calls.clear()
+            assert planar_epsilon_rows(W, E, owner, m, exact=exact) == ref
+        monkeypatch.undo()
+        kinds |= {r["Linf"][3].kind for r in ref}
+    assert {"sums", "support"} <= kinds

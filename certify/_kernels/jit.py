@@ -21,11 +21,11 @@ from typing import Callable, Iterable
 
 from numba import config, njit, types
 
-__all__ = ["cache_dir", "kernel", "precompile", "F1", "F2", "I1", "I2", "INT", "FLOAT", "BOOL"]
+__all__ = ["cache_dir", "kernel", "precompile", "F1", "F2", "F3", "I1", "I2", "INT", "FLOAT", "BOOL"]
 
-#: Argument types as the callers pass them: C-contiguous float64 and int64 arrays of 1 and 2
-#: dimensions, and Python's int, float and bool.
-F1, F2 = types.float64[::1], types.float64[:, ::1]
+#: Argument types as the callers pass them: C-contiguous float64 arrays of 1 to 3 dimensions and
+#: int64 arrays of 1 and 2, and Python's int, float and bool.
+F1, F2, F3 = types.float64[::1], types.float64[:, ::1], types.float64[:, :, ::1]
 I1, I2 = types.int64[::1], types.int64[:, ::1]
 INT, FLOAT, BOOL = types.int64, types.float64, types.boolean
 

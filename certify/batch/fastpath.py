@@ -8,8 +8,10 @@ grouped by contact pattern (dimension, contact count, each contact's model and v
 * planar groups go through :func:`qualgrasp.certify._kernels.planar.planar_batch`: the LP (the
   same kernel the per-grasp path calls), the certificate and its rigorous re-check in floating
   point with error bounds; with quality, the exact planar epsilon and its evidence of every
-  closure row by :func:`qualgrasp.certify.quality.bounds.planar_epsilons`, the per-grasp path's own
-  function;
+  closure row by :func:`qualgrasp.certify.quality.bounds.planar_epsilon_rows`, compiled for the
+  whole group and row for row what the per-grasp path's
+  :func:`~qualgrasp.certify.quality.bounds.planar_epsilons` gives (rows its float checks cannot
+  settle take that function);
 * spatial groups through the compiled dual barrier method over exact cones, with clear verdicts
   proved columnar, and near-boundary rows decided by the per-grasp rules on the arrays already
   built (the squeeze rule, then clarabel); form closure with six or more contacts by the fast
@@ -32,7 +34,6 @@ are built in Arrow by ``qualgrasp.certify.batch._arrow``.
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 from itertools import combinations
 
@@ -41,6 +42,7 @@ import pyarrow as pa
 import scipy.sparse as sp
 
 from .._kernels.barrier import barrier_batch
+from .._kernels.evidence import generator_rows
 from .._kernels.linalg import U as U_ROUND, projection_bound, world_values
 from .._kernels.planar import pair_null_rows, planar_batch, planar_generators, thin_screen
 from .._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
@@ -52,7 +54,7 @@ from ..core.cones import LORENTZ
 from ..core.grasp import Contact, Grasp
 from ..core.problem import (Block, ClosureProblem, System, conic_block_arrays, conic_columns, grasp_problem,
                             grasp_system, ray_block_arrays)
-from ..quality.bounds import planar_epsilons
+from ..quality.bounds import planar_epsilon_rows
 from ..solvers import BARRIER_NEAR_ZERO, FastSolver, make_solver
 from ..solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
 from ..solvers.enumeration import FEAS, bases
@@ -427,21 +429,21 @@ def _solve_generators(solver, W):
 
 
 def _planar_quality(cols, rows, closure, P, N, mu, width, c, L, models, variants, options):
-    """Epsilon columns of a planar group: :func:`qualgrasp.certify.quality.bounds.planar_epsilons`
-    (the per-grasp path's function, on the same generator floats) for every closure row; 0 and
-    no evidence elsewhere. Returns ``(l1_lo, l1_hi, linf_lo, linf_hi, limited, evidence)``."""
+    """Epsilon columns of a planar group: :func:`qualgrasp.certify.quality.bounds.planar_epsilon_rows`
+    (row for row what the per-grasp path's :func:`~qualgrasp.certify.quality.bounds.planar_epsilons`
+    gives, on the same generator floats) for every closure row; 0 and no evidence elsewhere.
+    Returns ``(l1_lo, l1_hi, linf_lo, linf_hi, limited, evidence)``."""
     B, m = mu.shape
     owner, offset, friction = generator_layout(models, variants, 2)
-    W = np.empty((3, len(owner)))
-    E = np.empty((3, len(owner)))
     vals = np.zeros((B, 4))
     limited = np.zeros(B, dtype=bool)
     evidence = np.full(B, None, dtype=object)
-    for i in np.flatnonzero(closure):
-        planar_generators(P[i], N[i], mu[i], width[i], c[i], L[i], owner, offset, friction, W, E)
-        deadline = None if options.eps_time is None else time.perf_counter() + options.eps_time
-        exact = lambda i=i: grasp_system(cols.grasps([rows[i]])[0], exact=True).columns  # noqa: E731
-        eps = planar_epsilons(W, E, owner, m, deadline=deadline, exact=exact)
+    at = np.flatnonzero(closure)
+    if not len(at):
+        return vals[:, 0], vals[:, 1], vals[:, 2], vals[:, 3], limited, evidence
+    W, E = generator_rows(*(np.ascontiguousarray(a[at]) for a in (P, N, mu, width, c, L)), owner, offset, friction)
+    exact = lambda q: grasp_system(cols.grasps([rows[at[q]]])[0], exact=True).columns  # noqa: E731
+    for i, eps in zip(at, planar_epsilon_rows(W, E, owner, m, time_limit=options.eps_time, exact=exact)):
         (a, b, _, ev1, lim1), (p, q, _, ev2, lim2) = eps["L1"], eps["Linf"]
         vals[i] = a, b, p, q
         limited[i] = lim1 or lim2

@@ -62,6 +62,13 @@ result.
 
 Epsilon is 0 for grasps not in closure (and for degenerate ones): the closure verdict is decided
 first, so flat hulls and rank-deficient sets never reach qhull.
+
+Many planar grasps sharing one generator layout (the columnar batch path):
+:func:`planar_epsilon_rows` gives, row for row, what :func:`planar_epsilons` gives, with the
+epsilons, the sums and the rigorous float checks of every surface compiled for the whole batch
+(:mod:`qualgrasp.certify._kernels.evidence`); qhull (whose faces the evidence states) and the
+``support`` refinement run per row, and a row whose surfaces need exact arithmetic takes
+:func:`planar_epsilons` itself.
 """
 
 from __future__ import annotations
@@ -77,21 +84,24 @@ import scipy.sparse as sp
 from scipy.spatial import ConvexHull, QhullError
 
 from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
-from .._kernels.jit import BOOL, F1, F2, FLOAT, I1, I2, INT, precompile
+from .._kernels.epsilon import planar_epsilon as epsilon_kernel
+from .._kernels.evidence import minkowski_sums, support_choices, surface_rows, vertex_sums
+from .._kernels.jit import BOOL, F1, F2, F3, FLOAT, I1, I2, INT, precompile
 from .._kernels.planar import planar_generators
-from .._kernels.surface import cycle_code, face_bounds
+from .._kernels.surface import cycle_code, face_bounds, leibniz_tables
 from ..core.arguments import count_in, number_in, require
 from ..errors import ArgumentError
 from ..core.closure import Verdict, force_closure
 from .evidence import EPS_TOL, Evidence, stated_lo, surface_minimum
-from .gws import ConicSupport, planar_generator_arrays, planar_support_vertices, sum_errors, surface_faces
+from .gws import (ConicSupport, planar_generator_arrays, planar_support_choices,
+                  sum_rows, surface_faces, surfaces_faces)
 from ..core.grasp import Grasp
 from ..core.problem import System, grasp_system
 from ..solvers.clarabel_direct import settings
 
 __all__ = ["Norm", "NORMS", "Epsilon", "epsilon", "epsilons", "planar_epsilon", "planar_epsilons",
-           "epsilon_of_points", "check_norm", "L1_ENUMERATION_MAX", "LINF_ENUMERATION_MAX",
-           "SUMS_MAX", "MAX_VERTICES", "SOCP_COST"]
+           "planar_epsilon_rows", "epsilon_of_points", "check_norm", "L1_ENUMERATION_MAX",
+           "LINF_ENUMERATION_MAX", "SUMS_MAX", "MAX_VERTICES", "SOCP_COST"]
 
 #: A norm of the grasp wrench space.
 Norm = Literal["L1", "Linf"]
@@ -125,6 +135,9 @@ _PLANAR_KERNELS = _SURFACE_KERNELS + (
     (support_rows, (F2, I1, INT, F2, BOOL)),
     (planar_edges, (F2, I1)),
     (linf_sweep, (F2, I1, INT, F2, INT, INT, F1, F2)),
+    (minkowski_sums, (F3, F3, I1, INT)),  # the vertices of sums and support evidence
+    (support_choices, (F2, I1, INT, F2)),
+    (vertex_sums, (F2, F2, I2)),
 )
 
 
@@ -263,27 +276,20 @@ def _hull_minimum(W, owner, m, faces):
     return float(h[j]), U[j]
 
 
+def _sum_count(owner, m: int) -> int:
+    """Number of sums of one point per contact polytope (the origin or a generator)."""
+    return math.prod(int(s) + 1 for s in np.bincount(owner, minlength=m))
+
+
 def _sums(W, E, owner, m):
     """Every sum of one point per contact polytope (the origin or a generator): the points
     (n, 3), their error bounds and the generator chosen per contact (n, m; -1 for the origin);
-    None when there are more than :data:`SUMS_MAX`."""
-    groups = [np.flatnonzero(owner == i) for i in range(m)]
-    if math.prod(len(g) + 1 for g in groups) > SUMS_MAX:
+    None when there are more than :data:`SUMS_MAX`
+    (:func:`~qualgrasp.certify._kernels.evidence.minkowski_sums`)."""
+    if _sum_count(owner, m) > SUMS_MAX:
         return None
-    pts = np.zeros((1, 3))
-    err = np.zeros((1, 3))
-    mag = np.zeros((1, 3))
-    choice = np.zeros((1, 0), dtype=np.int64)
-    for g in groups:
-        opt = np.vstack([np.zeros(3), W.T[g]])
-        oerr = np.vstack([np.zeros(3), E.T[g]])
-        ids = np.r_[-1, g]
-        n = len(opt)
-        pts = (pts[:, None, :] + opt[None]).reshape(-1, 3)
-        err = (err[:, None, :] + oerr[None]).reshape(-1, 3)
-        mag = (mag[:, None, :] + np.abs(opt)[None]).reshape(-1, 3)
-        choice = np.hstack([np.repeat(choice, n, axis=0), np.tile(ids, len(choice))[:, None]])
-    return pts, sum_errors(err, mag, m), choice
+    pts, err, choice = minkowski_sums(W[None], E[None], owner, m)
+    return pts[0], err[0], choice
 
 
 def planar_epsilons(W, E, owner, m: int, *, deadline: float | None = None, exact=None) -> dict:
@@ -325,15 +331,7 @@ def planar_epsilons(W, E, owner, m: int, *, deadline: float | None = None, exact
         eps = float(eps)
     else:
         eps, u = _hull_minimum(W, owner, m, faces)
-    cache = []
-
-    def gens():
-        if exact is None:
-            raise _NoExact
-        if not cache:
-            cache.append(exact())
-        return cache[0]
-
+    gens = _exact_once(exact)
     lo = _lower(eps, _prove(W.T, E.T, faces, lambda i: list(gens()[:, i])))
     direction = tuple(float(v) for v in u)
     if lo is None:
@@ -371,10 +369,8 @@ def planar_epsilons(W, E, owner, m: int, *, deadline: float | None = None, exact
                     ev = Evidence("sums", direction, ref=tuple(int(i) for i in choice[used].ravel()),
                                   faces=tuple(int(i) for i in faces.ravel()))
         else:
-            found, limited = _planar_support(W, E, owner, m, eps, np.asarray(u, dtype=float), deadline, gens)
-            if found is not None and found[0] >= l1_lo:
-                lo, dirs = found
-                ev = Evidence("support", direction, points=tuple(float(x) for x in dirs.ravel()))
+            out["Linf"] = _support_row(W, E, owner, m, eps, u, l1_lo, deadline, gens)
+            return out
     if ev is None:
         lo = min(l1_lo, eps)
         ev = Evidence("l1", direction)
@@ -382,33 +378,279 @@ def planar_epsilons(W, E, owner, m: int, *, deadline: float | None = None, exact
     return out
 
 
+def planar_epsilon_rows(W, E, owner, m: int, *, time_limit: float | None = None, exact=None) -> list[dict]:
+    """:func:`planar_epsilons` of ``B`` grasps in closure sharing one generator layout, the
+    same results row for row, with the per-row work compiled for the whole batch.
+
+    The epsilons (:func:`~qualgrasp.certify._kernels.epsilon.planar_epsilon`), the sums of
+    ``sums`` evidence (:func:`~qualgrasp.certify._kernels.evidence.minkowski_sums`) and the
+    rigorous float checks of every surface
+    (:func:`~qualgrasp.certify._kernels.evidence.surface_rows`) run on the whole batch; only the
+    hulls (qhull, whose faces the evidence states) and the ``support`` refinement (more than
+    :data:`SUMS_MAX` sums) are computed row by row. A row whose surfaces the float checks cannot
+    settle, whose hull qhull refuses, or with more than :data:`LINF_ENUMERATION_MAX` generators
+    takes :func:`planar_epsilons` itself, so that every row is what the per-grasp route gives.
+
+    Parameters
+    ----------
+    W, E : ndarray, shape (B, 3, k)
+        Generator wrenches of each grasp and bounds on their distance to the exact ones
+        (:func:`~qualgrasp.certify._kernels.evidence.generator_rows`).
+    owner : ndarray of int, shape (k,)
+        Contact of each generator (sorted), shared by the rows.
+    m : int
+        Number of contacts.
+    time_limit : float, optional
+        Seconds of the ``support`` refinement per row (the ``deadline`` of
+        :func:`planar_epsilons`, started when that row's refinement starts: the batch's
+        compiled work is not counted) and of the rows taking :func:`planar_epsilons`.
+    exact : callable, optional
+        ``exact(b)`` returns the exact generators (3, k) of row ``b`` (Fractions), asked for only
+        on the per-grasp route.
+
+    Returns
+    -------
+    list of dict
+        Per row, what :func:`planar_epsilons` returns.
+
+    Examples
+    --------
+    Two antipodal point contacts on the unit circle with ``mu = 0.5``, as for :func:`epsilon`:
+
+    >>> from qualgrasp.certify import Contact, Grasp
+    >>> g = Grasp((Contact((1, 0), (-1, 0), "point", 0.5), Contact((-1, 0), (1, 0), "point", 0.5)))
+    >>> W, E, owner = planar_generator_arrays(g)
+    >>> row = planar_epsilon_rows(W[None], E[None], owner, 2)[0]
+    >>> row == planar_epsilons(W, E, owner, 2)
+    True
+    >>> round(row["L1"][0], 6), row["Linf"][3].kind
+    (0.333333, 'sums')
+    """
+    _after_compiling(None, _PLANAR_KERNELS)
+    W = np.ascontiguousarray(W, dtype=float)
+    E = np.ascontiguousarray(E, dtype=float)
+    owner = np.ascontiguousarray(owner, dtype=np.int64)
+    B, _, k = W.shape
+    slow = np.zeros(B, dtype=bool)
+    slow[:] = k > LINF_ENUMERATION_MAX
+    rows = np.flatnonzero(~slow)
+    out: list = [None] * B
+    l1 = _l1_rows(W, E, owner, m, rows, slow)
+    linf = _linf_rows(W, E, owner, m, rows, slow, l1, time_limit, exact)
+    for b in rows:
+        if not slow[b]:
+            out[b] = {"L1": l1[b], "Linf": linf[b]}
+    for b in np.flatnonzero(slow):
+        deadline = None if time_limit is None else time.perf_counter() + time_limit
+        out[b] = planar_epsilons(W[b], E[b], owner, m, deadline=deadline,
+                                 exact=None if exact is None else (lambda b=b: exact(b)))
+    return out
+
+
+def _checked(V, EV, faces):
+    """:func:`~qualgrasp.certify._kernels.evidence.surface_rows` of the surfaces ``faces`` (a list
+    of (F, 3) arrays, None for none) on the vertices ``V``, ``EV`` (lists of (n, 3) arrays): per
+    surface the proved bounds ``(d2_lo, d2_hi)`` of its squared distance, or None where the
+    float checks cannot settle it. The bounds are floats, which :func:`_lower` compares as
+    exactly as the Fractions :func:`_prove` gives."""
+    vstart = np.r_[0, np.cumsum([len(v) for v in V])].astype(np.int64)
+    fs = [np.zeros((0, 3), dtype=np.int64) if f is None else f for f in faces]
+    fstart = np.r_[0, np.cumsum([len(f) for f in fs])].astype(np.int64)
+    perms, signs = leibniz_tables(2)
+    cat = lambda a: np.ascontiguousarray(np.concatenate(a) if a else np.zeros((0, 3)))  # noqa: E731
+    decided, lo, hi = surface_rows(cat(V), cat(EV), vstart, cat(fs).astype(np.int64), fstart, perms,
+                                   signs, EPS_TOL / 8)
+    return [(float(a), float(b)) if ok else None for ok, a, b in zip(decided, lo, hi)]
+
+
+def _l1_rows(W, E, owner, m, rows, slow):
+    """L1 part of :func:`planar_epsilon_rows`: ``(lo, hi, direction, evidence, False)`` by row;
+    rows whose hull qhull refuses or whose surface the float checks cannot settle are marked
+    ``slow``."""
+    k = W.shape[2]
+    faces = dict(zip(rows, surfaces_faces([W[b].T for b in rows])))
+    todo = [b for b in rows if faces[b] is not None]
+    slow[[b for b in rows if faces[b] is None]] = True
+    if k <= L1_ENUMERATION_MAX:
+        eps, arg = epsilon_kernel(W[todo], owner, m, False)
+        value = {b: (float(e), a) for b, e, a in zip(todo, eps, arg)}
+    else:
+        value = {b: _hull_minimum(W[b], owner, m, faces[b]) for b in todo}
+    proved = _checked([W[b].T for b in todo], [E[b].T for b in todo], [faces[b] for b in todo])
+    out = {}
+    for b, bounds in zip(todo, proved):
+        eps, u = value[b]
+        lo = None if bounds is None else _lower(eps, bounds)
+        if lo is None:
+            slow[b] = True
+            continue
+        direction = tuple(float(v) for v in u)
+        out[b] = (lo, eps, direction, Evidence("generators", direction, faces=tuple(faces[b].ravel().tolist())),
+                  False)
+    return out
+
+
+def _linf_rows(W, E, owner, m, rows, slow, l1, time_limit, exact):
+    """L-infinity part of :func:`planar_epsilon_rows` (``(lo, hi, direction, evidence,
+    limited)`` by row); rows not settled in floats are marked ``slow``."""
+    todo = np.array([b for b in rows if not slow[b]], dtype=np.int64)
+    out = {}
+    if not len(todo):
+        return out
+    eps, arg = epsilon_kernel(W[todo], owner, m, True)
+    n = _sum_count(owner, m)
+    if n > SUMS_MAX:
+        return _support_rows(W, E, owner, m, todo, eps, arg, l1, time_limit, exact)
+    step = max(1, (1 << 20) // n)  # rows of sums held at once
+    for a in range(0, len(todo), step):
+        part = todo[a:a + step]
+        pts, err, choice = minkowski_sums(W[part], E[part], owner, m)
+        faces = surfaces_faces(list(pts))
+        used = [None if f is None else np.unique(f) for f in faces]
+        local = []
+        for f, u in zip(faces, used):
+            if f is None:
+                local.append(None)
+                continue
+            remap = np.full(n, -1, dtype=np.int64)
+            remap[u] = np.arange(len(u))
+            local.append(remap[f])
+        have = [q for q in range(len(part)) if faces[q] is not None]
+        proved = dict(zip(have, _checked([pts[q][used[q]] for q in have], [err[q][used[q]] for q in have],
+                                         [local[q] for q in have])))
+        for q, b in enumerate(part):
+            e, direction = float(eps[a + q]), tuple(float(v) for v in arg[a + q])
+            l1_lo, ev = l1[b][0], None
+            if faces[q] is not None:
+                if proved[q] is None:
+                    slow[b] = True
+                    continue
+                lo = _lower(e, proved[q])
+                if lo >= l1_lo:
+                    ev = Evidence("sums", direction, ref=tuple(choice[used[q]].ravel().tolist()),
+                                  faces=tuple(local[q].ravel().tolist()))
+            if ev is None:
+                lo, ev = min(l1_lo, e), Evidence("l1", direction)
+            out[b] = (lo, e, direction, ev, False)
+    return out
+
+
+def _support_rows(W, E, owner, m, todo, eps, arg, l1, time_limit, exact):
+    """The L-infinity part of :func:`planar_epsilon_rows` beyond :data:`SUMS_MAX` sums: each
+    row's ``support`` surface refined on its own (:func:`_support_surface`), then the hulls'
+    faces oriented and their float checks run for all rows at once; a surface those cannot
+    settle is proved as :func:`_planar_support` proves it."""
+    refined = []
+    for b, e, u in zip(todo, eps, arg):
+        deadline = None if time_limit is None else time.perf_counter() + time_limit
+        refined.append(_support_surface(W[b], E[b], owner, m, float(e), np.asarray(u, dtype=float), deadline))
+    have = [q for q, (surface, _) in enumerate(refined) if surface is not None]
+    faces = dict(zip(have, surfaces_faces([refined[q][0][1] for q in have])))
+    done = [q for q in have if faces[q] is not None]
+    proved = dict(zip(done, _checked([refined[q][0][1] for q in done], [refined[q][0][2] for q in done],
+                                     [faces[q] for q in done])))
+    out = {}
+    for q, (b, e, u) in enumerate(zip(todo, eps, arg)):
+        surface, limited = refined[q]
+        found = None
+        if surface is not None:
+            dirs, V, EV, R = surface
+            bounds = proved.get(q)
+            if bounds is None:  # exact arithmetic needed, or no hull: as the per-grasp route
+                gens = _exact_once(None if exact is None else (lambda b=b: exact(b)))
+                bounds = _prove(V, EV, faces[q], _support_vertex(R, gens))
+            lo = _lower(float(e), bounds)
+            found = None if lo is None else (lo, dirs)
+        out[b] = _support_result(float(e), u, l1[b][0], found, limited)
+    return out
+
+
+def _exact_once(exact):
+    """``exact()`` called once and kept (the exact generators), or :class:`_NoExact` raised when
+    there is no ``exact``."""
+    cache = []
+
+    def gens():
+        if exact is None:
+            raise _NoExact
+        if not cache:
+            cache.append(exact())
+        return cache[0]
+
+    return gens
+
+
+def _support_row(W, E, owner, m, eps, u, l1_lo, deadline, gens):
+    """Planar L-infinity bounds ``(lo, hi, direction, evidence, limited)`` by ``support``
+    evidence (:func:`_planar_support`), or by the L1 evidence when that proves more."""
+    found, limited = _planar_support(W, E, owner, m, eps, np.asarray(u, dtype=float), deadline, gens)
+    return _support_result(eps, u, l1_lo, found, limited)
+
+
+def _support_result(eps, u, l1_lo, found, limited):
+    """The L-infinity bounds of :func:`_support_row` from what the ``support`` surface proved
+    (``found``: ``(lo, directions)`` or None)."""
+    direction = tuple(float(v) for v in u)
+    if found is not None and found[0] >= l1_lo:
+        lo, dirs = found
+        points = tuple(float(x) for x in dirs.ravel())
+        return lo, eps, direction, Evidence("support", direction, points=points), limited
+    return min(l1_lo, eps), eps, direction, Evidence("l1", direction), limited
+
+
 def _planar_support(W, E, owner, m, eps, u, deadline, gens):
-    """Planar L-infinity lower bound by ``support`` evidence: the hull of support points along
-    the coordinate directions and ``u``, refined along the normals of its faces nearest the
-    origin (each cut adds a vertex of the GWS beyond the face) until the surface proves ``eps``
-    or ``4 MAX_VERTICES`` directions are used, or the ``deadline`` passes. Returns ``((lo,
-    directions) or None, limited)``, ``limited`` when the deadline stopped the refinement."""
+    """Planar L-infinity lower bound by ``support`` evidence (:func:`_support_surface`, proved
+    by :func:`_prove`). Returns ``((lo, directions) or None, limited)``, ``limited`` when the
+    deadline stopped the refinement."""
+    surface, limited = _support_surface(W, E, owner, m, eps, u, deadline)
+    if surface is None:
+        return None, limited
+    dirs, V, EV, R = surface
+    lo = _lower(eps, _prove(V, EV, surface_faces(V), _support_vertex(R, gens)))
+    return (None if lo is None else (lo, dirs)), limited
+
+
+def _support_vertex(R, gens):
+    """Exact coordinates of the vertex ``i`` of ``support`` evidence with the generator choices
+    ``R``, for :func:`_prove`."""
+
+    def vertex(i):
+        C = gens()
+        return [sum((C[r, j] for j in R[i] if j >= 0), 0) for r in range(3)]
+
+    return vertex
+
+
+def _support_surface(W, E, owner, m, eps, u, deadline):
+    """The vertices of ``support`` evidence: the hull of support points along the coordinate
+    directions and ``u``, refined along the normals of its faces nearest the origin (each cut
+    adds a vertex of the GWS beyond the face) until qhull's hull reaches ``eps`` or ``4
+    MAX_VERTICES`` directions are used, or the ``deadline`` passes. Returns ``((directions,
+    vertices, their error bounds, generator choices) or None when qhull fails, limited)``."""
     dirs = [np.array(v, dtype=float) for v in np.vstack([np.eye(3), -np.eye(3), u[None]])]
     seen = set()
+    picks = []  # the generator choices of each direction kept
 
     def fresh(rows):
         out = []
-        for v, r in zip(rows, planar_support_vertices(W, E, owner, m, np.array(rows))[2]):
+        for v, r in zip(rows, planar_support_choices(W, owner, m, np.array(rows))):
             key = tuple(r)
             if key not in seen:
                 seen.add(key)
                 out.append(v)
+                picks.append(r)
         return out
 
     dirs = fresh(dirs)
     hull, done, limited = None, 0, False
     while True:
-        pts = planar_support_vertices(W, E, owner, m, np.array(dirs))[0]
+        # the new vertices, as planar_support_vertices gives them (each depends on its own row)
+        pts = sum_rows(W, E, np.array(picks[done:]))[0]
         try:
             if hull is None:
                 hull = ConvexHull(pts, incremental=True)
             else:
-                hull.add_points(pts[done:])
+                hull.add_points(pts)
             done = len(dirs)
         except (QhullError, ValueError):
             return None, limited
@@ -423,15 +665,8 @@ def _planar_support(W, E, owner, m, eps, u, deadline, gens):
             break
         dirs += new
     hull.close()
-    dirs = np.array(dirs)
-    V, EV, R = planar_support_vertices(W, E, owner, m, dirs)
-
-    def vertex(i):
-        C = gens()
-        return [sum((C[r, j] for j in R[i] if j >= 0), 0) for r in range(3)]
-
-    lo = _lower(eps, _prove(V, EV, surface_faces(V), vertex))
-    return (None if lo is None else (lo, dirs)), limited
+    R = np.array(picks)
+    return (np.array(dirs),) + sum_rows(W, E, R) + (R,), limited
 
 
 def _sweep(W, owner, m, deadline):

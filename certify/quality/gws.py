@@ -25,14 +25,16 @@ import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
 from .. import models as registry
+from .._kernels.evidence import support_choices, vertex_sums
 from .._kernels.planar import planar_generators
 from ..core import cones
 from ..core.grasp import Grasp
 from ..core.problem import grasp_system
 from ..core.wrench import force_column_errors, generator_layout, grasp_arrays, to_exact, variants_of
 
-__all__ = ["SHRINK", "surface_faces", "orient_faces", "generalised_cross", "face_distances",
-           "planar_generator_arrays", "sum_errors", "planar_support_choice", "planar_support_vertices",
+__all__ = ["SHRINK", "surface_faces", "surfaces_faces", "orient_faces", "generalised_cross", "face_distances",
+           "planar_generator_arrays", "sum_errors", "planar_support_choice", "planar_support_choices",
+           "planar_support_vertices",
            "sum_rows", "sqrt_bounds", "vertex_scale", "ConicSupport"]
 
 #: Support forces are pulled this far inside their cones (tangential part times ``SHRINK``).
@@ -44,11 +46,36 @@ def surface_faces(points: np.ndarray) -> np.ndarray | None:
     """Faces of the hull of ``points`` (n, d) from qhull, each ordered so that its float
     determinant ``det(v_1, ..., v_d)`` is positive (outward about an interior origin); None when
     qhull fails."""
-    try:
-        hull = ConvexHull(points)
-    except (QhullError, ValueError):
-        return None
-    return orient_faces(points, hull.simplices)
+    return surfaces_faces([points])[0]
+
+
+def surfaces_faces(point_sets) -> list[np.ndarray | None]:
+    """:func:`surface_faces` of each of ``point_sets`` (arrays (n_i, d) of one ``d``): qhull
+    runs once per set, the orientation once for all (the determinant of each face is computed
+    as for a single set, so the faces are the same)."""
+    hulls, offset, points, starts = [], 0, [], []
+    for pts in point_sets:
+        try:
+            hulls.append(np.asarray(ConvexHull(pts).simplices, dtype=np.int64) + offset)
+        except (QhullError, ValueError):
+            hulls.append(None)
+            continue
+        points.append(pts)
+        offset += len(pts)
+    if not points:
+        return hulls
+    done = [h for h in hulls if h is not None]
+    faces = orient_faces(np.concatenate(points), np.concatenate(done))
+    starts = np.cumsum([0] + [len(h) for h in done])
+    out, q, offset = [], 0, 0
+    for h, pts in zip(hulls, point_sets):
+        if h is None:
+            out.append(None)
+            continue
+        out.append(faces[starts[q]:starts[q + 1]] - offset)
+        offset += len(pts)
+        q += 1
+    return out
 
 
 def orient_faces(points: np.ndarray, simplices: np.ndarray) -> np.ndarray:
@@ -119,23 +146,35 @@ def planar_support_choice(W: np.ndarray, owner: np.ndarray, m: int, v: np.ndarra
     return np.where(best > 0, first, -1)
 
 
+def planar_support_choices(W, owner, m, dirs: np.ndarray) -> np.ndarray:
+    """The choices of :func:`planar_support_choice` along each row of ``dirs`` (n, m): compiled
+    for every direction whose choice rounding cannot change
+    (:func:`~qualgrasp.certify._kernels.evidence.support_choices`), by that function for the
+    others (ties, values at zero)."""
+    dirs = np.ascontiguousarray(dirs, dtype=float).reshape(-1, 3)
+    R, sure = support_choices(np.ascontiguousarray(W, dtype=float), np.ascontiguousarray(owner, dtype=np.int64),
+                              m, dirs)
+    for q in np.flatnonzero(~sure):
+        R[q] = planar_support_choice(W, owner, m, dirs[q])
+    return R
+
+
 def planar_support_vertices(W, E, owner, m, dirs: np.ndarray):
     """Float vertices, error bounds and generator choices (rows, -1 for the origin) of planar
-    ``support`` evidence along the rows of ``dirs``."""
-    R = np.array([planar_support_choice(W, owner, m, v) for v in dirs], dtype=np.int64).reshape(-1, m)
+    ``support`` evidence along the rows of ``dirs`` (:func:`planar_support_choices`,
+    :func:`sum_rows`); each vertex depends on its own direction only."""
+    R = planar_support_choices(W, owner, m, dirs)
     return sum_rows(W, E, R) + (R,)
 
 
 def sum_rows(W: np.ndarray, E: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Sums of generator rows: for each vertex the sum of the generators ``W`` (3, k) it picks in
-    ``R`` (vertices, contacts; -1 picks none), with the bound of :func:`sum_errors` on its error
-    from the generators' own bounds ``E``. Returns ``(V, bounds)``, both (vertices, 3)."""
-    used = R >= 0
-    idx = np.where(used, R, 0)
-    V = np.einsum("vi,vir->vr", used.astype(float), W.T[idx]) if R.size else np.zeros((len(R), 3))
-    EV = np.einsum("vi,vir->vr", used.astype(float), E.T[idx]) if R.size else np.zeros((len(R), 3))
-    mag = np.einsum("vi,vir->vr", used.astype(float), np.abs(W.T[idx])) if R.size else np.zeros((len(R), 3))
-    return V, sum_errors(EV, mag, R.shape[1])
+    ``R`` (vertices, contacts; -1 picks none), added in order from zero, with the bound of
+    :func:`sum_errors` on its error from the generators' own bounds ``E``
+    (:func:`~qualgrasp.certify._kernels.evidence.vertex_sums`). Returns ``(V, bounds)``, both
+    (vertices, 3); each row depends on its own picks only."""
+    R = np.ascontiguousarray(R, dtype=np.int64)
+    return vertex_sums(np.ascontiguousarray(W, dtype=float), np.ascontiguousarray(E, dtype=float), R)
 
 
 def sqrt_bounds(q: Fraction, bits: int = 60) -> tuple[Fraction, Fraction]:
