@@ -141,11 +141,19 @@ def certify_values(values: Sequence[Any], lines: Sequence[int], options: Options
     return certify_rows(cols, range(len(values)), lines, options, tol)
 
 
+FEW = 64
+"""Fewer parsed grasps than this are certified grasp by grasp (:func:`certify_parsed`)."""
+
+
 def certify_parsed(values: Sequence[Any], lines: Sequence[int], options: Options = Options(),
                    tol: Tolerances = Tolerances()) -> list[dict]:
     """The rows :func:`certify_values` gives, by the columnar path where its rules settle a row
     (:func:`qualgrasp.certify.batch.fastpath.certify_table`: row for row the per-grasp results)
-    and grasp by grasp for the others, fields carried from the input included."""
+    and grasp by grasp for the others, fields carried from the input included. Fewer than
+    :data:`FEW` values go grasp by grasp (the same rows): the first run after an install then
+    compiles fewer kernels for a handful of grasps."""
+    if len(values) < FEW:
+        return certify_values(values, lines, options, tol)
     cols = value_columns(values)
     carried = [_carried(cols.meta[i] if cols.meta else None) for i in range(len(values))]
     refused = np.array([message is not None for _, message in carried], dtype=bool)
