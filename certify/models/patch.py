@@ -16,20 +16,19 @@ from fractions import Fraction
 
 import numpy as np
 
-from .base import ContactModel, Param, register
+from .base import Param, register
 from .point import MU
+from .soft import Soft
 
 __all__ = ["Patch", "PATCH"]
 
 
-class Patch(ContactModel):
+class Patch(Soft):
+    """The soft finger's cone, its torsional length derived from the patch's radius."""
+
     name = "patch"
-    dims = (3,)
     params = (MU, Param("radius", "patch radius", positive=True))
-    reductions = (("mu", "frictionless"),)
-    forces = "axes"
     extra = ("radius",)
-    cone = "lorentz"
     description = "contact patch of radius `radius` under uniform pressure: a soft finger with torsion 2 radius / 3"
 
     def moment_lengths(self, values):
