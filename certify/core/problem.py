@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
+from functools import lru_cache
 from typing import Any, NamedTuple, Sequence
 
 import numpy as np
@@ -28,12 +29,13 @@ import scipy.sparse as sp
 from .grasp import Grasp
 from .. import models as registry
 from ..errors import ArgumentError, GraspError
+from .._kernels.conic import lorentz_system
 from .._kernels.linalg import world_values
 from .cones import cone_code
 from .wrench import (contact_frame, force_columns, generator_columns, grasp_arrays, tangent,
                      to_exact, variants_of, wrench)
 
-__all__ = ["Block", "block_arrays", "ray_block_arrays", "conic_block_arrays", "System", "ClosureProblem", "grasp_problem", "span_problem", "grasp_system",
+__all__ = ["Block", "block_arrays", "DENSE_CONTACTS", "LorentzLayout", "lorentz_layout", "ray_block_arrays", "conic_block_arrays", "System", "ClosureProblem", "grasp_problem", "span_problem", "grasp_system",
            "span_system", "span_vectors", "is_polyhedral"]
 
 
@@ -185,6 +187,10 @@ def grasp_problem(grasp: Grasp, *, frictionless: bool = False, socp: bool = Fals
     (the margin's scale differs), used to cross-check the LP (not for pads, which have no
     conic form).
     """
+    if not is_polyhedral(grasp, frictionless, socp) and len(grasp.contacts) <= DENSE_CONTACTS:
+        layout = lorentz_layout(tuple(contact.contact_model for contact in grasp.contacts), grasp.dim)
+        if layout is not None:
+            return _lorentz_problem(grasp, layout)
     system = grasp_system(grasp, frictionless=frictionless, socp=socp)
     if system.layout == "generators":
         k = system.columns.shape[1]
@@ -193,6 +199,68 @@ def grasp_problem(grasp: Grasp, *, frictionless: bool = False, socp: bool = Fals
     models = tuple(contact.model for contact in grasp.contacts)
     columns, rays, cones, to_values = conic_columns(P, N, params, models, c, L)
     return ClosureProblem(columns, rays, cones, to_values, system)
+
+
+#: Most contacts of a spatial grasp whose programme :func:`grasp_problem` builds by the compiled
+#: route (:func:`qualgrasp.certify._kernels.conic.lorentz_system`), with a dense value map; larger
+#: grasps keep it sparse (its size grows with the square of the contacts).
+DENSE_CONTACTS = 16
+
+
+class LorentzLayout(NamedTuple):
+    """Column layout of a spatial grasp whose contacts all have Lorentz cones over world-axis
+    forces (:func:`lorentz_layout`): per contact its ``first`` column, the number of moment
+    columns ``nextra`` and their length parameters ``extra``, and its block's columns ``cols``."""
+
+    first: np.ndarray
+    nextra: np.ndarray
+    extra: tuple[tuple[str, ...], ...]
+    cols: tuple[tuple[int, ...], ...]
+
+
+@lru_cache(maxsize=256)
+def lorentz_layout(models: tuple, dim: int) -> LorentzLayout | None:
+    """The :class:`LorentzLayout` of a contact pattern (registered model objects, in contact
+    order) in ``dim`` dimensions; None unless it is spatial and every model has a Lorentz cone
+    over the world axes (those grasps take :func:`grasp_problem`'s array route). A pure function
+    of the pattern, cached: a planning loop over one hand pays for it once.
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import models
+    >>> layout = lorentz_layout((models.get("point"), models.get("soft")), 3)
+    >>> layout.cols, layout.extra
+    (((0, 1, 2), (3, 4, 5, 6)), ((), ('torsion',)))
+    >>> lorentz_layout((models.get("frictionless"), models.get("point")), 3) is None
+    True
+    """
+    if dim != 3 or not all(m.cone == "lorentz" and m.forces == "axes" for m in models):
+        return None
+    nextra = np.array([len(m.extra) for m in models], dtype=np.int64)
+    width = 3 + nextra
+    first = np.concatenate([[0], np.cumsum(width)[:-1]]).astype(np.int64)
+    for a in (first, nextra):
+        a.setflags(write=False)  # shared by every call with this pattern
+    cols = tuple(tuple(range(int(f), int(f + w))) for f, w in zip(first, width))
+    return LorentzLayout(first, nextra, tuple(tuple(m.extra) for m in models), cols)
+
+
+def _lorentz_problem(grasp: Grasp, layout: LorentzLayout) -> ClosureProblem:
+    """:func:`grasp_problem` of a spatial grasp of pattern ``layout``, by the compiled route:
+    the same floats as the array route (:func:`conic_columns`, :func:`grasp_system`)."""
+    contacts = grasp.contacts
+    G = np.zeros((len(contacts), max(map(len, layout.extra))))
+    for i, names in enumerate(layout.extra):
+        for e, name in enumerate(names):
+            G[i, e] = contacts[i].param(name)
+    mu = [contact.mu for contact in contacts]
+    columns, to_values, C = lorentz_system(np.array([c.p for c in contacts]), np.array([c.n for c in contacts]),
+                                           np.array(grasp.center), float(grasp.length), layout.first,
+                                           layout.nextra, G)
+    blocks = tuple(Block("lorentz", cols, contact.n, mu[i], float(G[i, 0]) if names else 0, i)
+                   for i, (contact, cols, names) in enumerate(zip(contacts, layout.cols, layout.extra)))
+    cones = tuple((cols[0], len(cols), mu[i]) for i, cols in enumerate(layout.cols))
+    return ClosureProblem(columns, (), cones, to_values, System(C, blocks, "forces"))
 
 
 def conic_columns(P, N, params, models, center, length):
