@@ -53,7 +53,7 @@ from ..certify.report import certify_grasp
 from ..certify.solvers import make_solver
 from .dexnet import dexnet_inputs
 
-__all__ = ["KINDS", "DEGENERATE_KIND", "BenchRow", "run_bench", "print_bench", "SINGLE_KIND", "SingleRow",
+__all__ = ["KINDS", "DEGENERATE_KIND", "BenchRow", "run_bench", "print_bench", "SINGLE_KIND", "SINGLE_ROUND", "SingleRow",
            "run_single_bench", "print_single_bench", "CONTACTS", "ContactsRow", "epsilon_linearised",
            "run_contacts_bench", "print_contacts_bench"]
 
@@ -302,6 +302,10 @@ def print_quality_bench(rows: list[QualityRow]) -> None:
 SINGLE_KIND = dict(dim=3, n_contacts=3, model="point")
 
 
+#: Grasps per turn of each route in ``qualgrasp bench --single``.
+SINGLE_ROUND = 50
+
+
 @dataclass(frozen=True)
 class SingleRow:
     """Per-call times of one route on the grasps of ``qualgrasp bench --single``: ``median_us``
@@ -328,8 +332,9 @@ def run_single_bench(n: int = 2000, seed: int = 0, dexnet=None) -> list[SingleRo
     calls it (exact cones, with its certificate) and, with ``dexnet``
     (:func:`qualgrasp.experiments.dexnet.load_dexnet`), Dex-Net's ``force_closure_qp`` (8-edge
     cones, no certificate) on the same ``n`` grasps (:data:`SINGLE_KIND`), in the same run: the
-    two calls alternate grasp by grasp, so both see the same machine load, with the garbage
-    collector off. The kernels compile, and cvxopt warms up, on 20 grasps before the clock. Dex-Net's inputs
+    routes take turns over rounds of :data:`SINGLE_ROUND` grasps, so that both see the same
+    machine load and each runs as in a planning loop (calls in a row), with the garbage collector
+    off. The kernels compile, and cvxopt warms up, on 20 grasps before the clock. Dex-Net's inputs
     (:func:`~qualgrasp.experiments.dexnet.dexnet_inputs`) are built outside its clock."""
     grasps = random_grasps(seed, n, **SINGLE_KIND)
     inputs = [dexnet_inputs(g) for g in grasps] if dexnet is not None else None
@@ -342,10 +347,11 @@ def run_single_bench(n: int = 2000, seed: int = 0, dexnet=None) -> list[SingleRo
     gc.collect()
     gc.disable()  # as timeit does: a collection would land on whichever call happens to trigger it
     try:
-        for i, g in enumerate(grasps):
-            _per_call_us(lambda g: verdicts.append(force_closure(g).status), [g], ours)
+        for lo in range(0, n, SINGLE_ROUND):
+            _per_call_us(lambda g: verdicts.append(force_closure(g).status), grasps[lo:lo + SINGLE_ROUND], ours)
             if dexnet is not None:
-                _per_call_us(lambda args: dex.append(dexnet.force_closure_qp(*args)), [inputs[i]], theirs)
+                _per_call_us(lambda args: dex.append(dexnet.force_closure_qp(*args)),
+                             inputs[lo:lo + SINGLE_ROUND], theirs)
     finally:
         gc.enable()
     median = float(np.median(ours))
