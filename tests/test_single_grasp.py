@@ -7,12 +7,13 @@ checker accepts every certificate."""
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
-from qualgrasp.certify import Contact, Grasp, force_closure, verify
+from qualgrasp.certify import Contact, Grasp, form_closure, force_closure, positive_span, verify
 from qualgrasp.certify.batch import random_grasps
 from qualgrasp.certify.core.closure import decide
-from qualgrasp.certify.core.problem import (DENSE_CONTACTS, ClosureProblem, conic_columns, grasp_problem,
-                                            grasp_system)
+from qualgrasp.certify.core.problem import (DENSE_COLUMNS, ClosureProblem, conic_columns, grasp_problem,
+                                            grasp_system, span_problem, span_system)
 from qualgrasp.certify.core.wrench import grasp_arrays
 from qualgrasp.certify.solvers import make_solver
 
@@ -88,7 +89,7 @@ def test_verdicts_margins_and_certificates_are_the_array_routes_and_all_verify()
 
 
 def test_grasps_beyond_the_dense_bound_keep_the_array_route():
-    grasp = random_grasps(5, 1, dim=3, n_contacts=DENSE_CONTACTS + 1, model="point")[0]
+    grasp = random_grasps(5, 1, dim=3, n_contacts=DENSE_COLUMNS // 3 + 1, model="point")[0]
     problem = grasp_problem(grasp)
     assert not isinstance(problem.to_values, np.ndarray)
     v, ref = force_closure(grasp), decide(_array_route(grasp), lambda: grasp_system(grasp, exact=True).columns,
@@ -106,3 +107,33 @@ def test_patterns_with_rays_or_planar_grasps_keep_their_route(model):
     mixed = Grasp(spatial.contacts + (Contact((0, 0, 1), (0, 0, -1)),))
     problem = grasp_problem(mixed)
     assert problem.rays == (9,) and problem.system.layout == "forces"
+
+
+def _sparse_identity(problem: ClosureProblem) -> ClosureProblem:
+    return ClosureProblem(problem.columns, problem.rays, problem.cones, sp.identity(problem.nvar, format="csr"),
+                          problem.system)
+
+
+def test_generator_programmes_state_the_values_of_the_sparse_identity():
+    """Form closure and positive spanning keep a dense identity for small programmes: the same
+    verdicts and certificates as with the sparse identity they had."""
+    grasps = (random_grasps(21, 150, dim=2, n_contacts=4, model="frictionless")
+              + random_grasps(22, 150, dim=3, n_contacts=8, model="frictionless")
+              + random_grasps(23, 100, dim=3, n_contacts=9, model="point"))
+    closure = 0
+    for grasp in grasps:
+        problem = grasp_problem(grasp, frictionless=True)
+        assert isinstance(problem.to_values, np.ndarray)
+        v = form_closure(grasp)
+        ref = decide(_sparse_identity(problem), lambda g=grasp: grasp_system(g, frictionless=True, exact=True).columns,
+                     make_solver("fast"))
+        assert (v.status, v.margin, v.certificate) == (ref.status, ref.margin, ref.certificate)
+        closure += v.status == "closure"
+    vectors = np.random.default_rng(5).normal(size=(100, 5, 3))
+    for V in vectors:
+        v = positive_span(V)
+        ref = decide(_sparse_identity(span_problem(V)), lambda V=V: span_system(V, exact=True).columns,
+                     make_solver("fast"))
+        assert (v.status, v.margin, v.certificate) == (ref.status, ref.margin, ref.certificate)
+        closure += v.status == "closure"
+    assert closure >= 50

@@ -35,7 +35,7 @@ from .cones import cone_code
 from .wrench import (contact_frame, force_columns, generator_columns, grasp_arrays, tangent,
                      to_exact, variants_of, wrench)
 
-__all__ = ["Block", "block_arrays", "DENSE_CONTACTS", "LorentzLayout", "lorentz_layout", "ray_block_arrays", "conic_block_arrays", "System", "ClosureProblem", "grasp_problem", "span_problem", "grasp_system",
+__all__ = ["Block", "block_arrays", "DENSE_COLUMNS", "LorentzLayout", "lorentz_layout", "ray_block_arrays", "conic_block_arrays", "System", "ClosureProblem", "grasp_problem", "span_problem", "grasp_system",
            "span_system", "span_vectors", "is_polyhedral"]
 
 
@@ -110,8 +110,8 @@ class ClosureProblem:
         the tangential forces (and the scaled torsional moment).
     to_values : ndarray or scipy.sparse.csr_array, shape (ncert, nvar)
         Linear map from ``x`` to the certificate's values (world-frame forces): block diagonal,
-        stored sparse for one grasp (its size grows with the square of the contacts); see
-        :meth:`values`.
+        dense up to :data:`DENSE_COLUMNS` variables, else stored sparse (its size grows with the
+        square of the contacts); see :meth:`values`.
     system : System
         The float certificate system (for polyhedral problems its columns are ``columns``).
     """
@@ -125,7 +125,8 @@ class ClosureProblem:
     def values(self, x: np.ndarray) -> np.ndarray:
         """The certificate's values ``to_values @ x``, each summed in variable order as
         :func:`qualgrasp.certify._kernels.linalg.world_values` sums the columnar batch (the
-        zeros a sparse map skips add nothing), so both routes state the same values."""
+        zeros a sparse map skips add nothing: both sums start at +0, so a signed zero cannot
+        survive either), so dense and sparse maps, and both routes, state the same values."""
         x = np.asarray(x, dtype=float)
         if sp.issparse(self.to_values):
             return np.asarray(self.to_values @ x, dtype=float)
@@ -157,7 +158,13 @@ def span_problem(vectors) -> ClosureProblem:
     """Positive spanning of the rows of ``vectors`` (shape ``(k, d)``): every row is a ray."""
     system = span_system(vectors)
     k = system.columns.shape[1]
-    return ClosureProblem(system.columns, tuple(range(k)), (), sp.identity(k, format="csr"), system)
+    return ClosureProblem(system.columns, tuple(range(k)), (), _identity(k), system)
+
+
+def _identity(k: int):
+    """The value map of a programme over generator rays: the identity, dense up to
+    :data:`DENSE_COLUMNS` columns (its values are the same, :meth:`ClosureProblem.values`)."""
+    return np.eye(k) if k <= DENSE_COLUMNS else sp.identity(k, format="csr")
 
 
 def is_polyhedral(grasp: Grasp, frictionless: bool = False, socp: bool = False) -> bool:
@@ -186,36 +193,43 @@ def grasp_problem(grasp: Grasp, *, frictionless: bool = False, socp: bool = Fals
     second-order cones ``abs(f_t) <= mu f_n`` instead of edges: the same verdict by another route
     (the margin's scale differs), used to cross-check the LP (not for pads, which have no
     conic form).
+
+    A spatial grasp of point and soft contacts with at most :data:`DENSE_COLUMNS` columns, the
+    call a planning loop makes per grasp, takes a compiled route (its layout cached per contact
+    pattern, :func:`lorentz_layout`) that states the same floats as the array route of
+    :func:`conic_columns` and :func:`grasp_system`, which batches and the other grasps take.
     """
-    if not is_polyhedral(grasp, frictionless, socp) and len(grasp.contacts) <= DENSE_CONTACTS:
+    if not is_polyhedral(grasp, frictionless, socp):
         layout = lorentz_layout(tuple(contact.contact_model for contact in grasp.contacts), grasp.dim)
-        if layout is not None:
+        if layout is not None and layout.ncols <= DENSE_COLUMNS:
             return _lorentz_problem(grasp, layout)
     system = grasp_system(grasp, frictionless=frictionless, socp=socp)
     if system.layout == "generators":
         k = system.columns.shape[1]
-        return ClosureProblem(system.columns, tuple(range(k)), (), sp.identity(k, format="csr"), system)
+        return ClosureProblem(system.columns, tuple(range(k)), (), _identity(k), system)
     P, N, mu, params, c, L = grasp_arrays(grasp)
     models = tuple(contact.model for contact in grasp.contacts)
     columns, rays, cones, to_values = conic_columns(P, N, params, models, c, L)
     return ClosureProblem(columns, rays, cones, to_values, system)
 
 
-#: Most contacts of a spatial grasp whose programme :func:`grasp_problem` builds by the compiled
-#: route (:func:`qualgrasp.certify._kernels.conic.lorentz_system`), with a dense value map; larger
-#: grasps keep it sparse (its size grows with the square of the contacts).
-DENSE_CONTACTS = 16
+#: Most columns of a programme whose value map :func:`grasp_problem` stores dense (32 KB); larger
+#: ones keep it sparse (its size grows with the square of the contacts). Spatial grasps within
+#: the bound take the compiled route (:func:`qualgrasp.certify._kernels.conic.lorentz_system`).
+DENSE_COLUMNS = 64
 
 
 class LorentzLayout(NamedTuple):
     """Column layout of a spatial grasp whose contacts all have Lorentz cones over world-axis
     forces (:func:`lorentz_layout`): per contact its ``first`` column, the number of moment
-    columns ``nextra`` and their length parameters ``extra``, and its block's columns ``cols``."""
+    columns ``nextra`` and their length parameters ``extra``, and its block's columns ``cols``;
+    ``ncols`` columns in all."""
 
     first: np.ndarray
     nextra: np.ndarray
     extra: tuple[tuple[str, ...], ...]
     cols: tuple[tuple[int, ...], ...]
+    ncols: int
 
 
 @lru_cache(maxsize=256)
@@ -242,7 +256,7 @@ def lorentz_layout(models: tuple, dim: int) -> LorentzLayout | None:
     for a in (first, nextra):
         a.setflags(write=False)  # shared by every call with this pattern
     cols = tuple(tuple(range(int(f), int(f + w))) for f, w in zip(first, width))
-    return LorentzLayout(first, nextra, tuple(tuple(m.extra) for m in models), cols)
+    return LorentzLayout(first, nextra, tuple(tuple(m.extra) for m in models), cols, int(width.sum()))
 
 
 def _lorentz_problem(grasp: Grasp, layout: LorentzLayout) -> ClosureProblem:
