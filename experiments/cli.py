@@ -19,7 +19,7 @@ from . import figures
 from .bench import (print_bench, print_contacts_bench, print_quality_bench, print_single_bench, run_bench,
                     run_contacts_bench, run_quality_bench, run_single_bench)
 from .demo import demo_steps, run_demo
-from .dexnet import DexNetError, load_dexnet
+from .dexnet import load_dexnet
 from .silhouettes import available_silhouettes, available_wings, write_silhouettes
 from .silhouettes import silhouettes as bundled
 from .study import BUILTINS, SETTINGS, compare, workload
@@ -256,7 +256,7 @@ def bench_command(
     if single:
         try:
             loaded = None if dexnet is None else load_dexnet(dexnet)
-        except DexNetError as err:
+        except OptionError as err:
             fail(str(err))
         print_single_bench(run_single_bench(n=n, seed=seed, dexnet=loaded))
     elif contacts:

@@ -32,16 +32,13 @@ from typing import Any
 import numpy as np
 
 from ..certify.core import Grasp
+from ..certify.errors import ArgumentError, OptionError
 from ..certify.core.wrench import contact_frame, torque
 
-__all__ = ["QUALITY_FILE", "DexNetError", "DexNet", "load_dexnet", "dexnet_inputs"]
+__all__ = ["QUALITY_FILE", "DexNet", "load_dexnet", "dexnet_inputs"]
 
 #: Where Dex-Net's quality module sits in the graspnetAPI sdist.
 QUALITY_FILE = "graspnetAPI/utils/dexnet/grasping/quality.py"
-
-
-class DexNetError(Exception):
-    """Dex-Net's quality code cannot be loaded (the message says why)."""
 
 
 class _Config(dict):
@@ -70,22 +67,22 @@ class DexNet:
 def _quality_source(path: Path) -> tuple[str, str]:
     """The text of Dex-Net's quality module in ``path`` and where it was read."""
     if not path.exists():
-        raise DexNetError(f"--dexnet: {path} does not exist")
+        raise OptionError(f"--dexnet: {path} does not exist")
     if path.is_file() and path.suffix == ".py":
         return path.read_text(), str(path)
     if path.is_dir():
         found = sorted(p for p in path.rglob("quality.py") if p.as_posix().endswith(QUALITY_FILE))
         if not found:
-            raise DexNetError(f"--dexnet: no {QUALITY_FILE} under {path}")
+            raise OptionError(f"--dexnet: no {QUALITY_FILE} under {path}")
         return found[0].read_text(), str(found[0])
     try:
         with tarfile.open(path) as tar:
             member = next((m for m in tar.getmembers() if m.name.endswith(QUALITY_FILE)), None)
             if member is None:
-                raise DexNetError(f"--dexnet: {path} holds no {QUALITY_FILE}")
+                raise OptionError(f"--dexnet: {path} holds no {QUALITY_FILE}")
             return tar.extractfile(member).read().decode(), f"{path}:{member.name}"
     except tarfile.TarError as err:
-        raise DexNetError(f"--dexnet: {path} is not a graspnetAPI sdist ({err})") from None
+        raise OptionError(f"--dexnet: {path} is not a graspnetAPI sdist ({err})") from None
 
 
 def load_dexnet(path) -> DexNet:
@@ -98,7 +95,7 @@ def load_dexnet(path) -> DexNet:
 
     Raises
     ------
-    DexNetError
+    OptionError
         No such file, no quality module in it, no ``PointGraspMetrics3D`` in that, or cvxopt is
         not installed.
 
@@ -107,20 +104,23 @@ def load_dexnet(path) -> DexNet:
     >>> load_dexnet("/nonexistent/graspnetAPI-1.2.11.tar.gz")
     Traceback (most recent call last):
     ...
-    qualgrasp.experiments.dexnet.DexNetError: --dexnet: /nonexistent/graspnetAPI-1.2.11.tar.gz does not exist
+    qualgrasp.certify.errors.OptionError: --dexnet: /nonexistent/graspnetAPI-1.2.11.tar.gz does not exist
     """
-    text, source = _quality_source(Path(path))
+    try:
+        text, source = _quality_source(Path(path))
+    except (OSError, UnicodeDecodeError) as err:
+        raise OptionError(f"--dexnet: cannot read {path} ({err})") from None
     try:
         import cvxopt
     except ImportError:
-        raise DexNetError("--dexnet: Dex-Net's force_closure_qp needs cvxopt (pip install cvxopt)") from None
+        raise OptionError("--dexnet: Dex-Net's force_closure_qp needs cvxopt (pip install cvxopt)") from None
     try:
         tree = ast.parse(text)
     except SyntaxError as err:
-        raise DexNetError(f"--dexnet: {source} is not Python ({err.msg})") from None
+        raise OptionError(f"--dexnet: {source} is not Python ({err.msg})") from None
     found = [node for node in tree.body if isinstance(node, ast.ClassDef) and node.name == "PointGraspMetrics3D"]
     if not found:
-        raise DexNetError(f"--dexnet: {source} defines no PointGraspMetrics3D")
+        raise OptionError(f"--dexnet: {source} defines no PointGraspMetrics3D")
     # the class alone: its methods use numpy, cvxopt (as cvx) and logging, nothing else on this path
     namespace = {"np": np, "cvx": cvxopt, "logging": logging}
     exec(compile(ast.Module(body=found, type_ignores=[]), source, "exec"), namespace)
@@ -144,7 +144,7 @@ def dexnet_inputs(grasp: Grasp, edges: int = 8):
     True
     """
     if grasp.dim != 3 or any(c.model != "point" for c in grasp.contacts):
-        raise ValueError("dexnet_inputs takes spatial grasps of point contacts")
+        raise ArgumentError("dexnet_inputs takes spatial grasps of point contacts")
     P, N = grasp.points, grasp.normals
     mu = np.array([c.mu for c in grasp.contacts])
     t1, t2 = contact_frame(N)

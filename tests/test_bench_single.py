@@ -13,7 +13,8 @@ from qualgrasp.certify.batch import random_grasps
 from qualgrasp.certify.core.wrench import wrench
 from qualgrasp.cli import app
 from qualgrasp.experiments.bench import run_single_bench
-from qualgrasp.experiments.dexnet import QUALITY_FILE, DexNetError, dexnet_inputs, load_dexnet
+from qualgrasp.certify.errors import OptionError
+from qualgrasp.experiments.dexnet import QUALITY_FILE, dexnet_inputs, load_dexnet
 
 runner = CliRunner()
 
@@ -71,16 +72,19 @@ def test_the_loader_compiles_the_class_alone_from_each_form_of_the_sdist(tmp_pat
 
 
 def test_the_loader_says_what_is_wrong(tmp_path):
-    with pytest.raises(DexNetError, match="does not exist"):
+    with pytest.raises(OptionError, match="does not exist"):
         load_dexnet(tmp_path / "nope.tar.gz")
     (tmp_path / "empty").mkdir()
-    with pytest.raises(DexNetError, match="no graspnetAPI/utils/dexnet/grasping/quality.py under"):
+    with pytest.raises(OptionError, match="no graspnetAPI/utils/dexnet/grasping/quality.py under"):
         load_dexnet(tmp_path / "empty")
     (tmp_path / "junk.tar.gz").write_bytes(b"not a tar file")
-    with pytest.raises(DexNetError, match="is not a graspnetAPI sdist"):
+    with pytest.raises(OptionError, match="is not a graspnetAPI sdist"):
         load_dexnet(tmp_path / "junk.tar.gz")
+    (tmp_path / "quality.py").write_bytes(b"\xff\xfe not text")
+    with pytest.raises(OptionError, match="cannot read"):
+        load_dexnet(tmp_path / "quality.py")
     pytest.importorskip("cvxopt")
-    with pytest.raises(DexNetError, match="defines no PointGraspMetrics3D"):
+    with pytest.raises(OptionError, match="defines no PointGraspMetrics3D"):
         load_dexnet(_sdist(tmp_path, "x = 1\n"))
 
 
