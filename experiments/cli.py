@@ -215,7 +215,7 @@ def silhouettes_command(out: Path = typer.Option(Path("qualgrasp-silhouettes"), 
 
 
 def bench_command(
-    n: int = typer.Option(None, "--n", help="Grasps per kind (default 20000; 2000 with --single).",
+    n: int | None = typer.Option(None, "--n", help="Grasps per kind (default 20000; 2000 with --single).",
                           show_default=False),
     seed: int = typer.Option(0, help="Random seed of the grasps."),
     reference_n: int = typer.Option(300, "--reference-n", help="Grasps per kind for slow routes."),
@@ -224,7 +224,7 @@ def bench_command(
                                                             "(3 to 1000 point contacts, planar and spatial)."),
     single: bool = typer.Option(False, "--single", help="Time one spatial grasp per call: force_closure against "
                                                         "Dex-Net's force_closure_qp on the same grasps."),
-    dexnet: Path = typer.Option(None, "--dexnet", help="With --single: the graspnetAPI 1.2.11 sdist (.tar.gz, its "
+    dexnet: Path | None = typer.Option(None, "--dexnet", help="With --single: the graspnetAPI 1.2.11 sdist (.tar.gz, its "
                                                        "folder or its quality.py) to load Dex-Net from; without it "
                                                        "Dex-Net's row is skipped.", show_default=False),
 ) -> None:
@@ -243,7 +243,7 @@ def bench_command(
     With --single: per-call median and 95th percentile of force_closure on --n random spatial
     grasps of three point contacts, as a planning loop calls it, and of Dex-Net's force_closure_qp
     (8-edge cones, no certificate; loaded from --dexnet, which needs cvxopt) on the same grasps,
-    calls alternating, with the ratio of the medians.
+    in turns of 50 grasps, with the ratio of the medians.
     """
     n = (2000 if single else 20000) if n is None else n
     if n < 1 or reference_n < 0:
