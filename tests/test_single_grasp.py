@@ -137,3 +137,52 @@ def test_generator_programmes_state_the_values_of_the_sparse_identity():
         assert (v.status, v.margin, v.certificate) == (ref.status, ref.margin, ref.certificate)
         closure += v.status == "closure"
     assert closure >= 50
+
+
+def _project_out_by_fractions(y, A):
+    """The projection's formula over Fractions: ``y - B (B'B)^{-1} B'y``, ``B`` the pivot
+    columns of a reduced row echelon form computed over Fractions (the test's oracle)."""
+    from qualgrasp.certify.core import exact as ex
+
+    cols = ex.row_echelon(A)[1]
+    if not cols:
+        return list(y)
+    B = [[row[j] for j in cols] for row in A]
+    k = len(cols)
+    BtB = [[sum(B[r][i] * B[r][j] for r in range(len(B))) for j in range(k)] for i in range(k)]
+    c = ex.solve(BtB, [sum(B[r][i] * y[r] for r in range(len(B))) for i in range(k)])
+    return [y[r] - sum(B[r][i] * c[i] for i in range(k)) for r in range(len(B))]
+
+
+def test_the_exact_projection_in_integers_is_the_fraction_formula():
+    """exact.project_out (integers, fraction-free) gives the very rationals of the formula over
+    Fractions: on the tight columns of real certificates, and on random rank-deficient matrices
+    of floats, of rationals with odd denominators, and with repeated columns."""
+    from fractions import Fraction
+
+    from qualgrasp.certify.core import exact as ex
+    from qualgrasp.certify.core.wrench import to_exact
+
+    rng = np.random.default_rng(9)
+    cases = []
+    for grasp in GRASPS[::4]:
+        v = force_closure(grasp)
+        if v.certificate.kind == "farkas" and v.certificate.tight:
+            Cx = grasp_system(grasp, exact=True)
+            cols = [j for b in v.certificate.tight for j in Cx.blocks[b].cols]
+            cases.append((list(to_exact(rng.normal(size=6))), [[Cx.columns[i, j] for j in cols] for i in range(6)]))
+    assert len(cases) >= 10
+    for _ in range(300):
+        d, k, r = 6, int(rng.integers(1, 8)), int(rng.integers(1, 7))
+        F = rng.normal(size=(d, r)) @ rng.normal(size=(r, k)) if rng.random() < 0.5 else rng.normal(size=(d, k))
+        A = [list(row) for row in to_exact(F)]
+        if rng.random() < 0.3:
+            A = [[Fraction(int(rng.integers(-9, 9)), int(rng.integers(1, 9)) * 3) for _ in range(k)] for _ in range(d)]
+        if rng.random() < 0.3:
+            A = [row + row[:1] for row in A]
+        y = [Fraction(v) for v in rng.normal(size=d)]
+        cases.append((y, A))
+    cases.append(([Fraction(1)] * 6, [[0, 0]] * 6))
+    for y, A in cases:
+        assert ex.project_out(y, A) == _project_out_by_fractions(y, A)
+        assert ex.independent_columns(A) == ex.row_echelon(A)[1]
