@@ -53,8 +53,8 @@ from ..certify.report import certify_grasp
 from ..certify.solvers import make_solver
 from .dexnet import dexnet_inputs
 
-__all__ = ["KINDS", "DEGENERATE_KIND", "BenchRow", "run_bench", "print_bench", "SINGLE_KIND", "SINGLE_ROUND", "SingleRow",
-           "run_single_bench", "print_single_bench", "CONTACTS", "ContactsRow", "epsilon_linearised",
+__all__ = ["KINDS", "DEGENERATE_KIND", "BenchRow", "run_bench", "print_bench", "SINGLE_KIND", "SINGLE_ROUND",
+           "SingleRow", "run_single_bench", "print_single_bench", "CONTACTS", "ContactsRow", "epsilon_linearised",
            "run_contacts_bench", "print_contacts_bench"]
 
 #: name -> keyword arguments of :func:`qualgrasp.certify.batch.samples.random_grasp`

@@ -224,9 +224,10 @@ def bench_command(
                                                             "(3 to 1000 point contacts, planar and spatial)."),
     single: bool = typer.Option(False, "--single", help="Time one spatial grasp per call: force_closure against "
                                                         "Dex-Net's force_closure_qp on the same grasps."),
-    dexnet: Path | None = typer.Option(None, "--dexnet", help="With --single: the graspnetAPI 1.2.11 sdist (.tar.gz, its "
-                                                       "folder or its quality.py) to load Dex-Net from; without it "
-                                                       "Dex-Net's row is skipped.", show_default=False),
+    dexnet: Path | None = typer.Option(None, "--dexnet", show_default=False,
+                                       help="With --single: the graspnetAPI 1.2.11 sdist (.tar.gz, its folder or "
+                                            "its quality.py) to load Dex-Net from; without it Dex-Net's row is "
+                                            "skipped."),
 ) -> None:
     """Time every certification route on the same random grasps, with ratios to the batch path.
 

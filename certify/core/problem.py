@@ -35,8 +35,9 @@ from .cones import cone_code
 from .wrench import (contact_frame, force_columns, generator_columns, grasp_arrays, tangent,
                      to_exact, variants_of, wrench)
 
-__all__ = ["Block", "block_arrays", "DENSE_COLUMNS", "LorentzLayout", "lorentz_layout", "ray_block_arrays", "conic_block_arrays", "System", "ClosureProblem", "grasp_problem", "span_problem", "grasp_system",
-           "span_system", "span_vectors", "is_polyhedral"]
+__all__ = ["Block", "block_arrays", "ray_block_arrays", "conic_block_arrays", "System", "ClosureProblem",
+           "grasp_problem", "span_problem", "grasp_system", "span_system", "span_vectors", "is_polyhedral",
+           "DENSE_COLUMNS", "LorentzLayout", "lorentz_layout"]
 
 
 @dataclass(frozen=True)
