@@ -20,6 +20,12 @@ count, in the same run; their ratio is the degenerate set's time per grasp as a 
 generic set's. Speeds are single-process; ``qualgrasp certify --workers N`` runs N
 such processes.
 
+``qualgrasp bench --single`` times one spatial grasp per call, as a planning loop calls the API:
+:func:`~qualgrasp.certify.core.closure.force_closure` (exact cones, with its certificate) and
+Dex-Net's ``force_closure_qp`` (8-edge cones, no certificate; loaded from a graspnetAPI sdist by
+:mod:`qualgrasp.experiments.dexnet`) on the same grasps in the same run: per-call median, 95th
+percentile and the ratio of the medians.
+
 ``qualgrasp bench --quality`` times epsilon on small grasps (bound gaps, the 8-edge linearisation
 error); ``qualgrasp bench --contacts`` times one grasp in closure per size (3 to 1000 point
 contacts, planar and spatial): closure (both certificates and their re-check) and quality (both
@@ -28,8 +34,9 @@ epsilons with their evidence), in seconds per grasp, without a time limit.
 
 from __future__ import annotations
 
+import gc
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from rich.console import Console
@@ -44,8 +51,10 @@ from ..certify.files.columns import grasp_columns
 from ..certify.quality.bounds import check_norm, epsilon, epsilon_of_points, epsilons
 from ..certify.report import certify_grasp
 from ..certify.solvers import make_solver
+from .dexnet import dexnet_inputs
 
-__all__ = ["KINDS", "DEGENERATE_KIND", "BenchRow", "run_bench", "print_bench", "CONTACTS", "ContactsRow", "epsilon_linearised",
+__all__ = ["KINDS", "DEGENERATE_KIND", "BenchRow", "run_bench", "print_bench", "SINGLE_KIND", "SINGLE_ROUND",
+           "SingleRow", "run_single_bench", "print_single_bench", "CONTACTS", "ContactsRow", "epsilon_linearised",
            "run_contacts_bench", "print_contacts_bench"]
 
 #: name -> keyword arguments of :func:`qualgrasp.certify.batch.samples.random_grasp`
@@ -286,6 +295,98 @@ def print_quality_bench(rows: list[QualityRow]) -> None:
                       f"{r.median_ms:.0f}", f"{r.worst_ms:.0f}", pct(r.lin8_median_err),
                       pct(r.lin8_worst_err))
     Console(width=max(140, Console().width)).print(table)
+
+
+#: The grasps of ``qualgrasp bench --single``: :func:`~qualgrasp.certify.batch.samples.random_grasps`'
+#: keyword arguments (spatial, three point contacts, about 9 % in closure).
+SINGLE_KIND = dict(dim=3, n_contacts=3, model="point")
+
+
+#: Grasps per turn of each route in ``qualgrasp bench --single``.
+SINGLE_ROUND = 50
+
+
+@dataclass(frozen=True)
+class SingleRow:
+    """Per-call times of one route on the grasps of ``qualgrasp bench --single``: ``median_us``
+    and ``p95_us`` (microseconds, None when the route was not run), ``speedup`` (Dex-Net's median
+    over this route's, None without Dex-Net) and a ``note``."""
+
+    route: str
+    grasps: int
+    median_us: float | None
+    p95_us: float | None
+    speedup: float | None
+    note: str = ""
+
+
+def _per_call_us(fn, items, times: list) -> None:
+    for item in items:
+        start = time.perf_counter()
+        fn(item)
+        times.append(1e6 * (time.perf_counter() - start))
+
+
+def run_single_bench(n: int = 2000, seed: int = 0, dexnet=None) -> list[SingleRow]:
+    """Time one spatial grasp through the API, call by call: :func:`force_closure` as a user
+    calls it (exact cones, with its certificate) and, with ``dexnet``
+    (:func:`qualgrasp.experiments.dexnet.load_dexnet`), Dex-Net's ``force_closure_qp`` (8-edge
+    cones, no certificate) on the same ``n`` grasps (:data:`SINGLE_KIND`), in the same run: the
+    routes take turns over rounds of :data:`SINGLE_ROUND` grasps, so that both see the same
+    machine load and each runs as in a planning loop (calls in a row), with the garbage collector
+    off. The kernels compile, and cvxopt warms up, on 20 grasps before the clock. Dex-Net's inputs
+    (:func:`~qualgrasp.experiments.dexnet.dexnet_inputs`) are built outside its clock."""
+    grasps = random_grasps(seed, n, **SINGLE_KIND)
+    inputs = [dexnet_inputs(g) for g in grasps] if dexnet is not None else None
+    warm = random_grasps(seed + 1, 20, **SINGLE_KIND)
+    for g in warm:
+        force_closure(g)
+        if dexnet is not None:
+            dexnet.force_closure_qp(*dexnet_inputs(g))
+    ours, theirs, verdicts, dex = [], [], [], []
+    gc.collect()
+    gc.disable()  # as timeit does: a collection would land on whichever call happens to trigger it
+    try:
+        for lo in range(0, n, SINGLE_ROUND):
+            _per_call_us(lambda g: verdicts.append(force_closure(g).status), grasps[lo:lo + SINGLE_ROUND], ours)
+            if dexnet is not None:
+                _per_call_us(lambda args: dex.append(dexnet.force_closure_qp(*args)),
+                             inputs[lo:lo + SINGLE_ROUND], theirs)
+    finally:
+        gc.enable()
+    median = float(np.median(ours))
+    closure = sum(v == "closure" for v in verdicts)
+    rows = [SingleRow("qualgrasp force_closure (exact cones, certificate)", n, median,
+                      float(np.percentile(ours, 95)), None,
+                      f"{closure} in closure, {n - closure - verdicts.count('degenerate')} not, "
+                      f"{verdicts.count('degenerate')} degenerate")]
+    if dexnet is None:
+        rows.append(SingleRow("Dex-Net force_closure_qp (8-edge cones, no certificate)", 0, None, None, None,
+                              "not run: pass --dexnet PATH (graspnetAPI 1.2.11 sdist) and pip install cvxopt"))
+        return rows
+    theirs_median = float(np.median(theirs))
+    rows[0] = replace(rows[0], speedup=theirs_median / median)
+    both = sum(d == 1 and v == "closure" for d, v in zip(dex, verdicts))
+    only_dex = sum(d == 1 and v != "closure" for d, v in zip(dex, verdicts))
+    only_ours = sum(d == 0 and v == "closure" for d, v in zip(dex, verdicts))
+    rows.append(SingleRow("Dex-Net force_closure_qp (8-edge cones, no certificate)", n, theirs_median,
+                          float(np.percentile(theirs, 95)), 1.0,
+                          f"closure: {both} both, {only_ours} only exact cones, {only_dex} only Dex-Net"))
+    return rows
+
+
+def print_single_bench(rows: list[SingleRow]) -> None:
+    """Print the single-grasp benchmark table with rich."""
+    first = rows[0]
+    table = Table(title=f"one spatial grasp per call ({first.grasps} random grasps, {SINGLE_KIND['n_contacts']} "
+                        f"{SINGLE_KIND['model']} contacts, same grasps, same run)")
+    for col in ("route", "grasps", "median us", "p95 us", "x faster than Dex-Net", "note"):
+        table.add_column(col, justify="left" if col in ("route", "note") else "right")
+    num = lambda v, f: "-" if v is None else format(v, f)
+    for r in rows:
+        table.add_row(r.route, str(r.grasps), num(r.median_us, ".1f"), num(r.p95_us, ".1f"),
+                      num(r.speedup, ".2f"), r.note)
+    Console(width=max(150, Console().width)).print(table)
 
 
 #: Contact counts of ``qualgrasp bench --contacts``.

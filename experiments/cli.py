@@ -16,9 +16,10 @@ from rich.table import Table
 from ..certify.cli.options import OptionError, count_in, fail, output_folder
 from ..certify.errors import CertifyError
 from . import figures
-from .bench import (print_bench, print_contacts_bench, print_quality_bench, run_bench, run_contacts_bench,
-                    run_quality_bench)
+from .bench import (print_bench, print_contacts_bench, print_quality_bench, print_single_bench, run_bench,
+                    run_contacts_bench, run_quality_bench, run_single_bench)
 from .demo import demo_steps, run_demo
+from .dexnet import load_dexnet
 from .silhouettes import available_silhouettes, available_wings, write_silhouettes
 from .silhouettes import silhouettes as bundled
 from .study import BUILTINS, SETTINGS, compare, workload
@@ -214,12 +215,19 @@ def silhouettes_command(out: Path = typer.Option(Path("qualgrasp-silhouettes"), 
 
 
 def bench_command(
-    n: int = typer.Option(20000, "--n", help="Grasps per kind."),
+    n: int | None = typer.Option(None, "--n", help="Grasps per kind (default 20000; 2000 with --single).",
+                          show_default=False),
     seed: int = typer.Option(0, help="Random seed of the grasps."),
     reference_n: int = typer.Option(300, "--reference-n", help="Grasps per kind for slow routes."),
     quality: bool = typer.Option(False, "--quality", help="Benchmark epsilon instead: gaps, times, 8-edge error."),
     contacts: bool = typer.Option(False, "--contacts", help="Time closure and quality of one grasp per contact count "
                                                             "(3 to 1000 point contacts, planar and spatial)."),
+    single: bool = typer.Option(False, "--single", help="Time one spatial grasp per call: force_closure against "
+                                                        "Dex-Net's force_closure_qp on the same grasps."),
+    dexnet: Path | None = typer.Option(None, "--dexnet", show_default=False,
+                                       help="With --single: the graspnetAPI 1.2.11 sdist (.tar.gz, its folder or "
+                                            "its quality.py) to load Dex-Net from; without it Dex-Net's row is "
+                                            "skipped."),
 ) -> None:
     """Time every certification route on the same random grasps, with ratios to the batch path.
 
@@ -232,11 +240,27 @@ def bench_command(
     With --contacts: seconds per grasp of closure and of quality (both epsilons with their
     evidence, no time limit) for one grasp in closure with 3, 10, 50, 200 and 1000 point
     contacts, planar and spatial (about a minute).
+
+    With --single: per-call median and 95th percentile of force_closure on --n random spatial
+    grasps of three point contacts, as a planning loop calls it, and of Dex-Net's force_closure_qp
+    (8-edge cones, no certificate; loaded from --dexnet, which needs cvxopt) on the same grasps,
+    in turns of 50 grasps, with the ratio of the medians.
     """
+    n = (2000 if single else 20000) if n is None else n
     if n < 1 or reference_n < 0:
         fail(f"--n must be at least 1 and --reference-n at least 0, got {n} and {reference_n}")
+    if single and (quality or contacts):
+        fail("--single times one grasp per call; it does not go with --quality or --contacts")
+    if dexnet is not None and not single:
+        fail("--dexnet goes with --single")
 
-    if contacts:
+    if single:
+        try:
+            loaded = None if dexnet is None else load_dexnet(dexnet)
+        except OptionError as err:
+            fail(str(err))
+        print_single_bench(run_single_bench(n=n, seed=seed, dexnet=loaded))
+    elif contacts:
         print_contacts_bench(run_contacts_bench(seed=seed))
     elif quality:
         print_quality_bench(run_quality_bench(n=n, seed=seed))

@@ -18,10 +18,10 @@ import qualgrasp
 ROOT = pathlib.Path(qualgrasp.__file__).parent
 #: Imports allowed inside functions: optional dependencies (dask.distributed, pymunk, h5py for ACRONYM
 #: pose files, embreex and trimesh's embree route where embreex installs), a platform module
-#: (resource), and cvxpy's reference route (1.5 s to import; only ``make_solver("reference")``
-#: needs it).
+#: (resource), cvxpy's reference route (1.5 s to import; only ``make_solver("reference")``
+#: needs it), and cvxopt, which only Dex-Net's code run by ``bench --single --dexnet`` needs.
 LAZY = {"distributed", "resource", "qualgrasp.certify.solvers.reference", "h5py", "embreex",
-        "trimesh.ray.ray_pyembree", "pymunk", "mujoco", "coacd"}
+        "trimesh.ray.ray_pyembree", "pymunk", "mujoco", "coacd", "cvxopt"}
 
 MODULES = import_graph.modules(ROOT)
 

@@ -64,12 +64,31 @@ def row_echelon(A: Matrix) -> tuple[list[list[Fraction]], list[int]]:
     return R, pivots
 
 
-def rank(A: Matrix) -> int:
-    """Exact rank of ``A`` (Fractions or integers).
+def _integers(values) -> tuple[list[int], int]:
+    """Rationals (Fractions or integers) ``values`` times the least common multiple ``den`` of
+    their denominators: ``(integers, den)``."""
+    den = math.lcm(*(v.denominator for v in values)) if len(values) else 1
+    return [v.numerator * (den // v.denominator) for v in values], den
 
-    Each row is scaled to integers (by the least common multiple of its denominators: the rank
-    is unchanged) and eliminated without fractions, which is much cheaper than elimination over
-    :class:`~fractions.Fraction`.
+
+def _pivot_columns(A: Matrix) -> list[int]:
+    """Pivot columns of ``A``'s row echelon form, by elimination without fractions: each row is
+    scaled to integers (:func:`_integers`; the column dependencies are unchanged), which is much
+    cheaper than elimination over :class:`~fractions.Fraction`."""
+    R = [_integers(row)[0] for row in A]
+    pivots = []
+    for r, c in _pivots(R):
+        g = R[r][c]
+        for i in range(r + 1, len(R)):
+            f = R[i][c]
+            if f != 0:
+                R[i] = [a * g - b * f for a, b in zip(R[i], R[r])]
+        pivots.append(c)
+    return pivots
+
+
+def rank(A: Matrix) -> int:
+    """Exact rank of ``A`` (Fractions or integers), eliminated without fractions.
 
     Examples
     --------
@@ -77,19 +96,7 @@ def rank(A: Matrix) -> int:
     >>> rank([[F(1, 3), F(2, 3)], [F(1, 2), F(1)]]), rank([[1, 2, 3], [0, 1, 0]])
     (1, 2)
     """
-    R = []
-    for row in A:
-        den = math.lcm(*(getattr(v, "denominator", 1) for v in row)) if len(row) else 1
-        R.append([int(v * den) for v in row])
-    found = 0
-    for r, c in _pivots(R):
-        g = R[r][c]
-        for i in range(r + 1, len(R)):
-            f = R[i][c]
-            if f != 0:
-                R[i] = [a * g - b * f for a, b in zip(R[i], R[r])]
-        found = r + 1
-    return found
+    return len(_pivot_columns(A))
 
 
 def solve(A: Matrix, b: Sequence[Fraction]) -> list[Fraction] | None:
@@ -103,22 +110,61 @@ def solve(A: Matrix, b: Sequence[Fraction]) -> list[Fraction] | None:
 
 
 def independent_columns(A: Matrix) -> list[int]:
-    """Indices of a maximal set of linearly independent columns of ``A`` (its pivot columns)."""
-    return row_echelon(A)[1]
+    """Indices of a maximal set of linearly independent columns of ``A`` (its pivot columns,
+    the first independent column each time, whatever the elimination).
+
+    Examples
+    --------
+    >>> independent_columns([[1, 2, 0], [2, 4, 1]])
+    [0, 2]
+    """
+    return _pivot_columns(A)
+
+
+def _gram_solve(G: list[list[int]], b: list[int]) -> tuple[int, list[int]]:
+    """``(det G, det G * G^{-1} b)`` of a positive definite integer matrix ``G``, exactly, by
+    fraction-free (Bareiss) elimination: its pivots are the leading principal minors, positive,
+    and every division is exact (the second result is integer by Cramer's rule)."""
+    k = len(G)
+    M = [list(row) + [bi] for row, bi in zip(G, b)]
+    prev = 1
+    for p in range(k):
+        for i in range(p + 1, k):
+            M[i] = [0] * (p + 1) + [(M[i][j] * M[p][p] - M[i][p] * M[p][j]) // prev for j in range(p + 1, k + 1)]
+        prev = M[p][p]
+    det = prev
+    z = [0] * k
+    for i in reversed(range(k)):
+        z[i] = (det * M[i][k] - sum(M[i][j] * z[j] for j in range(i + 1, k))) // M[i][i]
+    return det, z
 
 
 def project_out(y: Sequence[Fraction], A: Matrix) -> list[Fraction]:
-    """Component of ``y`` orthogonal to the column space of ``A``: ``y - B (B'B)^{-1} B'y``."""
+    """Component of ``y`` orthogonal to the column space of ``A``: ``y - B (B'B)^{-1} B'y``
+    with ``B`` independent columns of ``A``, exactly.
+
+    Evaluated in integers: scaling each column of ``B``, and ``y``, to integers
+    (:func:`_integers`) changes neither the column space nor the projection's direction, and
+    ``det(B'B) y - B adj(B'B) B'y`` is an integer vector (:func:`_gram_solve`); the exact rationals
+    are that over ``det(B'B)`` and ``y``'s scale.
+
+    Examples
+    --------
+    >>> from fractions import Fraction as F
+    >>> project_out([F(1), F(2), F(3)], [[1, 0], [0, 1], [0, 0]])
+    [Fraction(0, 1), Fraction(0, 1), Fraction(3, 1)]
+    >>> project_out([F(1), F(1)], [[F(1, 3)], [F(-1, 3)]])
+    [Fraction(1, 1), Fraction(1, 1)]
+    """
     cols = independent_columns(A)
     if not cols:
         return list(y)
-    B = [[row[j] for j in cols] for row in A]
-    k = len(cols)
-    BtB = [[sum(B[r][i] * B[r][j] for r in range(len(B))) for j in range(k)] for i in range(k)]
-    Bty = [sum(B[r][i] * y[r] for r in range(len(B))) for i in range(k)]
-    c = solve(BtB, Bty)
-    assert c is not None  # B has independent columns, so B'B is invertible
-    return [y[r] - sum(B[r][i] * c[i] for i in range(k)) for r in range(len(B))]
+    B = [_integers([row[j] for row in A])[0] for j in cols]  # columns
+    Y, scale = _integers(y)
+    d, k = len(Y), len(B)
+    G = [[sum(B[i][r] * B[j][r] for r in range(d)) for j in range(k)] for i in range(k)]
+    det, z = _gram_solve(G, [sum(B[i][r] * Y[r] for r in range(d)) for i in range(k)])
+    return [Fraction(det * Y[r] - sum(B[i][r] * z[i] for i in range(k)), det * scale) for r in range(d)]
 
 
 def unit_direction(v: Sequence[Fraction | int]) -> tuple[float, ...]:

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
+from functools import lru_cache
 from typing import Any, NamedTuple, Sequence
 
 import numpy as np
@@ -28,13 +29,15 @@ import scipy.sparse as sp
 from .grasp import Grasp
 from .. import models as registry
 from ..errors import ArgumentError, GraspError
+from .._kernels.conic import lorentz_system
 from .._kernels.linalg import world_values
 from .cones import cone_code
 from .wrench import (contact_frame, force_columns, generator_columns, grasp_arrays, tangent,
                      to_exact, variants_of, wrench)
 
-__all__ = ["Block", "block_arrays", "ray_block_arrays", "conic_block_arrays", "System", "ClosureProblem", "grasp_problem", "span_problem", "grasp_system",
-           "span_system", "span_vectors", "is_polyhedral"]
+__all__ = ["Block", "block_arrays", "ray_block_arrays", "conic_block_arrays", "System", "ClosureProblem",
+           "grasp_problem", "span_problem", "grasp_system", "span_system", "span_vectors", "is_polyhedral",
+           "DENSE_COLUMNS", "LorentzLayout", "lorentz_layout"]
 
 
 @dataclass(frozen=True)
@@ -108,8 +111,8 @@ class ClosureProblem:
         the tangential forces (and the scaled torsional moment).
     to_values : ndarray or scipy.sparse.csr_array, shape (ncert, nvar)
         Linear map from ``x`` to the certificate's values (world-frame forces): block diagonal,
-        stored sparse for one grasp (its size grows with the square of the contacts); see
-        :meth:`values`.
+        dense up to :data:`DENSE_COLUMNS` variables, else stored sparse (its size grows with the
+        square of the contacts); see :meth:`values`.
     system : System
         The float certificate system (for polyhedral problems its columns are ``columns``).
     """
@@ -123,7 +126,8 @@ class ClosureProblem:
     def values(self, x: np.ndarray) -> np.ndarray:
         """The certificate's values ``to_values @ x``, each summed in variable order as
         :func:`qualgrasp.certify._kernels.linalg.world_values` sums the columnar batch (the
-        zeros a sparse map skips add nothing), so both routes state the same values."""
+        zeros a sparse map skips add nothing: both sums start at +0, so a signed zero cannot
+        survive either), so dense and sparse maps, and both routes, state the same values."""
         x = np.asarray(x, dtype=float)
         if sp.issparse(self.to_values):
             return np.asarray(self.to_values @ x, dtype=float)
@@ -155,7 +159,13 @@ def span_problem(vectors) -> ClosureProblem:
     """Positive spanning of the rows of ``vectors`` (shape ``(k, d)``): every row is a ray."""
     system = span_system(vectors)
     k = system.columns.shape[1]
-    return ClosureProblem(system.columns, tuple(range(k)), (), sp.identity(k, format="csr"), system)
+    return ClosureProblem(system.columns, tuple(range(k)), (), _identity(k), system)
+
+
+def _identity(k: int):
+    """The value map of a programme over generator rays: the identity, dense up to
+    :data:`DENSE_COLUMNS` columns (its values are the same, :meth:`ClosureProblem.values`)."""
+    return np.eye(k) if k <= DENSE_COLUMNS else sp.identity(k, format="csr")
 
 
 def is_polyhedral(grasp: Grasp, frictionless: bool = False, socp: bool = False) -> bool:
@@ -184,15 +194,90 @@ def grasp_problem(grasp: Grasp, *, frictionless: bool = False, socp: bool = Fals
     second-order cones ``abs(f_t) <= mu f_n`` instead of edges: the same verdict by another route
     (the margin's scale differs), used to cross-check the LP (not for pads, which have no
     conic form).
+
+    A spatial grasp of point and soft contacts with at most :data:`DENSE_COLUMNS` columns, the
+    call a planning loop makes per grasp, takes a compiled route (its layout cached per contact
+    pattern, :func:`lorentz_layout`) that states the same floats as the array route of
+    :func:`conic_columns` and :func:`grasp_system`, which batches and the other grasps take.
     """
+    if not is_polyhedral(grasp, frictionless, socp):
+        layout = lorentz_layout(tuple(contact.contact_model for contact in grasp.contacts), grasp.dim)
+        if layout is not None and layout.ncols <= DENSE_COLUMNS:
+            return _lorentz_problem(grasp, layout)
     system = grasp_system(grasp, frictionless=frictionless, socp=socp)
     if system.layout == "generators":
         k = system.columns.shape[1]
-        return ClosureProblem(system.columns, tuple(range(k)), (), sp.identity(k, format="csr"), system)
+        return ClosureProblem(system.columns, tuple(range(k)), (), _identity(k), system)
     P, N, mu, params, c, L = grasp_arrays(grasp)
     models = tuple(contact.model for contact in grasp.contacts)
     columns, rays, cones, to_values = conic_columns(P, N, params, models, c, L)
     return ClosureProblem(columns, rays, cones, to_values, system)
+
+
+#: Most columns of a programme whose value map :func:`grasp_problem` stores dense (32 KB); larger
+#: ones keep it sparse (its size grows with the square of the contacts). Spatial grasps within
+#: the bound take the compiled route (:func:`qualgrasp.certify._kernels.conic.lorentz_system`).
+DENSE_COLUMNS = 64
+
+
+class LorentzLayout(NamedTuple):
+    """Column layout of a spatial grasp whose contacts all have Lorentz cones over world-axis
+    forces (:func:`lorentz_layout`): per contact its ``first`` column, the number of moment
+    columns ``nextra`` and their length parameters ``extra``, and its block's columns ``cols``;
+    ``ncols`` columns in all."""
+
+    first: np.ndarray
+    nextra: np.ndarray
+    extra: tuple[tuple[str, ...], ...]
+    cols: tuple[tuple[int, ...], ...]
+    ncols: int
+
+
+@lru_cache(maxsize=256)
+def lorentz_layout(models: tuple, dim: int) -> LorentzLayout | None:
+    """The :class:`LorentzLayout` of a contact pattern (registered model objects, in contact
+    order) in ``dim`` dimensions; None unless it is spatial and every model has a Lorentz cone
+    over the world axes (those grasps take :func:`grasp_problem`'s array route). A pure function
+    of the pattern, cached: a planning loop over one hand pays for it once.
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import models
+    >>> layout = lorentz_layout((models.get("point"), models.get("soft")), 3)
+    >>> layout.cols, layout.extra
+    (((0, 1, 2), (3, 4, 5, 6)), ((), ('torsion',)))
+    >>> lorentz_layout((models.get("frictionless"), models.get("point")), 3) is None
+    True
+    """
+    if dim != 3 or not all(m.cone == "lorentz" and m.forces == "axes" for m in models):
+        return None
+    nextra = np.array([len(m.extra) for m in models], dtype=np.int64)
+    width = 3 + nextra
+    first = np.concatenate([[0], np.cumsum(width)[:-1]]).astype(np.int64)
+    for a in (first, nextra):
+        a.setflags(write=False)  # shared by every call with this pattern
+    cols = tuple(tuple(range(int(f), int(f + w))) for f, w in zip(first, width))
+    return LorentzLayout(first, nextra, tuple(tuple(m.extra) for m in models), cols, int(width.sum()))
+
+
+def _lorentz_problem(grasp: Grasp, layout: LorentzLayout) -> ClosureProblem:
+    """:func:`grasp_problem` of a spatial grasp of pattern ``layout``, by the compiled route:
+    the same floats as the array route (:func:`conic_columns`, :func:`grasp_system`)."""
+    contacts = grasp.contacts
+    G = np.zeros((len(contacts), max(map(len, layout.extra))))
+    for i, contact in enumerate(contacts):  # each model's moment lengths (a patch derives its own)
+        model = contact.contact_model
+        if model.extra:
+            lengths = model.moment_lengths({name: contact.param(name) for name in model.param_names})
+            G[i, :len(lengths)] = lengths
+    mu = [contact.mu for contact in contacts]
+    columns, to_values, C = lorentz_system(np.array([c.p for c in contacts]), np.array([c.n for c in contacts]),
+                                           np.array(grasp.center), float(grasp.length), layout.first,
+                                           layout.nextra, G)
+    blocks = tuple(Block("lorentz", cols, contact.n, mu[i], float(G[i, 0]) if names else 0, i)
+                   for i, (contact, cols, names) in enumerate(zip(contacts, layout.cols, layout.extra)))
+    cones = tuple((cols[0], len(cols), mu[i]) for i, cols in enumerate(layout.cols))
+    return ClosureProblem(columns, (), cones, to_values, System(C, blocks, "forces"))
 
 
 def conic_columns(P, N, params, models, center, length):
