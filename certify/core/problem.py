@@ -317,7 +317,8 @@ def conic_columns(P, N, params, models, center, length):
         if model.cone == "ray":
             cols.append(wrenches[..., i, 0, :])
             rays.append(start)
-            blocks.append(N[..., i, :, None])
+            # its certificate value is the force along n itself (force_columns: one column, n)
+            blocks.append(np.ones(batch + (1, 1)))
             continue
         if model.cone != "lorentz":
             raise ArgumentError(f"{name} contacts have no conic form (they are polyhedral: use the generators)")
