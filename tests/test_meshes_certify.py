@@ -124,7 +124,7 @@ def test_interrupted_run_resumes_and_refuses_another_mesh(scene, tmp_path):
             resume=True)
     summary = run(scene / "poses.jsonl", out, options=Options(quality=False, source=source), workers=1,
                   chunk_size=3, resume=True)
-    assert summary.resumed_chunks == 2
+    assert summary.resumed_chunks == 2 and summary.resumed_rows == 6 and summary.rows == 14  # 2 kept chunks of 3
     ids = [r["id"] for r in _rows(out)]
     assert ids == [f"p{i}" for i in range(11)] + ["narrow", "far", "bad"]
 

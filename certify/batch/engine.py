@@ -57,13 +57,15 @@ __all__ = ["RunSummary", "run", "check_paths", "certify_chunk", "parts_folder", 
 @dataclass
 class RunSummary:
     """Counts of a certification run, its wall time (s) and peak resident memory (MB) of this
-    process and of the largest local worker process (None where the platform does not say)."""
+    process and of the largest local worker process (None where the platform does not say);
+    ``resumed_rows`` of the ``rows`` were kept from an interrupted run, not certified in this one."""
 
     rows: int = 0
     statuses: dict[str, int] = field(default_factory=dict)
     unverified: int = 0
     chunks: int = 0
     resumed_chunks: int = 0
+    resumed_rows: int = 0
     seconds: float = 0.0
     peak_mb: float | None = None
     peak_worker_mb: float | None = None
@@ -482,6 +484,7 @@ def _run(grasps: Path, results: Path, options: Options, workers: int | None, das
             if resume and _part_ok(part, len(chunk)):
                 summary.add(*_part_counts(part))
                 summary.resumed_chunks += 1
+                summary.resumed_rows += len(chunk)
             elif pool is None:
                 _, counts, unverified = certify_chunk(chunk, options, str(part))
                 summary.add(counts, unverified)

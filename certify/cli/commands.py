@@ -120,10 +120,12 @@ def certify_command(
         if summary.resumed_chunks:
             table.add_row("chunks kept from the interrupted run", str(summary.resumed_chunks))
         console.print(table)
-        rate = summary.rows / summary.seconds if summary.seconds > 0 else 0.0
+        done = summary.rows - summary.resumed_rows  # the kept rows took no time in this run
+        rate = done / summary.seconds if summary.seconds > 0 else 0.0
         memory = "" if summary.peak_mb is None else f"; peak memory {summary.peak_mb:.0f} MB" + (
             "" if summary.peak_worker_mb is None else f" (largest worker {summary.peak_worker_mb:.0f} MB)")
-        console.print(f"{summary.seconds:.1f} s, {rate:,.0f} grasps/s{memory}")
+        kept = f" ({done:,} rows certified in this run)" if summary.resumed_rows else ""
+        console.print(f"{summary.seconds:.1f} s, {rate:,.0f} grasps/s{kept}{memory}")
     if summary.errors or summary.unverified:
         raise typer.Exit(1)
 
