@@ -35,6 +35,7 @@ are built in Arrow by ``qualgrasp.certify.batch._arrow``.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 from itertools import combinations
 
 import numpy as np
@@ -233,6 +234,10 @@ def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
     owner, offset, friction = layout
     k = len(owner)
     rows = np.flatnonzero(code == 0)
+
+    def pair_normal(i, cols=slice(None)):  # the exact normal of two generators of row i
+        return planar_pair_normal(P[i], N[i], mu[i], width[i], c[i], L[i], owner[cols], offset[cols], friction[cols])
+
     tight_rows: dict[int, np.ndarray] = {}
     W = np.empty((len(rows), 3, k))
     E = np.empty((len(rows), 3, k))
@@ -240,7 +245,7 @@ def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
         planar_generators(P[i], N[i], mu[i], width[i], c[i], L[i], owner, offset, friction, W[r], E[r])
     if k < 3:  # the kernel's float proof of its null direction failed: decided exactly
         for i in rows if k == 2 else ():
-            z = planar_pair_normal(P[i], N[i], mu[i], width[i], c[i], L[i], owner, offset, friction)
+            z = pair_normal(i)
             yi = y[i] if _pair_orthogonal(z, y[i]) else _projected_normal(z, y[i])
             if yi is not None and _pair_orthogonal(z, yi):
                 code[i], y[i] = 3, yi
@@ -273,8 +278,7 @@ def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
         state = pair_null_rows(np.ascontiguousarray(W[thin_rows[pair]]), np.ascontiguousarray(E[thin_rows[pair]]),
                                np.ascontiguousarray(yp))
         for q, i in zip(np.flatnonzero(state == 0), at[pair][state == 0]):  # refuted: the span's exact normal
-            z = _span_normal(lambda cols, i=i: planar_pair_normal(
-                P[i], N[i], mu[i], width[i], c[i], L[i], owner[cols], offset[cols], friction[cols]), range(k))
+            z = _span_normal(partial(pair_normal, i), range(k))
             yq = None if z is None else _projected_normal(z, yp[q])
             if yq is not None and _pair_orthogonal(z, yq):
                 yp[q], state[q] = yq, 1
@@ -294,8 +298,6 @@ def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
                                 planar_generator_rank(P[i], N[i], mu[i], width[i], owner, offset, friction))
             return rank_all[0]
 
-        pair_normal = lambda cols, i=i: planar_pair_normal(  # noqa: E731
-            P[i], N[i], mu[i], width[i], c[i], L[i], owner[cols], offset[cols], friction[cols])
         if has_y[q]:
             yc, mask = (yf[q], tight[q]) if ok[q] else (None, None)
         else:  # no dual basis: the fast solver asks clarabel, as grasp by grasp
@@ -312,12 +314,12 @@ def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
                 code[i], y[i] = 2, yc
             continue
         cols = np.flatnonzero(mask)
-        proof, shift = _orthogonal(W[r], E[r], cols, exact_rank, pair_normal, yc)
+        proof, shift = _orthogonal(W[r], E[r], cols, exact_rank, partial(pair_normal, i), yc)
         if proof is False:  # as exact_farkas: the exact normal of the tight generators' span, if rank 2
             if exact_rank(cols) == 3:
                 code[i] = 5  # nothing is left once projected; the exact rank of all is 3 as well
                 continue
-            z = _span_normal(pair_normal, cols) if exact_rank(cols) == 2 else None
+            z = _span_normal(partial(pair_normal, i), cols) if exact_rank(cols) == 2 else None
             yc = None if z is None else _projected_normal(z, yc)
             proof = None if yc is None or not _pair_orthogonal(z, yc) else True
             shift = 0.5e-6 * np.sqrt(yc @ yc) * (1 + 8 * U_ROUND) if proof else np.inf

@@ -20,7 +20,6 @@ from rich.markup import escape
 
 from ..batch.chunk import RowFailure
 from ..cli.options import OptionError, number_in, output_file
-from ..core.grasp import grasp_from_dict
 from ..errors import CertifyError
 from ..files.reader import grasps_table, is_parquet
 from .contacts import RESOLUTION, TOLERANCE
@@ -31,7 +30,7 @@ from .poses import error_row, read_poses
 from .rays import ENGINES, RayCaster
 from .source import check_contact_options, pose_grasps
 from .sampling import sample_poses
-from .task import hold_fields, parse_gravity
+from .task import parse_gravity
 
 __all__ = ["register", "contacts_file", "ContactsSummary", "write_rows"]
 
@@ -100,13 +99,12 @@ def contacts_file(mesh_path: Path, poses_path: Path, output: Path, *, gripper: s
     rows, bad = [], []
     for chunk in read_poses(poses_path, g, convention):
         found = pose_grasps(chunk, mesh, g, caster, props, mu=friction, model=model, tolerance=tolerance,
-                            resolution=resolution, points=points)
+                            resolution=resolution, points=points, hold=hold, gravity=grav, level=level)
         for r, row in zip(chunk, found):
             if isinstance(row, RowFailure):
                 bad.append(error_row(r, row.fields["reason"], str(row)))
                 continue
             if hold is not None:
-                row.update(hold_fields(grasp_from_dict(row), props, hold, grav, level))
                 summary.holds[row["hold_status"]] += 1
             rows.append(row)
     summary.grasps = len(rows)

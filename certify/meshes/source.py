@@ -35,7 +35,6 @@ from .errors import PoseFileError
 from .poses import HDF5_MAGIC, PoseRow, chunk_poses, contact_row, grasp_of
 from .rays import RayCaster
 from .task import hold_fields, parse_gravity
-from ..core.grasp import grasp_from_dict
 
 __all__ = ["MODELS", "PoseSource", "check_contact_options", "check_pose_file", "pose_grasps", "file_digest"]
 
@@ -92,11 +91,14 @@ def file_digest(path: str | Path) -> str:
 
 def pose_grasps(rows: list[PoseRow], mesh: trimesh.Trimesh, gripper: Gripper, caster: RayCaster,
                 props: MassProperties, *, mu: float, model: str = "soft", tolerance: float = TOLERANCE,
-                resolution: int = RESOLUTION, points: bool = True) -> list[dict | RowFailure]:
+                resolution: int = RESOLUTION, points: bool = True, hold: float | None = None,
+                gravity: np.ndarray | None = None, level: int = 1) -> list[dict | RowFailure]:
     """Close the gripper at every pose of ``rows`` on the mesh: for each pose, in order, its grasp
     row (:func:`~qualgrasp.certify.meshes.poses.contact_row`, certify's grasp format) or a
     :class:`~qualgrasp.certify.batch.chunk.RowFailure` whose fields are ``pose_id`` and
     ``reason`` (``bad_pose`` for a row that cannot be read, else the contact search's reason).
+    With a grip force ``hold`` (N), each grasp row also has the hold columns
+    (:func:`~qualgrasp.certify.meshes.task.hold_fields`, ``gravity`` and ``level`` as there).
 
     Examples
     --------
@@ -130,6 +132,8 @@ def pose_grasps(rows: list[PoseRow], mesh: trimesh.Trimesh, gripper: Gripper, ca
             continue
         grasp = grasp_of(outcome, mu, model if isinstance(gripper, ParallelJaw) else "point", props, r.id)
         out[k] = contact_row(r, outcome, grasp, gripper, props, points=points)
+        if hold is not None:
+            out[k].update(hold_fields(grasp, props, hold, gravity, level))
     return out
 
 
@@ -202,12 +206,7 @@ class PoseSource:
         """The grasp rows (or failures) of a chunk of the pose file, in order."""
         mesh, gripper, caster, props = self.load()
         rows = chunk_poses(chunk, gripper, self.convention)
-        out = pose_grasps(rows, mesh, gripper, caster, props, mu=gripper.mu if self.mu is None else self.mu,
-                          model=self.model, tolerance=self.tolerance, resolution=self.resolution,
-                          points=self.points)
-        if self.hold is not None:
-            gravity = parse_gravity(self.gravity)
-            for row in out:
-                if isinstance(row, dict):
-                    row.update(hold_fields(grasp_from_dict(row), props, self.hold, gravity, self.level))
-        return out
+        return pose_grasps(rows, mesh, gripper, caster, props, mu=gripper.mu if self.mu is None else self.mu,
+                           model=self.model, tolerance=self.tolerance, resolution=self.resolution,
+                           points=self.points, hold=self.hold, gravity=parse_gravity(self.gravity),
+                           level=self.level)
