@@ -43,6 +43,7 @@ from rich.console import Console
 from rich.progress import Progress
 from rich.table import Table
 
+from ..certify import models
 from ..certify.batch import Options, certify_table, random_grasp_table, random_grasps
 from ..certify.core import Grasp, force_closure, form_closure, grasp_to_dict, verify
 from ..certify.core.problem import grasp_system
@@ -153,7 +154,7 @@ def run_bench(n: int = 20000, seed: int = 0, reference_n: int = 300,
             tick = lambda: bar.advance(task)
             solvers = [("per-grasp fast route", make_solver("fast"), grasps[: max(reference_n, n // 10)]),
                        ("clarabel direct", make_solver("clarabel"), few)]
-            if kwargs["dim"] == 2 or kwargs["model"] == "frictionless":
+            if models.get(kwargs["model"]).generators(kwargs["dim"]) is not None:  # a polyhedral cone: an LP
                 solvers.append(("scipy linprog (HiGHS)", make_solver("linprog"), few))
             solvers += [("cvxpy + Parameters (reference)", make_solver("reference"), few),
                         ("cvxpy rebuilt per grasp", make_solver("reference-rebuilt"), few)]
@@ -273,7 +274,7 @@ def run_quality_bench(n: int = 30, seed: int = 0, budget: int = 200_000) -> list
                 e = epsilon(g, norm, budget=budget)
                 times.append(1e3 * (time.perf_counter() - start))
                 gaps.append(e.gap)
-                linear = kwargs["model"] == "point" and kwargs["dim"] == 3
+                linear = kwargs["model"] == models.POINT.name and kwargs["dim"] == 3
                 if linear and (norm == "L1" or kwargs["n_contacts"] <= 3):
                     errs.append((e.hi - epsilon_linearised(g, norm, 8)) / e.hi)
             rows.append(QualityRow(kind, norm, len(grasps), float(np.median(gaps)), max(gaps),

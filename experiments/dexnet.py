@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from ..certify import models
 from ..certify.core import Grasp
 from ..certify.errors import ArgumentError, OptionError
 from ..certify.core.wrench import contact_frame, torque
@@ -143,7 +144,7 @@ def dexnet_inputs(grasp: Grasp, edges: int = 8):
     >>> bool(np.allclose(np.linalg.norm(forces[1:, :8], axis=0), 0.5))  # each edge mu off the normal
     True
     """
-    if grasp.dim != 3 or any(c.model != "point" for c in grasp.contacts):
+    if grasp.dim != 3 or any(c.model != models.POINT.name for c in grasp.contacts):
         raise ArgumentError("dexnet_inputs takes spatial grasps of point contacts")
     P, N = grasp.points, grasp.normals
     mu = np.array([c.mu for c in grasp.contacts])

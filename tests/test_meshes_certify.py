@@ -153,7 +153,7 @@ def test_hold_in_one_run_equals_contacts_hold(scene):
     (["--mesh", "MESH", "--gravity", "all"], "--gravity needs --hold"),
     (["--mesh", "MESH", "--hold", "0"], "--hold must be"),
     (["--mesh", "MESH", "--hold", "2", "--level", "7"], "--level must be between 0 and 4"),
-    (["--mesh", "MESH", "--model", "elliptic"], "--model must be soft or point"),
+    (["--mesh", "MESH", "--model", "elliptic"], "--model must be a model that describes a patch (point, soft, patch)"),
     (["--mesh", "missing.stl"], "missing.stl"),
     (["--mesh", "MESH", "--units", "mm", "-o", "MESH"], "never overwritten"),
 ])

@@ -117,3 +117,27 @@ def test_halves_are_not_importable_on_their_own(name, tmp_path, monkeypatch):
     monkeypatch.setattr(sys, "path", [p for p in sys.path if p not in ("", str(ROOT), ".")])
     with pytest.raises(ModuleNotFoundError):
         __import__(name)
+
+
+def _model_name_comparisons(tree: ast.AST, names: set[str]) -> list[int]:
+    """Lines of ``x == "point"``, ``x != "soft"`` or ``x in ("pad", ...)`` with a model's name."""
+    def named(node):
+        if isinstance(node, ast.Constant):
+            return node.value in names
+        return isinstance(node, (ast.Tuple, ast.List, ast.Set)) and any(named(e) for e in node.elts)
+
+    return [node.lineno for node in ast.walk(tree) if isinstance(node, ast.Compare)
+            and any(named(side) for side in (node.left, *node.comparators))]
+
+
+def test_only_models_branch_on_a_model_name():
+    # a model owns its forms: no code of the library outside certify/models asks which model a
+    # contact is by name (defaults, options and docstring examples may name one: they choose)
+    from qualgrasp.certify import models
+
+    names = set(models.names())
+    bad = {m: lines for m, path in MODULES.items() if m.split(".")[1:2] in (["certify"], ["qualitative"])
+           and not m.startswith("qualgrasp.certify.models")
+           and (lines := _model_name_comparisons(ast.parse(path.read_text()), names))}
+    assert not bad
+    assert _model_name_comparisons(ast.parse('if c.model == "pad" or m in ("x", "soft"): pass'), names) == [1, 1]

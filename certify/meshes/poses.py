@@ -30,7 +30,6 @@ contacts is an error row, written to the error file: ``id``, ``pose_id``, ``line
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterator
@@ -38,6 +37,7 @@ from typing import Any, Iterator
 import numpy as np
 
 from ..errors import GraspFileError
+from .. import models
 from ..core.grasp import Contact, Grasp, grasp_to_dict
 from ..files.reader import Chunk, chunk_values, iter_chunks
 from ..core.validation import number, numbers, show
@@ -199,10 +199,11 @@ def _hdf5_poses(path: Path, gripper: Gripper, chunk_size: int) -> Iterator[list[
 
 def grasp_of(outcome: Outcome, mu: float, model: str, props: MassProperties, gid: Any = None,
              meta: dict | None = None) -> Grasp:
-    """certify's :class:`~qualgrasp.certify.Grasp` of a pose's patches: ``soft`` contacts (patch
-    centroid, area-weighted normal, torsion from the patch), ``patch`` contacts (radius of the
-    disc of the patch's area) or ``point`` contacts (a fingertip's one-point patch is a ``point``
-    for every model), torques about the centre of mass with the object's radius as length.
+    """certify's :class:`~qualgrasp.certify.Grasp` of a pose's patches: contacts of ``model`` with
+    the parameters the model states for each patch (:meth:`~qualgrasp.certify.models.ContactModel.patch_params`:
+    ``soft`` takes the torsion from the patch's points, ``patch`` the radius of the disc of its
+    area), or ``point`` contacts where it states none (a fingertip's one-point patch), torques about
+    the centre of mass with the object's radius as length.
 
     Examples
     --------
@@ -216,15 +217,12 @@ def grasp_of(outcome: Outcome, mu: float, model: str, props: MassProperties, gid
     >>> [c.model for c in g.contacts], round(g.contacts[0].torsion, 4)
     (['soft', 'soft'], 0.0069)
     """
+    described = models.get(model)
     contacts = []
     for p in outcome.patches:
-        if model == "soft" and p.torsion > 0:
-            contacts.append(Contact(tuple(p.centroid), tuple(p.normal), "soft", mu, torsion=p.torsion))
-        elif model == "patch" and p.area > 0:  # the disc of the patch's area
-            contacts.append(Contact(tuple(p.centroid), tuple(p.normal), "patch", mu,
-                                    radius=math.sqrt(p.area / math.pi)))
-        else:
-            contacts.append(Contact(tuple(p.centroid), tuple(p.normal), "point", mu))
+        params = described.patch_params(mu, p.area, p.torsion)
+        name = model if params is not None else models.POINT.name
+        contacts.append(Contact(tuple(p.centroid), tuple(p.normal), name, **(params or {"mu": mu})))
     return Grasp(tuple(contacts), center=props.com, length=props.radius, id=gid, meta=meta or {})
 
 

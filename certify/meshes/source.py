@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 import trimesh
 
+from .. import models
 from ..batch.chunk import RowFailure
 from ..core.arguments import number_in
 from ..errors import OptionError
@@ -36,10 +37,7 @@ from .poses import HDF5_MAGIC, PoseRow, chunk_poses, contact_row, grasp_of
 from .rays import RayCaster
 from .task import hold_fields, parse_gravity
 
-__all__ = ["MODELS", "PoseSource", "check_contact_options", "check_pose_file", "pose_grasps", "file_digest"]
-
-#: Contact models of the patches a pose's contacts become.
-MODELS = ("soft", "point", "patch")
+__all__ = ["PoseSource", "check_contact_options", "check_pose_file", "pose_grasps", "file_digest"]
 
 
 def check_contact_options(convention: str, model: str, tolerance: float, resolution: int,
@@ -53,12 +51,14 @@ def check_contact_options(convention: str, model: str, tolerance: float, resolut
     >>> check_contact_options("qualgrasp", "elliptic", 0.0005, 21, None)
     Traceback (most recent call last):
     ...
-    qualgrasp.certify.errors.OptionError: --model must be soft or point or patch, got 'elliptic'
+    qualgrasp.certify.errors.OptionError: --model must be a model that describes a patch (point, soft, patch), got 'elliptic'
     """
     if convention not in CONVENTIONS:
         raise OptionError(f"--convention must be one of {', '.join(CONVENTIONS)}, got {convention!r}")
-    if model not in MODELS:
-        raise OptionError(f"--model must be {' or '.join(MODELS)}, got {model!r}")
+    known = models.names()
+    if model not in known or not models.get(model).describes_patches:
+        choices = [m.name for m in models.models() if m.describes_patches]
+        raise OptionError(f"--model must be a model that describes a patch ({', '.join(choices)}), got {model!r}")
     number_in(tolerance, "--tolerance", 0, 0.1, unit="m", error=OptionError)
     if not 2 <= resolution <= 200:
         raise OptionError(f"--resolution must be between 2 and 200 cells per side, got {resolution}")
@@ -130,7 +130,7 @@ def pose_grasps(rows: list[PoseRow], mesh: trimesh.Trimesh, gripper: Gripper, ca
         if not outcome.ok:
             out[k] = RowFailure(outcome.message, id=r.id, fields={"pose_id": r.id, "reason": outcome.reason})
             continue
-        grasp = grasp_of(outcome, mu, model if isinstance(gripper, ParallelJaw) else "point", props, r.id)
+        grasp = grasp_of(outcome, mu, model if isinstance(gripper, ParallelJaw) else models.POINT.name, props, r.id)
         out[k] = contact_row(r, outcome, grasp, gripper, props, points=points)
         if hold is not None:
             out[k].update(hold_fields(grasp, props, hold, gravity, level))

@@ -36,6 +36,9 @@ the model's declaration, never re-stated elsewhere:
 ``moment_lengths``
     The cone weight of each moment column, from the parameters (:meth:`ContactModel.moment_lengths`:
     the ``extra`` parameters themselves, or a length derived from them, as the patch's ``2 a / 3``).
+``patch_params``
+    The parameters of a spatial contact on a flat patch where a gripper's pad touches a mesh
+    (:meth:`ContactModel.patch_params`), for the models a pose's patches can become.
 
 A new model is one new module declaring a subclass, plus its import in
 :mod:`qualgrasp.certify.models`.
@@ -190,6 +193,18 @@ class ContactModel:
         float cone weights are the exact ones; a derived length (the patch's ``2 a / 3``) is
         rounded in floats, and the batch path leaves such grasps to the exact checker."""
         return type(self).moment_lengths is ContactModel.moment_lengths
+
+    def patch_params(self, mu: float, area: float, torsion: float) -> dict[str, float] | None:
+        """The parameters of a spatial contact on a flat patch of ``area`` (m^2) whose points give
+        the torsional length ``torsion`` (m), with friction coefficient ``mu``; None when the model
+        does not describe this patch (then it is a point contact). Default: the model describes no
+        patch (:attr:`describes_patches` is False)."""
+        return None
+
+    @property
+    def describes_patches(self) -> bool:
+        """True when the model states the parameters of a contact patch (:meth:`patch_params`)."""
+        return type(self).patch_params is not ContactModel.patch_params
 
     def columns(self, dim: int) -> int:
         """Number of certificate columns of a contact in the conic form."""

@@ -12,6 +12,7 @@ axes). A patch of radius 0 is a point contact; ``mu = 0`` is frictionless.
 
 from __future__ import annotations
 
+import math
 from fractions import Fraction
 
 import numpy as np
@@ -35,6 +36,9 @@ class Patch(Soft):
         radius = values["radius"]
         exact = isinstance(radius, Fraction) or np.asarray(radius).dtype == object
         return (radius * Fraction(2, 3) if exact else 2.0 * np.asarray(radius, dtype=float) / 3.0,)
+
+    def patch_params(self, mu, area, torsion):
+        return {"mu": mu, "radius": math.sqrt(area / math.pi)} if area > 0 else None  # the disc of its area
 
 
 PATCH = register(Patch())

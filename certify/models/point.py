@@ -29,5 +29,8 @@ class Point(ContactModel):
             return None  # the spatial friction cone has no finite generators
         return (Generator(0.0, 1.0), Generator(0.0, -1.0))
 
+    def patch_params(self, mu, area, torsion):
+        return {"mu": mu}  # the patch as its centroid
+
 
 POINT = register(Point())

@@ -20,5 +20,8 @@ class Soft(ContactModel):
     cone = "lorentz"
     description = "soft finger: norm((f_t, m / torsion)) <= mu f_n (spatial)"
 
+    def patch_params(self, mu, area, torsion):
+        return {"mu": mu, "torsion": torsion} if torsion > 0 else None  # torsion from the patch's points
+
 
 SOFT = register(Soft())
