@@ -4,8 +4,9 @@ The input is read in chunks of a fixed number of grasps (:func:`qualgrasp.certif
 Each chunk is certified by a worker (local processes by default, or a dask.distributed cluster)
 and its results are written to ``RESULTS.parts/part-NNNNNN.EXT`` under a temporary name, renamed
 atomically when complete, with ``part-NNNNNN.EXT.sum`` stating its rows, bytes and CRC-32 (local
-workers write their own parts; dask workers send their results back to the client, which writes
-them, so a remote cluster needs no shared filesystem). Parts of a Parquet output are Arrow IPC
+workers write their own parts; dask workers encode their parts and send the bytes back to the
+client, which writes them, so a remote cluster needs no shared filesystem and the client's work
+per row stays a copy). Parts of a Parquet output are Arrow IPC
 files (``.arrow``, LZ4): cheap to write and to read back, so the Parquet encoding is done once.
 The main process appends the parts in chunk order to a temporary results file in the parts folder
 (JSON Lines parts as they complete; Parquet parts when the last one is in, in one schema: the
@@ -51,7 +52,8 @@ from ..files.reader import (Chunk, conform, input_format, is_parquet, iter_chunk
                             unified_schema)
 from ..core.validation import TOP_LEVEL
 
-__all__ = ["RunSummary", "run", "check_paths", "certify_chunk", "parts_folder", "MADE_BY"]
+__all__ = ["RunSummary", "run", "check_paths", "certify_chunk", "encoded_chunk", "encode_part", "parts_folder",
+           "MADE_BY"]
 
 
 @dataclass
@@ -113,25 +115,28 @@ def _sum_path(part: Path) -> Path:
     return part.with_name(part.name + ".sum")
 
 
-def _write_part(results, path: Path) -> None:
-    """Write a part atomically, with its companion ``.sum`` (rows, bytes, CRC-32) written first:
-    a part counts only when its sum matches (:func:`_part_ok`), so a part truncated by a crash
-    or a disk error is found and computed again."""
+def encode_part(results, suffix: str) -> tuple[bytes, int]:
+    """The bytes of a part holding ``results`` (an Arrow table or a list of rows), and its row
+    count: Arrow IPC for ``.arrow``, else JSON Lines."""
+    if suffix == ".arrow":
+        table = results if isinstance(results, pa.Table) else rows_to_table(results)
+        sink = pa.BufferOutputStream()
+        with pa.ipc.new_file(sink, table.schema, options=_IPC) as writer:
+            writer.write_table(table)
+        return sink.getvalue().to_pybytes(), table.num_rows
+    rows = table_to_rows(results) if isinstance(results, pa.Table) else results
+    return "".join(json.dumps(row, allow_nan=False) + "\n" for row in rows).encode("utf-8"), len(rows)
+
+
+def _write_part(data: bytes, rows: int, path: Path) -> None:
+    """Write a part's bytes (:func:`encode_part`) atomically, with its companion ``.sum`` (rows,
+    bytes, CRC-32) written first: a part counts only when its sum matches (:func:`_part_ok`), so a
+    part truncated by a crash or a disk error is found and computed again."""
     tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")  # writers never share a temporary
     tmp_sum = path.with_name(f"{path.name}.sum.{os.getpid()}.tmp")
     try:
-        if path.suffix == ".arrow":
-            table = results if isinstance(results, pa.Table) else rows_to_table(results)
-            with pa.ipc.new_file(tmp, table.schema, options=_IPC) as writer:
-                writer.write_table(table)
-            rows = table.num_rows
-        else:
-            rows = table_to_rows(results) if isinstance(results, pa.Table) else results
-            with tmp.open("w", encoding="utf-8") as fh:
-                for row in rows:
-                    fh.write(json.dumps(row, allow_nan=False) + "\n")
-            rows = len(rows)
-        size, crc = _checksum(tmp)
+        tmp.write_bytes(data)
+        size, crc = _checksum(tmp)  # read back: what the disk holds, not what was meant
         tmp_sum.write_text(json.dumps({"rows": rows, "bytes": size, "crc32": crc}))
         os.replace(tmp_sum, _sum_path(path))
         os.replace(tmp, path)  # atomic: a part exists only when complete
@@ -160,15 +165,22 @@ def certify_chunk(chunk: Chunk, options: Options, part: str) -> tuple[int, dict[
     Returns ``(chunk index, status counts, unverified count)``. This is the unit of work sent to
     local processes.
     """
-    return chunk.index, *_finish(certify_chunk_results(chunk, options), Path(part))
+    data, rows, counts, unverified = encoded_chunk(chunk, options, Path(part).suffix)
+    _write_part(data, rows, Path(part))
+    return chunk.index, counts, unverified
 
 
-def _finish(results, part: Path) -> tuple[dict[str, int], int]:
-    """Write a chunk's results to ``part`` atomically; its status counts and unverified count."""
-    _write_part(results, part)
+def encoded_chunk(chunk: Chunk, options: Options, suffix: str) -> tuple[bytes, int, dict[str, int], int]:
+    """Certify ``chunk``: its part's bytes (:func:`encode_part`), row count, status counts and
+    unverified count. This is the unit of work sent to dask workers: the client only writes the
+    bytes, so encoding the rows runs on the workers, in parallel."""
+    results = certify_chunk_results(chunk, options)
+    data, rows = encode_part(results, suffix)
     if isinstance(results, pa.Table):
-        return status_counts(results.column("status"), results.column("verified"))
-    return status_counts([r["status"] for r in results], [r["verified"] for r in results])
+        counts = status_counts(results.column("status"), results.column("verified"))
+    else:
+        counts = status_counts([r["status"] for r in results], [r["verified"] for r in results])
+    return data, rows, *counts
 
 
 def _part_counts(part: Path) -> tuple[dict[str, int], int]:
@@ -369,12 +381,14 @@ class _DaskPool:
         # Workers only compute: the chunk travels by scatter (not inside the task graph) and the
         # results come back here to be written, so a remote cluster needs no shared filesystem.
         data = self.client.scatter(chunk, direct=False)
-        future = self.client.submit(certify_chunk_results, data, options, pure=False)
+        future = self.client.submit(encoded_chunk, data, options, Path(part).suffix, pure=False)
         self.parts[future] = Path(part)
         return future
 
     def result(self, future) -> tuple[dict[str, int], int]:
-        return _finish(future.result(), self.parts.pop(future))
+        data, rows, counts, unverified = future.result()
+        _write_part(data, rows, self.parts.pop(future))
+        return counts, unverified
 
     @staticmethod
     def wait_one(futures):
