@@ -16,6 +16,7 @@ from rich.table import Table
 from ..certify.cli.options import OptionError, count_in, fail, output_folder
 from ..certify.errors import CertifyError
 from . import figures
+from .bench_jobs import print_jobs_bench, run_jobs_bench
 from .bench import (print_bench, print_contacts_bench, print_quality_bench, print_single_bench, run_bench,
                     run_contacts_bench, run_quality_bench, run_single_bench)
 from .demo import demo_steps, run_demo
@@ -224,6 +225,11 @@ def bench_command(
                                                             "(3 to 1000 point contacts, planar and spatial)."),
     single: bool = typer.Option(False, "--single", help="Time one spatial grasp per call: force_closure against "
                                                         "Dex-Net's force_closure_qp on the same grasps."),
+    jobs: bool = typer.Option(False, "--jobs", help="Time the offline job end to end: qualgrasp certify, Parquet in "
+                                                    "and out, 2 workers, against per-grasp baselines; start-up "
+                                                    "and first-call compile time."),
+    quick: bool = typer.Option(False, "--quick", help="With --jobs: 20,000 planar and 2,000 spatial rows per job "
+                                                      "instead of 1,000,000 and 100,000."),
     dexnet: Path | None = typer.Option(None, "--dexnet", show_default=False,
                                        help="With --single: the graspnetAPI 1.2.11 sdist (.tar.gz, its folder or "
                                             "its quality.py) to load Dex-Net from; without it Dex-Net's row is "
@@ -245,6 +251,13 @@ def bench_command(
     grasps of three point contacts, as a planning loop calls it, and of Dex-Net's force_closure_qp
     (8-edge cones, no certificate; loaded from --dexnet, which needs cvxopt) on the same grasps,
     in turns of 50 grasps, with the ratio of the medians.
+
+    With --jobs: the offline job end to end, one table from one run: qualgrasp certify on Parquet
+    in and out with 2 workers (planar with and without quality, a degenerate planar set and its
+    generic counterpart, spatial with and without quality; 1,000,000 planar and 100,000 spatial
+    rows, 20,000 and 2,000 with --quick), each against the per-grasp route and cvxpy rebuilt per
+    grasp on the same grasps (CPU per grasp); then CLI start-up and the first certify of one line
+    with a fresh compile cache.
     """
     n = (2000 if single else 20000) if n is None else n
     if n < 1 or reference_n < 0:
@@ -253,8 +266,16 @@ def bench_command(
         fail("--single times one grasp per call; it does not go with --quality or --contacts")
     if dexnet is not None and not single:
         fail("--dexnet goes with --single")
+    if jobs and (single or quality or contacts):
+        fail("--jobs times the whole job; it does not go with --single, --quality or --contacts")
+    if quick and not jobs:
+        fail("--quick goes with --jobs")
 
-    if single:
+    if jobs:
+        with Console(stderr=True).status("") as status:
+            print_jobs_bench(*run_jobs_bench(quick=quick, seed=seed, reference_n=reference_n,
+                                             progress=lambda what: status.update(f"bench --jobs: {what}")))
+    elif single:
         try:
             loaded = None if dexnet is None else load_dexnet(dexnet)
         except OptionError as err:

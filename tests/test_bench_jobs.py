@@ -1,0 +1,33 @@
+"""``qualgrasp bench --jobs``: the offline job end to end against its per-grasp baselines. No
+timing is asserted: what is checked is that every job ran its whole set through the engine with
+two workers, no row unverified, its baselines timed, and the options."""
+
+import pytest
+from typer.testing import CliRunner
+
+from qualgrasp.cli import app
+from qualgrasp.experiments.bench_jobs import JOB_KINDS, run_jobs_bench
+
+runner = CliRunner()
+
+
+def test_every_job_certifies_its_whole_set_and_times_its_baselines():
+    jobs, starts = run_jobs_bench(sizes={2: 120, 3: 12}, reference_n=6, startup=False)
+    assert [j.kind for j in jobs] == list(JOB_KINDS) and starts == []
+    for job, (kwargs, _) in zip(jobs, JOB_KINDS.values()):
+        assert job.rows == (120 if kwargs["dim"] == 2 else 12) == sum(job.statuses.values())
+        assert job.unverified == 0 and job.statuses.get("error", 0) == 0
+        assert job.per_grasp_n == 6 and job.cvxpy_n == 2
+        assert min(job.wall, job.cpu, job.per_grasp, job.cvxpy) > 0
+    # the degenerate set is what its label says: antipodal and collinear grasps, mostly not in closure
+    assert jobs[2].statuses != jobs[3].statuses
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--jobs", "--single"], "does not go with --single"),
+    (["--jobs", "--quality"], "does not go with"),
+    (["--quick"], "--quick goes with --jobs"),
+])
+def test_jobs_options_are_checked(args, message):
+    result = runner.invoke(app, ["bench", *args])
+    assert result.exit_code == 2 and message in result.output, result.output
