@@ -21,12 +21,15 @@ printed beside it.
 
 The **start-up rows**: ``qualgrasp --help`` and ``--version`` (median of five runs) against the
 interpreter's own start-up (``python -c pass``), and the first ``qualgrasp certify`` of one line
-with a fresh compile cache (compiling the kernels it needs), with and without quality, against the
-same command once the cache is warm.
+(a planar grasp in closure, so that quality has an epsilon to compute) with a fresh compile cache
+(compiling the kernels it needs), with and without quality, against the same command once the
+cache is warm.
 """
 
 from __future__ import annotations
 
+import json
+import math
 import os
 import resource
 import shutil
@@ -155,8 +158,10 @@ def _start_rows(folder: Path, seed: int) -> list[StartRow]:
     bare = _median_wall([sys.executable, "-c", "pass"])
     rows = [StartRow(f"qualgrasp {flag}", _median_wall([exe, flag]), "python -c pass", bare)
             for flag in ("--help", "--version")]
-    one = folder / "one.parquet"
-    pq.write_table(random_grasp_table(seed, 1, dim=2, n_contacts=3, model="point"), one)
+    one = folder / "one.jsonl"  # three point contacts 120 degrees apart, normals through the centre: closure
+    contacts = [{"p": [math.cos(a), math.sin(a)], "n": [-math.cos(a), -math.sin(a)], "model": "point", "mu": 0.5}
+                for a in (0.0, 2 * math.pi / 3, 4 * math.pi / 3)]
+    one.write_text(json.dumps({"id": "one", "contacts": contacts}) + "\n")
     for quality in (True, False):
         env = {**os.environ, "XDG_CACHE_HOME": str(folder / f"cache-{quality}")}
         env.pop("NUMBA_CACHE_DIR", None)

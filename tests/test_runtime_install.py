@@ -75,3 +75,22 @@ def test_version_has_one_source():
 def test_version_option():
     result = CliRunner().invoke(app, ["--version"])
     assert result.exit_code == 0 and result.output == f"qualgrasp {qualgrasp.__version__}\n"
+
+
+def test_the_cache_folder_changes_with_any_kernel_source(tmp_path):
+    # numba checks only a cached kernel's own file: a callee changed in another module (a new
+    # release, an edit) must not be loaded from a cache compiled with the old callee
+    from qualgrasp.certify._kernels.jit import KERNEL_SOURCES, source_fingerprint
+
+    names = {p.name for p in KERNEL_SOURCES}
+    assert {"cones.py", "planar.py", "linalg.py", "order.py"} <= names and KERNEL_SOURCES[-1].parent.name == "core"
+    copies = []
+    for path in KERNEL_SOURCES:
+        copies.append(tmp_path / path.parent.name / path.name)
+        copies[-1].parent.mkdir(exist_ok=True)
+        copies[-1].write_bytes(path.read_bytes())
+    before = source_fingerprint(tuple(copies))
+    assert before == source_fingerprint(KERNEL_SOURCES)
+    callee = next(c for c in copies if c.name == "cones.py" and c.parent.name == "_kernels")
+    callee.write_text(callee.read_text() + "\n# an edit\n")
+    assert source_fingerprint(tuple(copies)) != before

@@ -64,6 +64,46 @@ def polar_values(C, cone, first, width, n, mu, g, y):
 
 
 @kernel
+def _project_off_tight(C, first, width, tight, scale, v):
+    """Project ``v`` in place off the span of the tight blocks' columns of ``C``: modified
+    Gram-Schmidt over those columns in order, keeping the directions whose remaining norm is above
+    ``1e-12 scale`` (the rank the columns have at that tolerance). Written as loops: numba compiles
+    ``np.linalg.qr`` and slice assignments slowly, and this runs on a first call."""
+    d = C.shape[0]
+    basis = np.empty((d, d))
+    rank = 0
+    q = np.empty(d)
+    for b in range(first.shape[0]):
+        if not tight[b]:
+            continue
+        for c in range(width[b]):
+            if rank == d:
+                break
+            for i in range(d):
+                q[i] = C[i, first[b] + c]
+            for r in range(rank):
+                dot = 0.0
+                for i in range(d):
+                    dot += basis[i, r] * q[i]
+                for i in range(d):
+                    q[i] -= dot * basis[i, r]
+            nq = 0.0
+            for i in range(d):
+                nq += q[i] * q[i]
+            nq = np.sqrt(nq)
+            if nq > 1e-12 * scale:
+                for i in range(d):
+                    basis[i, rank] = q[i] / nq
+                rank += 1
+    for r in range(rank):
+        dot = 0.0
+        for i in range(d):
+            dot += basis[i, r] * v[i]
+        for i in range(d):
+            v[i] -= dot * basis[i, r]
+
+
+@kernel
 def farkas_direction(C, cone, first, width, n, mu, g, y, rel):
     """The rule of :func:`qualgrasp.certify.core.closure.farkas_certificate`, compiled: ``(ok, y,
     tight)``.
@@ -71,7 +111,7 @@ def farkas_direction(C, cone, first, width, n, mu, g, y, rel):
     ``y`` is normalised; if every block's polar value is below ``-1e-9 scale`` (``scale`` the
     largest ``abs(C)``) it is a strict certificate. Otherwise blocks whose functional
     ``C_b' y`` is at most ``rel scale`` in absolute value are tight, ``y`` is projected off the
-    span of their columns (QR, columns with ``abs(R_ii) > 1e-12 scale``) and normalised again
+    span of their columns (Gram-Schmidt, directions above ``1e-12 scale``) and normalised again
     (refused if the projection leaves less than half of it), and every other block must be
     strictly separated."""
     d = C.shape[0]
@@ -104,22 +144,10 @@ def farkas_direction(C, cone, first, width, n, mu, g, y, rel):
             tight[b] = True
             ntc += width[b]
     if ntc > 0:
-        T = np.empty((d, ntc))
-        c0 = 0
-        for b in range(nb):
-            if tight[b]:
-                for c in range(width[b]):
-                    T[:, c0] = C[:, first[b] + c]
-                    c0 += 1
-        Q, R = np.linalg.qr(T)
-        proj = out.copy()
-        for c in range(min(d, ntc)):
-            if abs(R[c, c]) > 1e-12 * scale:
-                dot = 0.0
-                for i in range(d):
-                    dot += Q[i, c] * out[i]
-                for i in range(d):
-                    proj[i] -= Q[i, c] * dot
+        proj = np.empty(d)
+        for i in range(d):
+            proj[i] = out[i]
+        _project_off_tight(C, first, width, tight, scale, proj)
         ss = 0.0
         for i in range(d):
             ss += proj[i] * proj[i]

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import kernel
+from .order import stable_argsort
 
 __all__ = ["planar_epsilon_one", "planar_epsilon", "planar_edges", "linf_sweep", "support_rows"]
 
@@ -313,7 +314,7 @@ def linf_sweep(Wb, owner, m, E, first, last, top_val, top_u):
                 nev += 1
             SA += xs[init]  # the maximiser on the arc through pseudo-angle 0
             SB += ys[init]
-        order = np.argsort(ev_key[:nev])
+        order = stable_argsort(ev_key[:nev])
         for q in order:
             SA += ev_dA[q]
             SB += ev_dB[q]

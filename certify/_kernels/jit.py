@@ -11,17 +11,26 @@ is then a namespace package that shadows a later editable install of the project
 numba picks a function's cache folder once, when the function is decorated, from
 ``numba.config.CACHE_DIR``; :func:`kernel` sets that value for the decoration only and restores
 it, so numba behaves as before for the user's other code.
+
+numba's cache checks only the source file of the function it caches, not those of the functions
+it calls, which are compiled into it: a kernel cached before a change to a kernel it calls (in
+another module, or in a new release) would be loaded with the old callee. The cache folder is
+therefore named by :func:`source_fingerprint`, a digest of every kernel module and of the
+constants they import, so that a changed kernel source starts a fresh cache.
 """
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import os
 import tempfile
-from typing import Callable, Iterable
+from pathlib import Path
+from typing import Callable, Iterable, Sequence
 
 from numba import config, njit, types
 
-__all__ = ["cache_dir", "kernel", "precompile", "F1", "F2", "F3", "I1", "I2", "INT", "FLOAT", "BOOL"]
+__all__ = ["cache_dir", "source_fingerprint", "KERNEL_SOURCES", "kernel", "precompile", "F1", "F2", "F3", "I1", "I2", "INT", "FLOAT", "BOOL"]
 
 #: Argument types as the callers pass them: C-contiguous float64 arrays of 1 to 3 dimensions and
 #: int64 arrays of 1 and 2, and Python's int, float and bool.
@@ -39,13 +48,39 @@ def _writable(path: str) -> bool:
     return True
 
 
+_HERE = Path(__file__).resolve().parent
+#: The files whose text the compiled kernels depend on: the kernel modules, and the cone codes
+#: they take from :mod:`qualgrasp.certify.core.cones`.
+KERNEL_SOURCES = tuple(sorted(_HERE.glob("*.py"))) + (_HERE.parent / "core" / "cones.py",)
+
+
+def source_fingerprint(paths: Sequence[Path] = KERNEL_SOURCES) -> str:
+    """The first 16 hexadecimal digits of the SHA-256 of ``paths``' names and contents, in order.
+
+    Examples
+    --------
+    >>> len(source_fingerprint())
+    16
+    """
+    digest = hashlib.sha256()
+    for path in paths:
+        digest.update(Path(path).name.encode() + b"\0" + Path(path).read_bytes() + b"\0")
+    return digest.hexdigest()[:16]
+
+
+@functools.lru_cache(maxsize=None)
+def _installed_fingerprint() -> str:  # read once per process: every kernel's decoration asks
+    return source_fingerprint()
+
+
 def cache_dir(environ=os.environ) -> str | None:
     """The folder holding the compiled kernels' cache.
 
-    ``NUMBA_CACHE_DIR`` when set (numba's own setting, honoured as numba does), else
-    ``$XDG_CACHE_HOME/qualgrasp/numba`` (an absolute ``XDG_CACHE_HOME`` only, as the XDG base
-    directory specification says), else ``~/.cache/qualgrasp/numba``; None when that folder
-    cannot be created or written (the kernels are then compiled in every process).
+    The folder :func:`source_fingerprint` names (module docstring) under ``NUMBA_CACHE_DIR`` when
+    set (numba's own setting, honoured as numba does), else under ``$XDG_CACHE_HOME/qualgrasp/numba``
+    (an absolute ``XDG_CACHE_HOME`` only, as the XDG base directory specification says), else under
+    ``~/.cache/qualgrasp/numba``; None when that folder cannot be created or written (the kernels
+    are then compiled in every process).
 
     Parameters
     ----------
@@ -67,6 +102,7 @@ def cache_dir(environ=os.environ) -> str | None:
         if not os.path.isabs(base):
             base = os.path.join(os.path.expanduser("~"), ".cache")
         path = os.path.join(base, "qualgrasp", "numba")
+    path = os.path.join(path, _installed_fingerprint())
     return path if _writable(path) else None
 
 

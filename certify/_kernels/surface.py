@@ -18,6 +18,7 @@ import numpy as np
 
 from .jit import kernel
 from .linalg import U, gamma
+from .order import stable_argsort
 
 __all__ = ["face_bounds", "leibniz_tables", "planar_h_bounds", "cycle_code"]
 
@@ -169,7 +170,7 @@ def cycle_code(faces, nv):
             keys[f * d + k] = key
             s = 1 if k % 2 == 0 else -1
             sgn[f * d + k] = s if parity % 2 == 0 else -s
-    order = np.argsort(keys)
+    order = stable_argsort(keys)
     n = F * d
     if n % 2:
         return 3

@@ -142,7 +142,9 @@ def certify_values(values: Sequence[Any], lines: Sequence[int], options: Options
 
 
 FEW = 64
-"""Fewer parsed grasps than this are certified grasp by grasp (:func:`certify_parsed`)."""
+"""Fewer grasps than this in a chunk (parsed from JSON Lines or a source, or an Arrow chunk) are
+certified grasp by grasp (the same rows): the first run after an install then compiles fewer
+kernels for a handful of grasps."""
 
 
 def certify_parsed(values: Sequence[Any], lines: Sequence[int], options: Options = Options(),
@@ -203,7 +205,7 @@ def _certify_arrow_rows(table: pa.Table, lines, options: Options, tol: Tolerance
     def slow(rows):
         return certify_rows(cols, rows, [lines[i] for i in rows], options, tol)
 
-    return certify_table(table, lines, options, tol, slow=slow, columns=cols)
+    return certify_table(table, lines, options, tol, slow=slow, columns=cols, columnar=table.num_rows >= FEW)
 
 
 def certify_arrow(data: Any, options: Options = Options(), tol: Tolerances = Tolerances()) -> pa.Table:

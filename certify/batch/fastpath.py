@@ -692,14 +692,15 @@ def _tight_shift(C, E, owner, mask, models, P, y) -> float:
 
 
 def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(), slow=None, *,
-                  columns: GraspColumns | None = None) -> pa.Table:
+                  columns: GraspColumns | None = None, columnar: bool = True) -> pa.Table:
     """Results table of an Arrow grasp table (rows in input order), with the table's extra
     columns carried through.
 
     ``slow(row_indices) -> list of results rows`` certifies rows grasp by grasp (the per-grasp
     path, :func:`qualgrasp.certify.batch.chunk.certify_rows`); it receives every row that the columnar
     rules do not settle, invalid rows included. ``columns``: the table's checked columns, when
-    the caller has them already.
+    the caller has them already. ``columnar=False`` sends every row to ``slow`` (the same rows,
+    without compiling the columnar kernels: for a handful of grasps).
     """
     cols = grasp_columns(table) if columns is None else columns
     lines = (np.arange(lines.start, lines.stop, lines.step) if isinstance(lines, range)
@@ -707,7 +708,7 @@ def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(
     n = len(lines)
     done = np.zeros(n, dtype=bool)
     pieces, order = [], []
-    if options.method == "fast" and cols.ok.any():
+    if columnar and options.method == "fast" and cols.ok.any():
         label = cols.pattern()
         for k in np.unique(label[cols.ok]):
             rows = np.flatnonzero(label == k)
