@@ -14,7 +14,8 @@ in this process: the build's own **per-grasp route** (:func:`qualgrasp.certify.r
 the same results row: both closures, both certificates re-checked and, for the quality rows, both
 epsilons) and **cvxpy + CLARABEL rebuilt per grasp** (the reference formulation built anew for
 each grasp, as naive cvxpy code does; force and form closure, no epsilon: on the quality rows this
-baseline does less than the job). Every route is judged by the same rule: CPU seconds per grasp
+baseline does less than the job). A grasp on which CLARABEL fails (rank-deficient sets) is
+timed and counted as failed. Every route is judged by the same rule: CPU seconds per grasp
 (the job's summed over its processes, start-up and file work included), and the ratio is the
 baseline's CPU time per grasp over the job's. The job's wall time and rate on the two workers are
 printed beside it.
@@ -48,6 +49,7 @@ from rich.table import Table
 
 from ..certify.batch import Options, random_grasp_table, run
 from ..certify.core import force_closure, form_closure
+from ..certify.errors import SolverError
 from ..certify.files.columns import grasp_columns
 from ..certify.report import certify_grasp
 from ..certify.solvers import make_solver
@@ -77,7 +79,8 @@ WORKERS = 2
 class JobRow:
     """A job and its baselines: ``wall`` and ``cpu`` seconds of the job (all its processes);
     per-grasp CPU seconds of the per-grasp route and of cvxpy rebuilt per grasp, each on its first
-    ``*_n`` grasps; the job's status counts and unverified rows."""
+    ``*_n`` grasps (``cvxpy_failed`` of them where CLARABEL failed); the job's status counts and
+    unverified rows."""
 
     kind: str
     rows: int
@@ -87,6 +90,7 @@ class JobRow:
     per_grasp_n: int
     cvxpy: float
     cvxpy_n: int
+    cvxpy_failed: int
     statuses: dict
     unverified: int
 
@@ -135,10 +139,18 @@ def _job(label: str, kwargs: dict, quality: bool, rows: int, seed: int, referenc
     per_grasp = _cpu_per_item(lambda g: certify_grasp(g, quality=quality).row(), few)
     rebuilt = make_solver("reference-rebuilt")
     cvxpy_few = few[: max(reference_n // 3, 1)]
-    cvxpy = _cpu_per_item(lambda g: (force_closure(g, solver=rebuilt), form_closure(g, solver=rebuilt)), cvxpy_few)
+    failed = set()
+
+    def both(g):  # a solver failure is that route's answer for the grasp: counted, and timed
+        try:
+            force_closure(g, solver=rebuilt), form_closure(g, solver=rebuilt)
+        except SolverError:
+            failed.add(g.id)
+
+    cvxpy = _cpu_per_item(both, cvxpy_few)
     for path in (grasps_path, results_path, folder / "warm-in.parquet", folder / "warm.parquet"):
         path.unlink(missing_ok=True)
-    return JobRow(label, summary.rows, wall, cpu, per_grasp, len(few), cvxpy, len(cvxpy_few),
+    return JobRow(label, summary.rows, wall, cpu, per_grasp, len(few), cvxpy, len(cvxpy_few), len(failed),
                   dict(summary.statuses), summary.unverified)
 
 
@@ -202,13 +214,13 @@ def print_jobs_bench(jobs: list[JobRow], starts: list[StartRow]) -> None:
     table = Table(title=f"offline job: qualgrasp certify, Parquet in and out, --workers {WORKERS}; "
                         "baselines in this process on the same grasps; x = baseline CPU / job CPU per grasp")
     for col in ("job", "rows", "wall s", "grasps/s", "CPU us/grasp", "per-grasp route us (n)", "x",
-                "cvxpy rebuilt us (n)", "x", "unverified"):
+                "cvxpy rebuilt us (n, failed)", "x", "unverified"):
         table.add_column(col, justify="left" if col == "job" else "right")
     for r in jobs:
         us = 1e6 * r.cpu_per_grasp
         table.add_row(r.kind, f"{r.rows:,}", f"{r.wall:.1f}", f"{r.rows / r.wall:,.0f}", f"{us:,.1f}",
                       f"{1e6 * r.per_grasp:,.1f} ({r.per_grasp_n})", f"{r.per_grasp / r.cpu_per_grasp:.1f}",
-                      f"{1e6 * r.cvxpy:,.0f} ({r.cvxpy_n})", f"{r.cvxpy / r.cpu_per_grasp:.0f}", str(r.unverified))
+                      f"{1e6 * r.cvxpy:,.0f} ({r.cvxpy_n}, {r.cvxpy_failed})", f"{r.cvxpy / r.cpu_per_grasp:.0f}", str(r.unverified))
     console = Console(width=max(160, Console().width))
     console.print(table)
     console.print("cvxpy rebuilt: force and form closure only (no epsilon), also on the quality rows.")

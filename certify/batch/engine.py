@@ -175,20 +175,20 @@ def encoded_chunk(chunk: Chunk, options: Options, suffix: str) -> tuple[bytes, i
     unverified count. This is the unit of work sent to dask workers: the client only writes the
     bytes, so encoding the rows runs on the workers, in parallel."""
     results = certify_chunk_results(chunk, options)
-    data, rows = encode_part(results, suffix)
+    return *encode_part(results, suffix), *_counts(results)
+
+
+def _counts(results) -> tuple[dict[str, int], int]:
+    """Status counts and unverified count of results (an Arrow table or a list of rows)."""
     if isinstance(results, pa.Table):
-        counts = status_counts(results.column("status"), results.column("verified"))
-    else:
-        counts = status_counts([r["status"] for r in results], [r["verified"] for r in results])
-    return data, rows, *counts
+        return status_counts(results.column("status"), results.column("verified"))
+    return status_counts([r["status"] for r in results], [r["verified"] for r in results])
 
 
 def _part_counts(part: Path) -> tuple[dict[str, int], int]:
     if part.suffix == ".arrow":
-        t = _read_part(part)
-        return status_counts(t.column("status"), t.column("verified"))
-    rows = [json.loads(line) for line in part.read_text(encoding="utf-8").splitlines()]
-    return status_counts([r["status"] for r in rows], [r["verified"] for r in rows])
+        return _counts(_read_part(part))
+    return _counts([json.loads(line) for line in part.read_text(encoding="utf-8").splitlines()])
 
 
 MADE_BY = "qualgrasp certify"
@@ -378,8 +378,8 @@ class _DaskPool:
         self.parts: dict[Any, Path] = {}
 
     def submit(self, chunk: Chunk, options: Options, part: str):
-        # Workers only compute: the chunk travels by scatter (not inside the task graph) and the
-        # results come back here to be written, so a remote cluster needs no shared filesystem.
+        # Workers only compute: the chunk travels by scatter (not inside the task graph) and its
+        # encoded part comes back here to be written, so a remote cluster needs no shared filesystem.
         data = self.client.scatter(chunk, direct=False)
         future = self.client.submit(encoded_chunk, data, options, Path(part).suffix, pure=False)
         self.parts[future] = Path(part)
