@@ -1,8 +1,8 @@
 """``qualgrasp bench --jobs``: the offline job end to end, one table from one run.
 
-Each **job row** is a certification run as ``qualgrasp certify GRASPS.parquet -o RESULTS.parquet
---workers 2`` does it (:func:`qualgrasp.certify.batch.run`: Parquet in and out, two worker
-processes, chunked, every certificate re-checked), on random grasps written to Parquet outside
+Each **job row** is the command ``qualgrasp certify GRASPS.parquet -o RESULTS.parquet --workers 2``
+run as a user runs it, in a process of its own (Parquet in and out, two worker processes,
+chunked, every certificate re-checked; its kernels compiled by a run on 200 of the grasps first), on random grasps written to Parquet outside
 the timing: planar grasps of three point contacts with quality (both epsilons with their
 evidence) and without, a degenerate planar set (``qualgrasp sample --degenerate mixed``) and its
 generic counterpart (same model and contact count), and spatial grasps of three point contacts
@@ -16,7 +16,7 @@ epsilons) and **cvxpy + CLARABEL rebuilt per grasp** (the reference formulation 
 each grasp, as naive cvxpy code does; force and form closure, no epsilon: on the quality rows this
 baseline does less than the job). A grasp on which CLARABEL fails (rank-deficient sets) is
 timed and counted as failed. Every route is judged by the same rule: CPU seconds per grasp
-(the job's summed over its processes, start-up and file work included), and the ratio is the
+(the job's summed over the command and its workers, start-up and file work included), and the ratio is the
 baseline's CPU time per grasp over the job's. The job's wall time and rate on the two workers are
 printed beside it.
 
@@ -29,6 +29,7 @@ cache is warm.
 
 from __future__ import annotations
 
+import collections
 import json
 import math
 import os
@@ -47,9 +48,9 @@ import pyarrow.parquet as pq
 from rich.console import Console
 from rich.table import Table
 
-from ..certify.batch import Options, random_grasp_table, run
+from ..certify.batch import random_grasp_table
 from ..certify.core import force_closure, form_closure
-from ..certify.errors import SolverError
+from ..certify.errors import OptionError, SolverError
 from ..certify.files.columns import grasp_columns
 from ..certify.report import certify_grasp
 from ..certify.solvers import make_solver
@@ -109,12 +110,6 @@ class StartRow:
     baseline: float
 
 
-def _cpu_all() -> float:
-    """CPU seconds of this process and of its finished children."""
-    own, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
-    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
-
-
 def _cpu_per_item(fn: Callable, items) -> float:
     """CPU seconds per item of ``fn`` over ``items`` (the first call outside the timing)."""
     fn(items[0])
@@ -124,17 +119,35 @@ def _cpu_per_item(fn: Callable, items) -> float:
     return (time.process_time() - start) / len(items)
 
 
+def _qualgrasp() -> str | None:
+    """The ``qualgrasp`` command of this interpreter's environment."""
+    return shutil.which("qualgrasp", path=os.pathsep.join([str(Path(sys.executable).parent),
+                                                           os.environ.get("PATH", "")]))
+
+
+def _certify(exe: str, grasps: Path, results: Path, quality: bool) -> tuple[float, float]:
+    """Wall and CPU seconds (the command and every process it waited for) of ``qualgrasp certify``."""
+    cmd = [exe, "certify", str(grasps), "-o", str(results), "--workers", str(WORKERS), "-q"]
+    cmd += [] if quality else ["--no-quality"]
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
+    start = time.perf_counter()
+    subprocess.run(cmd, check=True, capture_output=True)
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, (after.ru_utime + after.ru_stime) - (kids.ru_utime + kids.ru_stime)
+
+
 def _job(label: str, kwargs: dict, quality: bool, rows: int, seed: int, reference_n: int,
-         folder: Path) -> JobRow:
+         folder: Path, exe: str) -> JobRow:
     table = random_grasp_table(seed, rows, **kwargs)
     grasps_path, results_path = folder / "grasps.parquet", folder / "results.parquet"
     pq.write_table(table, grasps_path)
-    options = Options(quality=quality)
     pq.write_table(table.slice(0, 200), folder / "warm-in.parquet")
-    run(folder / "warm-in.parquet", folder / "warm.parquet", options=options, workers=1)  # compile first
-    cpu0, wall0 = _cpu_all(), time.perf_counter()
-    summary = run(grasps_path, results_path, options=options, workers=WORKERS)
-    wall, cpu = time.perf_counter() - wall0, _cpu_all() - cpu0
+    _certify(exe, folder / "warm-in.parquet", folder / "warm.parquet", quality)  # compiled before the timing
+    wall, cpu = _certify(exe, grasps_path, results_path, quality)
+    done = pq.read_table(results_path, columns=["status", "verified"])
+    statuses = collections.Counter(done.column("status").to_pylist())
+    unverified = done.num_rows - sum(done.column("verified").to_pylist())
     few = grasp_columns(table.slice(0, max(reference_n, 1))).grasps(range(min(max(reference_n, 1), rows)))
     per_grasp = _cpu_per_item(lambda g: certify_grasp(g, quality=quality).row(), few)
     rebuilt = make_solver("reference-rebuilt")
@@ -150,8 +163,8 @@ def _job(label: str, kwargs: dict, quality: bool, rows: int, seed: int, referenc
     cvxpy = _cpu_per_item(both, cvxpy_few)
     for path in (grasps_path, results_path, folder / "warm-in.parquet", folder / "warm.parquet"):
         path.unlink(missing_ok=True)
-    return JobRow(label, summary.rows, wall, cpu, per_grasp, len(few), cvxpy, len(cvxpy_few), len(failed),
-                  dict(summary.statuses), summary.unverified)
+    return JobRow(label, done.num_rows, wall, cpu, per_grasp, len(few), cvxpy, len(cvxpy_few), len(failed),
+                  dict(statuses), unverified)
 
 
 def _median_wall(cmd: list[str], env: dict | None = None, times: int = 5) -> float:
@@ -163,10 +176,7 @@ def _median_wall(cmd: list[str], env: dict | None = None, times: int = 5) -> flo
     return statistics.median(walls)
 
 
-def _start_rows(folder: Path, seed: int) -> list[StartRow]:
-    exe = shutil.which("qualgrasp", path=os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")]))
-    if exe is None:
-        return []
+def _start_rows(folder: Path, exe: str) -> list[StartRow]:
     bare = _median_wall([sys.executable, "-c", "pass"])
     rows = [StartRow(f"qualgrasp {flag}", _median_wall([exe, flag]), "python -c pass", bare)
             for flag in ("--help", "--version")]
@@ -196,16 +206,19 @@ def run_jobs_bench(*, quick: bool = False, seed: int = 0, reference_n: int = 300
     rows (module docstring), in a temporary folder removed at the end. ``sizes``: rows per job by
     dimension, instead of :data:`SIZES` (:data:`QUICK_SIZES` with ``quick``)."""
     sizes = sizes or (QUICK_SIZES if quick else SIZES)
+    exe = _qualgrasp()
+    if exe is None:
+        raise OptionError("bench --jobs runs the qualgrasp command: it is not installed beside this Python")
     jobs = []
     with tempfile.TemporaryDirectory(prefix="qualgrasp-bench-") as tmp:
         folder = Path(tmp)
         for label, (kwargs, quality) in JOB_KINDS.items():
             if progress:
                 progress(label)
-            jobs.append(_job(label, kwargs, quality, sizes[kwargs["dim"]], seed, reference_n, folder))
+            jobs.append(_job(label, kwargs, quality, sizes[kwargs["dim"]], seed, reference_n, folder, exe))
         if progress and startup:
             progress("start-up")
-        starts = _start_rows(folder, seed) if startup else []
+        starts = _start_rows(folder, exe) if startup else []
     return jobs, starts
 
 

@@ -272,9 +272,13 @@ def bench_command(
         fail("--quick goes with --jobs")
 
     if jobs:
-        with Console(stderr=True).status("") as status:
-            print_jobs_bench(*run_jobs_bench(quick=quick, seed=seed, reference_n=reference_n,
-                                             progress=lambda what: status.update(f"bench --jobs: {what}")))
+        try:
+            with Console(stderr=True).status("") as status:
+                measured = run_jobs_bench(quick=quick, seed=seed, reference_n=reference_n,
+                                          progress=lambda what: status.update(f"bench --jobs: {what}"))
+        except OptionError as err:
+            fail(str(err))
+        print_jobs_bench(*measured)
     elif single:
         try:
             loaded = None if dexnet is None else load_dexnet(dexnet)

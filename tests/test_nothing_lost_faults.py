@@ -21,6 +21,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from qualgrasp.certify.batch import certify_file
+from qualgrasp.certify.batch.engine import certify_chunk as _certify_chunk
 from qualgrasp.certify.files import read_results, write_grasps
 from qualgrasp.certify.batch import random_grasps
 
@@ -215,3 +216,24 @@ def test_parquet_results_of_a_resumed_run_match(grasps, tmp_path):
     certify_file(src, out, quality=False, chunk_size=CHUNK, resume=True)
     assert pq.read_table(out).equals(pq.read_table(refs["parquet"]))
     assert json.loads(json.dumps(pq.read_metadata(out).num_rows)) == N
+
+
+def _dies_on_the_third_chunk(chunk, options, part):
+    if chunk.index == 2:
+        os._exit(1)  # as the system's out-of-memory killer leaves it: no Python error, no part
+    return _certify_chunk(chunk, options, part)
+
+
+def test_a_worker_killed_mid_run_ends_in_one_error_then_resume_finishes(grasps, tmp_path, monkeypatch):
+    from qualgrasp.certify.batch import engine
+    from qualgrasp.certify.errors import CertifyError
+
+    path, refs = grasps
+    out = tmp_path / "r.jsonl"
+    monkeypatch.setattr(engine, "certify_chunk", _dies_on_the_third_chunk)
+    with pytest.raises(CertifyError, match="a worker process ended abruptly") as err:
+        certify_file(path, out, quality=False, chunk_size=CHUNK, workers=2)
+    assert "Traceback" not in str(err.value) and not out.exists()
+    monkeypatch.undo()
+    certify_file(path, out, quality=False, chunk_size=CHUNK, workers=2, resume=True)
+    assert_whole(out, refs["jsonl"])

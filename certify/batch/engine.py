@@ -37,6 +37,7 @@ import sys
 import time
 import zlib
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Sequence
@@ -452,6 +453,9 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
             return _run(grasps, results, options, workers, dask, resume, chunk_size, progress)
         except (OSError, pa.ArrowException) as err:
             raise CertifyError(_fault(err, results)) from None
+        except BrokenProcessPool:  # a worker killed (a signal, out of memory) or crashed: no Python error to give
+            raise CertifyError("a worker process ended abruptly (killed by a signal or by the system, for example "
+                               "out of memory)" + _kept(results)) from None
 
 
 def _fault(err: Exception, results: Path) -> str:
@@ -459,10 +463,14 @@ def _fault(err: Exception, results: Path) -> str:
     what failed, and that the finished parts are kept for ``--resume``."""
     target = getattr(err, "filename", None) or results
     message = write_error(target, err) if isinstance(err, OSError) else f"cannot write {results}: {str(err).splitlines()[0][:200]}"
+    return message + _kept(results)
+
+
+def _kept(results: Path) -> str:
+    """What a run that ended mid-way keeps: its finished parts, for ``--resume``."""
     parts = parts_folder(results)
-    kept = (f"; the finished parts are kept in {parts}: fix the cause and run again with --resume"
+    return (f"; the finished parts are kept in {parts}: fix the cause and run again with --resume"
             if parts.is_dir() and any(parts.glob("part-*.sum")) else "")
-    return message + kept
 
 
 def _run(grasps: Path, results: Path, options: Options, workers: int | None, dask: str | None,
