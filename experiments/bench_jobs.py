@@ -1,30 +1,30 @@
 """``qualgrasp bench --jobs``: the offline job end to end, one table from one run.
 
 Each **job row** is the command ``qualgrasp certify GRASPS.parquet -o RESULTS.parquet --workers 2``
-run as a user runs it, in a process of its own (Parquet in and out, two worker processes,
-chunked, every certificate re-checked; its kernels compiled by a run on 200 of the grasps first), on random grasps written to Parquet outside
-the timing: planar grasps of three point contacts with quality (both epsilons with their
-evidence) and without, a degenerate planar set (``qualgrasp sample --degenerate mixed``) and its
-generic counterpart (same model and contact count), and spatial grasps of three point contacts
-with and without quality. Sizes: 1,000,000 planar and 100,000 spatial rows; with ``quick``
-20,000 and 2,000.
+run as a user runs it, in a process of its own (Parquet in and out, two worker processes, chunked,
+every certificate re-checked; its kernels compiled by a run on 200 of the grasps first), on random
+grasps written to Parquet outside the timing: planar grasps of three point contacts with quality
+(both epsilons with their evidence) and without, a degenerate planar set (``qualgrasp sample
+--degenerate mixed``) and its generic counterpart (same model and contact count), and spatial grasps
+of three point contacts with and without quality. Sizes: 1,000,000 planar and 100,000 spatial rows;
+with ``quick`` 20,000 and 2,000.
 
-Each job row is set against two baselines timed in the same run, on a prefix of the same grasps,
-in this process: the build's own **per-grasp route** (:func:`qualgrasp.certify.report.certify_grasp`,
+Each job row is set against two baselines timed in the same run, on a prefix of the same grasps, in
+this process: the build's own **per-grasp route** (:func:`qualgrasp.certify.report.certify_grasp`,
 the same results row: both closures, both certificates re-checked and, for the quality rows, both
-epsilons) and **cvxpy + CLARABEL rebuilt per grasp** (the reference formulation built anew for
-each grasp, as naive cvxpy code does; force and form closure, no epsilon: on the quality rows this
-baseline does less than the job). A grasp on which CLARABEL fails (rank-deficient sets) is
-timed and counted as failed. Every route is judged by the same rule: CPU seconds per grasp
-(the job's summed over the command and its workers, start-up and file work included), and the ratio is the
-baseline's CPU time per grasp over the job's. The job's wall time and rate on the two workers are
-printed beside it.
+epsilons) and **cvxpy + CLARABEL rebuilt per grasp** (the reference formulation built anew for each
+grasp, as naive cvxpy code does; force and form closure, no epsilon: on the quality rows this
+baseline does less than the job). A grasp on which CLARABEL fails (rank-deficient sets) is timed and
+counted as failed. Every route is judged by the same rule: CPU seconds per grasp (the job's summed
+over the command and its workers, start-up and file work included), and the ratio is the baseline's
+CPU time per grasp over the job's. The job's wall time and rate on the two workers are printed
+beside it.
 
 The **start-up rows**: ``qualgrasp --help`` and ``--version`` (median of five runs) against the
-interpreter's own start-up (``python -c pass``), and the first ``qualgrasp certify`` of one line
-(a planar grasp in closure, so that quality has an epsilon to compute) with a fresh compile cache
-(compiling the kernels it needs), with and without quality, against the same command once the
-cache is warm.
+interpreter's own start-up (``python -c pass``), and the first ``qualgrasp certify`` of one line (a
+planar grasp in closure, so that quality has an epsilon to compute) with a fresh compile cache
+(compiling the kernels it needs), with and without quality, against the same command once the cache
+is warm.
 """
 
 from __future__ import annotations
@@ -131,8 +131,12 @@ def _certify(exe: str, grasps: Path, results: Path, quality: bool) -> tuple[floa
     cmd += [] if quality else ["--no-quality"]
     kids = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    subprocess.run(cmd, check=True, capture_output=True)
+    done = subprocess.run(cmd, capture_output=True, text=True)
     wall = time.perf_counter() - start
+    if done.returncode != 0:  # a row refused or unverified (exit 1) is a result; anything else is not
+        last = (done.stderr or done.stdout).strip().splitlines()[-1:] or ["no output"]
+        if done.returncode != 1:
+            raise OptionError(f"qualgrasp certify {grasps.name} ended with exit code {done.returncode}: {last[0]}")
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return wall, (after.ru_utime + after.ru_stime) - (kids.ru_utime + kids.ru_stime)
 
@@ -233,7 +237,8 @@ def print_jobs_bench(jobs: list[JobRow], starts: list[StartRow]) -> None:
         us = 1e6 * r.cpu_per_grasp
         table.add_row(r.kind, f"{r.rows:,}", f"{r.wall:.1f}", f"{r.rows / r.wall:,.0f}", f"{us:,.1f}",
                       f"{1e6 * r.per_grasp:,.1f} ({r.per_grasp_n})", f"{r.per_grasp / r.cpu_per_grasp:.1f}",
-                      f"{1e6 * r.cvxpy:,.0f} ({r.cvxpy_n}, {r.cvxpy_failed})", f"{r.cvxpy / r.cpu_per_grasp:.0f}", str(r.unverified))
+                      f"{1e6 * r.cvxpy:,.0f} ({r.cvxpy_n}, {r.cvxpy_failed})", f"{r.cvxpy / r.cpu_per_grasp:.0f}",
+                      str(r.unverified))
     console = Console(width=max(160, Console().width))
     console.print(table)
     console.print("cvxpy rebuilt: force and form closure only (no epsilon), also on the quality rows.")

@@ -2,6 +2,8 @@
 independent fine linearisations, torque scaling, degenerate inputs, Steinitz efficiency."""
 
 import math
+import subprocess
+import sys
 from itertools import product
 
 import numpy as np
@@ -496,3 +498,23 @@ def test_epsilon_rows_are_planar_epsilons_also_where_floats_cannot_decide(monkey
         monkeypatch.undo()
         kinds |= {r["Linf"][3].kind for r in ref}
     assert {"sums", "support"} <= kinds
+
+
+#: A spatial grasp (the 10,494th of ``random_grasp_table(0, 100000, dim=3, n_contacts=3, spread=0.3)``)
+#: on which qhull's incremental mode, once used for the inscribed polytope, hit a precision error and
+#: ended the whole process with exit code 7 and no exception (scipy issue 4974).
+_QHULL_EXIT = [((-0.12583017335373678, -0.6926030617793424, 0.08240230754888508),
+                (0.2565282335436242, 0.7023932218591253, -0.594523249796205), 0.8645646262224405),
+               ((0.6957657578956175, -0.33196433055367264, -0.9660734533235635),
+                (-0.5739031538071512, 0.2548342222720025, 0.42923753305820567), 0.4288170667369781),
+               ((-0.6104408853090029, -0.24305585344434316, 0.7357854124115999),
+                (0.39738360173717646, 0.19147550094834725, -0.23305847241371713), 0.799361815319938)]
+
+
+def test_spatial_epsilon_survives_qhull_precision_errors():
+    code = ("from qualgrasp import Contact, Grasp, epsilon\n"
+            f"g = Grasp(tuple(Contact(p, n, 'point', mu) for p, n, mu in {_QHULL_EXIT!r}))\n"
+            "e = epsilon(g, 'L1')\n"
+            "print(e.lo <= e.hi)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0 and done.stdout.strip() == "True", (done.returncode, done.stderr[-500:])

@@ -30,7 +30,8 @@ from typing import Callable, Iterable, Sequence
 
 from numba import config, njit, types
 
-__all__ = ["cache_dir", "source_fingerprint", "KERNEL_SOURCES", "kernel", "precompile", "F1", "F2", "F3", "I1", "I2", "INT", "FLOAT", "BOOL"]
+__all__ = ["cache_dir", "source_fingerprint", "KERNEL_SOURCES", "kernel",
+           "precompile", "F1", "F2", "F3", "I1", "I2", "INT", "FLOAT", "BOOL"]
 
 #: Argument types as the callers pass them: C-contiguous float64 arrays of 1 to 3 dimensions and
 #: int64 arrays of 1 and 2, and Python's int, float and bool.

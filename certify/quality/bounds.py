@@ -642,15 +642,13 @@ def _support_surface(W, E, owner, m, eps, u, deadline):
         return out
 
     dirs = fresh(dirs)
-    hull, done, limited = None, 0, False
+    hull, done, limited, pts = None, 0, False, None
     while True:
         # the new vertices, as planar_support_vertices gives them (each depends on its own row)
-        pts = sum_rows(W, E, np.array(picks[done:]))[0]
-        try:
-            if hull is None:
-                hull = ConvexHull(pts, incremental=True)
-            else:
-                hull.add_points(pts)
+        new_pts = sum_rows(W, E, np.array(picks[done:]))[0]
+        pts = np.vstack([pts, new_pts]) if done else new_pts
+        try:  # built anew: qhull's incremental mode ends the process on a precision error (scipy issue 4974)
+            hull = ConvexHull(pts)
             done = len(dirs)
         except (QhullError, ValueError):
             return None, limited
@@ -664,7 +662,6 @@ def _support_surface(W, E, owner, m, eps, u, deadline):
         if not new:
             break
         dirs += new
-    hull.close()
     R = np.array(picks)
     return (np.array(dirs),) + sum_rows(W, E, R) + (R,), limited
 
@@ -928,14 +925,11 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
     rounds, hull, done = 0, None, 0
     while not limited:
         rounds += 1
-        try:
-            if hull is None and len(V) > d:
-                hull = ConvexHull(np.array(V), incremental=True)
+        try:  # built anew, not with qhull's incremental mode, whose precision errors end the process
+            if len(V) > d and (hull is None or len(V) > done):  # (scipy issue 4974: exit code 7, no exception)
+                hull = ConvexHull(np.array(V))
                 done = len(V)
-            elif hull is not None and len(V) > done:
-                hull.add_points(np.array(V[done:]))
-                done = len(V)
-        except (QhullError, ValueError):  # a flat or degenerate set: start again from scratch
+        except (QhullError, ValueError):  # a flat or degenerate set: more directions first
             hull = None
         if hull is not None:
             dist = -hull.equations[:, -1]  # qhull's unit outward normals: a guide, not a proof
@@ -968,8 +962,6 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
             add(v)
         if len(V) == before and hv[j] >= hi:
             break  # nothing new to add: the polytope is as good as these directions make it
-    if hull is not None:
-        hull.close()
     faces = surface_faces(np.array(V)) if len(V) > d else None
     direction = tuple(float(v) for v in u_best)
     lo, ev = 0.0, Evidence("none", direction)
