@@ -81,12 +81,7 @@ def _project_off_tight(C, first, width, tight, scale, v):
                 break
             for i in range(d):
                 q[i] = C[i, first[b] + c]
-            for r in range(rank):
-                dot = 0.0
-                for i in range(d):
-                    dot += basis[i, r] * q[i]
-                for i in range(d):
-                    q[i] -= dot * basis[i, r]
+            _remove_components(basis, rank, q)
             nq = 0.0
             for i in range(d):
                 nq += q[i] * q[i]
@@ -95,11 +90,18 @@ def _project_off_tight(C, first, width, tight, scale, v):
                 for i in range(d):
                     basis[i, rank] = q[i] / nq
                 rank += 1
+    _remove_components(basis, rank, v)
+
+
+@kernel
+def _remove_components(basis, rank, v):
+    """Subtract from ``v``, in place and in order, its component along each of the first ``rank``
+    orthonormal columns of ``basis`` (modified Gram-Schmidt)."""
     for r in range(rank):
         dot = 0.0
-        for i in range(d):
+        for i in range(v.shape[0]):
             dot += basis[i, r] * v[i]
-        for i in range(d):
+        for i in range(v.shape[0]):
             v[i] -= dot * basis[i, r]
 
 
