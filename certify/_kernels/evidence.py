@@ -59,26 +59,32 @@ def minkowski_sums(W, E, owner, m):
             o = rest % size
             rest //= size
             choice[p, i] = -1 if o == 0 else start[i] + o - 1
-    factor = 2 * (m + 1) * 2.0**-53
     pts = np.zeros((B, n, 3))
     err = np.zeros((B, n, 3))
     for b in range(B):
         for p in range(n):
-            for r in range(3):
-                s, e, a = 0.0, 0.0, 0.0
-                for i in range(m):
-                    j = choice[p, i]
-                    if j >= 0:
-                        s = s + W[b, r, j]
-                        e = e + E[b, r, j]
-                        a = a + abs(W[b, r, j])
-                    else:  # the origin, added as the per-grasp route adds it
-                        s = s + 0.0
-                        e = e + 0.0
-                        a = a + 0.0
-                pts[b, p, r] = s
-                err[b, p, r] = e + factor * a
+            _pick_sum(W[b], E[b], choice[p], pts[b, p], err[b, p])
     return pts, err, choice
+
+
+@kernel
+def _pick_sum(W, E, picks, v, ev):
+    """Into ``v`` and ``ev`` (3,): the sum of the columns of ``W`` (3, k) that ``picks`` (m,;
+    -1 picks none) names, added in order from zero, and the bound on its error: the sum of
+    their ``E`` plus ``2 (m + 1) u`` times the sum of their magnitudes
+    (:func:`qualgrasp.certify.quality.gws.sum_errors`). Adding nothing for the origin is adding
+    ``+0.0``: a sum started at ``+0.0`` is never ``-0.0``."""
+    factor = 2 * (picks.shape[0] + 1) * 2.0**-53
+    for r in range(3):
+        s, e, a = 0.0, 0.0, 0.0
+        for i in range(picks.shape[0]):
+            j = picks[i]
+            if j >= 0:
+                s = s + W[r, j]
+                e = e + E[r, j]
+                a = a + abs(W[r, j])
+        v[r] = s
+        ev[r] = e + factor * a
 
 
 @kernel
@@ -171,19 +177,9 @@ def vertex_sums(W, E, R):
     """Sums of generators: for each row of ``R`` (n, m; -1 picks none) the sum of the columns
     of ``W`` (3, k) it picks, added in order from zero, and the bound on its error of
     :func:`minkowski_sums`. Returns ``(V, EV)``, both (n, 3)."""
-    n, m = R.shape
+    n = R.shape[0]
     V = np.zeros((n, 3))
     EV = np.zeros((n, 3))
-    factor = 2 * (m + 1) * 2.0**-53
     for q in range(n):
-        for r in range(3):
-            s, e, a = 0.0, 0.0, 0.0
-            for i in range(m):
-                j = R[q, i]
-                if j >= 0:
-                    s = s + W[r, j]
-                    e = e + E[r, j]
-                    a = a + abs(W[r, j])
-            V[q, r] = s
-            EV[q, r] = e + factor * a
+        _pick_sum(W, E, R[q], V[q], EV[q])
     return V, EV

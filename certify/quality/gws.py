@@ -53,7 +53,7 @@ def surfaces_faces(point_sets) -> list[np.ndarray | None]:
     """:func:`surface_faces` of each of ``point_sets`` (arrays (n_i, d) of one ``d``): qhull
     runs once per set, the orientation once for all (the determinant of each face is computed
     as for a single set, so the faces are the same)."""
-    hulls, offset, points, starts = [], 0, [], []
+    hulls, offset, points = [], 0, []
     for pts in point_sets:
         try:
             hulls.append(np.asarray(ConvexHull(pts).simplices, dtype=np.int64) + offset)
