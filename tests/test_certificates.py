@@ -1,6 +1,7 @@
 """Certificates re-check without a solver; tampered ones are rejected."""
 
 import dataclasses
+import functools
 
 import numpy as np
 import pytest
@@ -9,23 +10,27 @@ from qualgrasp.certify import Certificate, certify_grasp, force_closure, form_cl
 from qualgrasp.experiments.bench import KINDS
 from qualgrasp.certify.batch import random_grasps, textbook_grasps
 
-KIND_GRASPS = {kind: random_grasps(7, 150, **kw) for kind, kw in KINDS.items()}
+@functools.cache
+def _grasps(kind: str) -> list:
+    """150 random grasps of a bench kind, made once when first asked for (not at collection,
+    which every test process does)."""
+    return random_grasps(7, 150, **KINDS[kind])
 
 
 @pytest.mark.parametrize("kind", list(KINDS))
 def test_every_certificate_verifies(kind):
-    for g in KIND_GRASPS[kind]:
+    for g in _grasps(kind):
         report = certify_grasp(g)
         assert report.verified, g
 
 
 def _verdicts(kind, status):
-    out = [(g, force_closure(g)) for g in KIND_GRASPS[kind]]
+    out = [(g, force_closure(g)) for g in _grasps(kind)]
     return [(g, v) for g, v in out if v.status == status]
 
 
 def _other(kind, g):
-    return next(h for h in KIND_GRASPS[kind] if h is not g)
+    return next(h for h in _grasps(kind) if h is not g)
 
 
 @pytest.mark.parametrize("kind", list(KINDS))

@@ -106,7 +106,9 @@ def test_extents_on_polygons_with_contacts_near_corners(vertices, fingers, mu):
     assert clipped, "no contact was clipped: the test does not reach the case it is about"
 
 
-@pytest.mark.parametrize("name", ["figure3", "polygon", "nut", "disc"])
+# dense sampling: the two curved objects (about 10 s each) in the slow set
+@pytest.mark.parametrize("name", ["figure3", "polygon", pytest.param("nut", marks=pytest.mark.slow),
+                                  pytest.param("disc", marks=pytest.mark.slow)])
 def test_extents_on_the_builtin_objects(name):
     """Random two- and three-finger grasps on the outline of each built-in object, and the
     qualitative route's grasps, with the feasible regions as limits."""

@@ -36,7 +36,8 @@ def image():
 
 
 class _Syntheses(dict):
-    """The syntheses figures 5 to 8 draw, by finger count, each computed once on first use."""
+    """The syntheses figures 5 to 9 draw, by finger count, each computed once on first use; with
+    the certified tolerance for three fingers only (figure 9's), as :func:`figures.make_figures`."""
 
     def __init__(self, image):
         super().__init__()
@@ -44,7 +45,7 @@ class _Syntheses(dict):
 
     def __missing__(self, fingers):
         self[fingers] = synthesize(self.image, fingers, mu=None if fingers == 4 else figures.MU,
-                                   name=figures.OBJECT)
+                                   name=figures.OBJECT, tolerance=fingers == 3)
         return self[fingers]
 
 

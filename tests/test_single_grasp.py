@@ -61,12 +61,16 @@ def _grasps() -> list[Grasp]:
     return grasps + mixed
 
 
-GRASPS = _grasps()
+@pytest.fixture(scope="module")
+def grasps() -> list[Grasp]:
+    """The grasps of the comparisons, made once when a test of the module first runs (not at
+    collection, which every test process does)."""
+    return _grasps()
 
 
-def test_the_compiled_route_states_the_array_routes_programme_bit_for_bit():
-    assert len(GRASPS) >= 2000
-    for grasp in GRASPS:
+def test_the_compiled_route_states_the_array_routes_programme_bit_for_bit(grasps):
+    assert len(grasps) >= 2000
+    for grasp in grasps:
         new, old = grasp_problem(grasp), _array_route(grasp)
         assert isinstance(new.to_values, np.ndarray)  # no sparse map for one small grasp
         assert _same_bits(new.columns, old.columns) and _same_bits(new.to_values, old.to_values)
@@ -75,9 +79,9 @@ def test_the_compiled_route_states_the_array_routes_programme_bit_for_bit():
                (old.rays, old.cones, old.system.blocks, old.system.layout)
 
 
-def test_verdicts_margins_and_certificates_are_the_array_routes_and_all_verify():
+def test_verdicts_margins_and_certificates_are_the_array_routes_and_all_verify(grasps):
     statuses = set()
-    for grasp in GRASPS:
+    for grasp in grasps:
         v = force_closure(grasp)
         ref = decide(_array_route(grasp), lambda g=grasp: grasp_system(g, exact=True).columns,
                      make_solver("fast"))
@@ -154,7 +158,7 @@ def _project_out_by_fractions(y, A):
     return [y[r] - sum(B[r][i] * c[i] for i in range(k)) for r in range(len(B))]
 
 
-def test_the_exact_projection_in_integers_is_the_fraction_formula():
+def test_the_exact_projection_in_integers_is_the_fraction_formula(grasps):
     """exact.project_out (integers, fraction-free) gives the very rationals of the formula over
     Fractions: on the tight columns of real certificates, and on random rank-deficient matrices
     of floats, of rationals with odd denominators, and with repeated columns."""
@@ -165,7 +169,7 @@ def test_the_exact_projection_in_integers_is_the_fraction_formula():
 
     rng = np.random.default_rng(9)
     cases = []
-    for grasp in GRASPS[::4]:
+    for grasp in grasps[::4]:
         v = force_closure(grasp)
         if v.certificate.kind == "farkas" and v.certificate.tight:
             Cx = grasp_system(grasp, exact=True)

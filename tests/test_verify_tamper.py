@@ -22,7 +22,7 @@ import pyarrow.parquet as pq
 import pytest
 from typer.testing import CliRunner
 
-from qualgrasp.certify import Contact, Grasp
+from qualgrasp.certify import Contact, Grasp, force_closure
 from qualgrasp.certify.batch import certify_file, verify_file
 from qualgrasp.certify.files import write_grasps
 from qualgrasp.certify.files import NAMES, RESULT_SCHEMA
@@ -36,11 +36,17 @@ DEEP = 100_000  # nesting depth of the line-level tampering (beyond json's recur
 
 
 def _grasps():
+    """The rows tampered with (:func:`_targets`) and a pad grasp: each tampered file is verified
+    whole over a thousand times, so it holds no other row."""
     planar = random_grasps(8, 12, dim=2, n_contacts=3)
     pad = Grasp((Contact((1, 0), (-1, 0), "pad", mu=0.5, width=0.4),
                  Contact((-1, 0), (1, 0), "pad", mu=0.5, width=0.4)), id="pads")
     spatial = random_grasps(9, 4, dim=3, n_contacts=3, model="point", spread=0.3)
-    return planar + [pad] + [Grasp(g.contacts, id=f"s{i}") for i, g in enumerate(spatial)]
+    status = [force_closure(g).status for g in planar]
+    closure = next(g for g, s in zip(planar, status) if s == "closure")
+    no_closure = next(g for g, s in zip(planar, status) if s == "no_closure")
+    spatial = next(g for g in spatial if force_closure(g).status == "closure")
+    return [closure, no_closure, pad, Grasp(spatial.contacts, id="s0")]
 
 
 @pytest.fixture(scope="module")

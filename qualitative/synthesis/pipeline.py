@@ -612,7 +612,7 @@ def synthesize(image: ImageSource, fingers: int | None = None, mu: float | None 
     --------
     >>> from qualgrasp.qualitative.objects import render
     >>> from qualgrasp.qualitative.synthesis.pipeline import synthesize
-    >>> s = synthesize(render("polygon"), procedure="formgrasp", quality=False)
+    >>> s = synthesize(render("polygon"), procedure="formgrasp", quality=False, tolerance=False)
     >>> s.procedure.title, s.fingers, len(s.grasps) > 0, all(s.certified)
     ('FormGrasp', 4, True, True)
     """
