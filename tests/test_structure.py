@@ -19,9 +19,11 @@ ROOT = pathlib.Path(qualgrasp.__file__).parent
 #: Imports allowed inside functions: optional dependencies (dask.distributed, pymunk, h5py for ACRONYM
 #: pose files, embreex and trimesh's embree route where embreex installs), a platform module
 #: (resource), cvxpy's reference route (1.5 s to import; only ``make_solver("reference")``
-#: needs it), and cvxopt, which only Dex-Net's code run by ``bench --single --dexnet`` needs.
+#: needs it), cvxopt, which only Dex-Net's code run by ``bench --single --dexnet`` needs, and the
+#: meshes' pose source in ``certify``'s command (trimesh and networkx: 0.2 s of every ``certify``
+#: start-up, for runs on a mesh only).
 LAZY = {"distributed", "resource", "qualgrasp.certify.solvers.reference", "h5py", "embreex",
-        "trimesh.ray.ray_pyembree", "pymunk", "mujoco", "coacd", "cvxopt"}
+        "trimesh.ray.ray_pyembree", "pymunk", "mujoco", "coacd", "cvxopt", "qualgrasp.certify.meshes.source"}
 
 MODULES = import_graph.modules(ROOT)
 

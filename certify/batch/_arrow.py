@@ -14,8 +14,15 @@ from ..files.results import CERTIFICATE, RESULT_SCHEMA, carried_name, result_tab
 __all__ = ["list_array", "certificates", "group_table", "assemble", "carry"]
 
 
-_STATUS = pa.array(["no_closure", "closure", "degenerate"])
-_KIND = pa.array(["farkas", "interior", "degenerate"])
+# built at first use: pyarrow imports pandas (when installed) for its first array, about 0.15 s
+# that a run writing JSON Lines never needs
+_STATUS = ("no_closure", "closure", "degenerate")
+_KIND = ("farkas", "interior", "degenerate")
+
+
+def _labels(names: tuple[str, ...], code: np.ndarray) -> pa.Array:
+    """The string of ``names`` for each verdict code (:func:`_kind_index`)."""
+    return pa.array(names).take(_kind_index(code))
 
 
 def _kind_index(code: np.ndarray) -> pa.Array:
@@ -64,7 +71,7 @@ def certificates(code: np.ndarray, lam: np.ndarray, basis: np.ndarray, y: np.nda
     tight_arr = pa.ListArray.from_arrays(pa.array(offsets), pa.array(flat, type=pa.int32()),
                                          mask=pa.array(~farkas))
     return pa.StructArray.from_arrays([
-        _KIND.take(_kind_index(code)),
+        _labels(_KIND, code),
         pa.array([layout]).take(pa.array(np.zeros(n, np.int8))),
         list_array(lam, interior, CERTIFICATE.field("values").type),
         list_array(basis.astype(np.int32), interior, CERTIFICATE.field("basis").type),
@@ -100,11 +107,11 @@ def group_table(cols: GraspColumns, rows: np.ndarray, lines: np.ndarray, out, op
         "id": cols.id_column(rows),
         "line": pa.array(lines, type=pa.int64()),
         "dim": pa.array(np.full(n, dim, dtype=np.int8)),
-        "status": _STATUS.take(_kind_index(code)),
+        "status": _labels(_STATUS, code),
         "form_closure": pa.array(fclosure, mask=fcode == 5),
         "force_closure": pa.array(closure, mask=code == 5),
         "margin": pa.array(np.where(closure, t, 0.0)),
-        "form_status": _STATUS.take(_kind_index(fcode)),
+        "form_status": _labels(_STATUS, fcode),
         "form_margin": pa.array(np.where(fclosure, ft, 0.0)),
         "certificate": cert,
         "verified": pa.array(out.get("verified", np.ones(n, dtype=bool))),

@@ -24,7 +24,6 @@ from ..regions.files import DEFAULT_BUDGET, certify_region_file, verify_region_f
 from ..batch.samples import DEGENERATE, write_random_grasp_file
 from ..files.reader import count_grasps
 from ..core.validation import MAX_CONTACTS
-from ..meshes.source import PoseSource, check_pose_file
 from .options import fail, printable
 
 __all__ = ["register"]
@@ -98,6 +97,8 @@ def certify_command(
         fail(f"--{next(iter(mesh_options))} needs --mesh")
     source = None
     if mesh is not None:
+        from ..meshes.source import PoseSource, check_pose_file  # trimesh: only for a run on a mesh
+
         try:
             check_pose_file(grasps)
             source = PoseSource.of(mesh, **mesh_options)
