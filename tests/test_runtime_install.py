@@ -94,3 +94,41 @@ def test_the_cache_folder_changes_with_any_kernel_source(tmp_path):
     callee = next(c for c in copies if c.name == "cones.py" and c.parent.name == "_kernels")
     callee.write_text(callee.read_text() + "\n# an edit\n")
     assert source_fingerprint(tuple(copies)) != before
+
+
+def test_await_compiled_waits_for_the_process_compiling_the_set(tmp_path, monkeypatch):
+    """While a kernel set's lock is held (here by another open file of this process, as by the
+    process compiling it), await_compiled does not return; when nobody holds it, at once."""
+    import fcntl
+    import threading
+
+    from qualgrasp.certify._kernels.jit import await_compiled, cache_dir
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    await_compiled("demo")  # no lock file: nobody compiles it
+    fd = os.open(Path(cache_dir()) / "demo.lock", os.O_RDWR | os.O_CREAT)
+    fcntl.flock(fd, fcntl.LOCK_EX)
+    released = threading.Event()
+
+    def release():
+        released.set()
+        os.close(fd)
+
+    threading.Timer(0.2, release).start()
+    await_compiled("demo")
+    assert released.is_set()
+    await_compiled("demo")  # released: at once
+
+
+def test_a_cold_cache_gets_a_kernel_set_compiled_by_another_process_once(tmp_path, monkeypatch):
+    from qualgrasp.certify._kernels.jit import await_compiled, cache_dir, compile_elsewhere
+    from qualgrasp.certify.quality.bounds import KERNEL_SETS
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    folder = Path(cache_dir())
+    assert compile_elsewhere("qualgrasp.certify.quality.bounds", "quality-spatial")
+    await_compiled("quality-spatial")
+    assert (folder / "quality-spatial.compiled").exists()
+    for fn, _ in KERNEL_SETS["quality-spatial"]:  # each kernel's cache index, written there
+        assert any(folder.rglob(f"*.{fn.__name__}-*.nbi")), fn.__name__
+    assert not compile_elsewhere("qualgrasp.certify.quality.bounds", "quality-spatial")  # marked: not again

@@ -17,21 +17,37 @@ it calls, which are compiled into it: a kernel cached before a change to a kerne
 another module, or in a new release) would be loaded with the old callee. The cache folder is
 therefore named by :func:`source_fingerprint`, a digest of every kernel module and of the
 constants they import, so that a changed kernel source starts a fresh cache.
+
+A *kernel set* (a module's ``KERNEL_SETS[name]``, pairs for :func:`precompile`) can be compiled
+into the cache by another process while this one works on something else: on a cold cache the
+first ``qualgrasp certify`` with quality compiles closure's kernels here and quality's in a second
+process, on a second core (:func:`compile_elsewhere`, :func:`await_compiled`). The cache folder
+then holds ``NAME.compiled`` once the set is in it, and ``NAME.lock``, locked (``flock``) by the
+process compiling it. Where ``fcntl`` is missing (Windows) every process compiles what it needs.
 """
 
 from __future__ import annotations
 
 import functools
 import hashlib
+import importlib
 import os
+import subprocess
+import sys
 import tempfile
+import time
 from pathlib import Path
 from typing import Callable, Iterable, Sequence
 
 from numba import config, njit, types
 
+try:
+    import fcntl
+except ImportError:  # Windows: no flock, no compiling elsewhere
+    fcntl = None
+
 __all__ = ["cache_dir", "source_fingerprint", "KERNEL_SOURCES", "kernel",
-           "precompile", "F1", "F2", "F3", "I1", "I2", "INT", "FLOAT", "BOOL"]
+           "precompile", "compile_elsewhere", "await_compiled", "compile_set", "mark_compiled", "WAIT_SECONDS", "F1", "F2", "F3", "I1", "I2", "INT", "FLOAT", "BOOL"]
 
 #: Argument types as the callers pass them: C-contiguous float64 arrays of 1 to 3 dimensions and
 #: int64 arrays of 1 and 2, and Python's int, float and bool.
@@ -137,3 +153,83 @@ def precompile(signatures: Iterable[tuple[Callable, tuple]]) -> None:
         overloads = getattr(fn, "overloads", None)
         if overloads is not None and args not in overloads:
             fn.compile(args)
+
+
+#: Longest wait (s) for another process compiling a kernel set (:func:`await_compiled`): past it
+#: the waiting process compiles the set itself.
+WAIT_SECONDS = 300.0
+
+
+def _set_file(name: str, suffix: str) -> str | None:
+    path = cache_dir() if fcntl is not None and not config.DISABLE_JIT else None
+    return None if path is None else os.path.join(path, name + suffix)
+
+
+def compile_elsewhere(module: str, name: str) -> bool:
+    """Start a process compiling the kernel set ``KERNEL_SETS[name]`` of ``module`` into the
+    on-disk cache (:func:`compile_set`), unless the cache holds it (``NAME.compiled``), another
+    process is compiling it, or there is no cache or no ``fcntl``. Returns whether it started.
+
+    The new process inherits the lock on ``NAME.lock`` taken here, so :func:`await_compiled`
+    waits for it from the moment this returns; the lock ends with that process, however it ends.
+    """
+    lock = _set_file(name, ".lock")
+    if lock is None or os.path.exists(_set_file(name, ".compiled")):
+        return False
+    fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:  # another process compiles it
+        os.close(fd)
+        return False
+    code = f"from qualgrasp.certify._kernels.jit import compile_set; compile_set({module!r}, {name!r})"
+    try:
+        subprocess.Popen([sys.executable, "-c", code], pass_fds=(fd,), stdin=subprocess.DEVNULL,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    except OSError:
+        return False
+    finally:
+        os.close(fd)  # the lock stays with the new process
+    return True
+
+
+def await_compiled(name: str, timeout: float = WAIT_SECONDS) -> None:
+    """Wait while another process compiles the kernel set ``name`` (holds ``NAME.lock``), at
+    most ``timeout`` seconds; at once when none does."""
+    lock = _set_file(name, ".lock")
+    if lock is None:
+        return
+    try:
+        fd = os.open(lock, os.O_RDONLY)
+    except OSError:  # no lock file: nobody compiles it
+        return
+    try:
+        end = time.monotonic() + timeout
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+                return
+            except OSError:
+                if time.monotonic() > end:
+                    return
+                time.sleep(0.02)
+    finally:
+        os.close(fd)
+
+
+def mark_compiled(name: str) -> None:
+    """Record that the cache holds the kernel set ``name`` (``NAME.compiled``), so that no
+    process compiles it elsewhere again."""
+    marker = _set_file(name, ".compiled")
+    if marker is not None and not os.path.exists(marker):
+        try:
+            Path(marker).touch()
+        except OSError:  # a cache that cannot take it: the set is compiled where needed
+            pass
+
+
+def compile_set(module: str, name: str) -> None:
+    """Compile (or load) the kernel set ``KERNEL_SETS[name]`` of ``module`` and mark it
+    compiled: what the process :func:`compile_elsewhere` starts runs."""
+    precompile(importlib.import_module(module).KERNEL_SETS[name])
+    mark_compiled(name)

@@ -35,6 +35,7 @@ from ..errors import CertifyError, GraspFileError
 from .fastpath import certify_table
 from ._recheck import recheck_table, schema_matches
 from ..report import certify_grasp, verify_row
+from ..quality.bounds import compile_ahead
 from ..files.results import NAMES, carried_clash, carried_name, error_row
 from ..solvers import METHODS, Method, make_solver
 from ..core.arguments import choice, count_in, number_in, require
@@ -95,6 +96,8 @@ def certify_rows(cols: GraspColumns, rows: Sequence[int], lines: Sequence[int],
     """Results rows of ``rows`` of checked columns, grasp by grasp (``lines[k]`` is the line of
     ``rows[k]``); invalid rows become error rows."""
     solver = make_solver(options.method)
+    if options.quality:  # on a cold compile cache, quality's kernels compile on another core meanwhile
+        compile_ahead(cols.dim[[i for i in rows if cols.ok[i]]])
     out = []
     for i, line in zip(rows, lines):
         gid = cols.id_of(i)

@@ -57,8 +57,8 @@ verdict and reports the bounds reached (planar L-infinity: ``hi`` the best suppo
 ``lo`` and the best ``hi``), with ``limited`` set whenever the limit cut a bound. Results then
 depend on the machine's speed; without the limit being hit they are deterministic. The clock
 counts computation only: it starts once the closure verdict is known, and the kernels are
-compiled (or loaded from numba's cache) before it runs, so a cold compile cache never changes a
-result.
+compiled (or loaded from numba's cache, or awaited from another process compiling them into a
+cold cache: :func:`compile_ahead`) before it runs, so a cold compile cache never changes a result.
 
 Epsilon is 0 for grasps not in closure (and for degenerate ones): the closure verdict is decided
 first, so flat hulls and rank-deficient sets never reach qhull.
@@ -86,7 +86,8 @@ from scipy.spatial import ConvexHull, QhullError
 from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .._kernels.epsilon import planar_epsilon as epsilon_kernel
 from .._kernels.evidence import minkowski_sums, support_choices, surface_rows, vertex_sums
-from .._kernels.jit import BOOL, F1, F2, F3, FLOAT, I1, I2, INT, precompile
+from .._kernels.jit import (BOOL, F1, F2, F3, FLOAT, I1, I2, INT, await_compiled, compile_elsewhere, mark_compiled,
+                           precompile)
 from .._kernels.planar import planar_generators
 from .._kernels.surface import cycle_code, face_bounds, leibniz_tables
 from ..core.arguments import count_in, number_in, require
@@ -101,7 +102,7 @@ from ..solvers.clarabel_direct import settings
 
 __all__ = ["Norm", "NORMS", "Epsilon", "epsilon", "epsilons", "planar_epsilon", "planar_epsilons",
            "planar_epsilon_rows", "epsilon_of_points", "check_norm", "L1_ENUMERATION_MAX",
-           "LINF_ENUMERATION_MAX", "SUMS_MAX", "MAX_VERTICES", "SOCP_COST"]
+           "LINF_ENUMERATION_MAX", "SUMS_MAX", "MAX_VERTICES", "SOCP_COST", "KERNEL_SETS", "compile_ahead"]
 
 #: A norm of the grasp wrench space.
 Norm = Literal["L1", "Linf"]
@@ -139,6 +140,8 @@ _PLANAR_KERNELS = _SURFACE_KERNELS + (
     (support_choices, (F2, I1, INT, F2)),
     (vertex_sums, (F2, F2, I2)),
 )
+#: Those kernel sets by name (:func:`compile_ahead`; :mod:`qualgrasp.certify._kernels.jit`).
+KERNEL_SETS = {"quality-planar": _PLANAR_KERNELS, "quality-spatial": _SURFACE_KERNELS}
 
 
 @dataclass(frozen=True)
@@ -213,12 +216,34 @@ def _expired(deadline: float | None) -> bool:
     return deadline is not None and time.perf_counter() > deadline
 
 
-def _after_compiling(deadline: float | None, kernels) -> float | None:
-    """Compile ``kernels`` (:func:`~qualgrasp.certify._kernels.jit.precompile`) and return
-    ``deadline`` pushed back by the time that took: a time limit counts computation, never
-    compilation, so that a cold compile cache cannot change a result."""
+def _set_name(dim: int) -> str:
+    return "quality-planar" if dim == 2 else "quality-spatial"
+
+
+def compile_ahead(dims) -> None:
+    """Have another process compile quality's kernels for grasps of ``dims`` (2, 3) into the
+    compile cache when it lacks them, while this one certifies closure: on a cold cache two cores
+    compile at once (:func:`qualgrasp.certify._kernels.jit.compile_elsewhere`). A no-op on a warm
+    cache, and the results are the same either way.
+
+    Examples
+    --------
+    >>> compile_ahead([2])   # the cache holds them: nothing to do
+    """
+    for dim in sorted({int(d) for d in dims} & {2, 3}):
+        compile_elsewhere(__name__, _set_name(dim))
+
+
+def _after_compiling(deadline: float | None, dim: int) -> float | None:
+    """Compile the kernel set of ``dim`` (:data:`KERNEL_SETS`), first waiting for another process
+    compiling it (:func:`compile_ahead`), and return ``deadline`` pushed back by the time that
+    took: a time limit counts computation, never compilation, so that a cold compile cache cannot
+    change a result."""
     start = time.perf_counter()
-    precompile(kernels)
+    name = _set_name(dim)
+    await_compiled(name)
+    precompile(KERNEL_SETS[name])
+    mark_compiled(name)
     return None if deadline is None else deadline + (time.perf_counter() - start)
 
 
@@ -318,7 +343,7 @@ def planar_epsilons(W, E, owner, m: int, *, deadline: float | None = None, exact
     dict
         ``{"L1": (lo, hi, direction, evidence, limited), "Linf": (...)}``.
     """
-    deadline = _after_compiling(deadline, _PLANAR_KERNELS)
+    deadline = _after_compiling(deadline, 2)
     W = np.ascontiguousarray(W, dtype=float)
     E = np.ascontiguousarray(E, dtype=float)
     owner = np.ascontiguousarray(owner, dtype=np.int64)
@@ -426,7 +451,7 @@ def planar_epsilon_rows(W, E, owner, m: int, *, time_limit: float | None = None,
     >>> round(row["L1"][0], 6), row["Linf"][3].kind
     (0.333333, 'sums')
     """
-    _after_compiling(None, _PLANAR_KERNELS)
+    _after_compiling(None, 2)
     W = np.ascontiguousarray(W, dtype=float)
     E = np.ascontiguousarray(E, dtype=float)
     owner = np.ascontiguousarray(owner, dtype=np.int64)
@@ -774,7 +799,7 @@ def epsilons(grasp: Grasp, norms=NORMS, *, rel_gap: float = 0.01, budget: int = 
     if verdict.status != "closure":
         return {norm: _zero(grasp, norm) for norm in norms}
     deadline = None if time_limit is None else time.perf_counter() + time_limit
-    deadline = _after_compiling(deadline, _PLANAR_KERNELS if grasp.dim == 2 else _SURFACE_KERNELS)
+    deadline = _after_compiling(deadline, grasp.dim)
     center, length = tuple(grasp.center), grasp.length
     out = {}
     if grasp.dim == 2:
