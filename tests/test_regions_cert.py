@@ -656,3 +656,36 @@ def test_cli_independent_regions(tmp_path):
     assert "from the outline" in errors[0]["error"] and errors[1]["error"].startswith(f"line {len(rows)}: malformed")
     assert runner.invoke(app, ["independent-regions", str(tmp_path / "none.png"), str(grasps), "-o", str(out)]).exit_code == 2
     assert runner.invoke(app, ["independent-regions", str(image), str(grasps), "-o", str(grasps)]).exit_code == 2
+
+
+@settings(max_examples=60)
+@given(st.integers(1, 40), st.integers(0, 2**32 - 1),
+       st.sampled_from([("point", 0.5, None), ("frictionless", None, None), (None, 0.3, None), ("pad", 0.4, 0.02),
+                        ("point", 0.0, None), ("soft", 0.5, None), ("point", -1.0, None), ("nope", None, None)]),
+       st.sampled_from(["ok", "nan", "zero-normal", "far", "float32"]))
+def test_curved_regions_from_arrays_are_those_from_lists(k, seed, model, twist):
+    """A curved region given as arrays (the boundary's sub-curves) is the region given as lists,
+    bit for bit, or fails with the same message."""
+    rng = np.random.default_rng(seed)
+    P, N = rng.normal(size=(k, 2)), rng.normal(size=(k, 2))
+    if twist == "nan":
+        P[rng.integers(k)] = np.nan
+    elif twist == "zero-normal":
+        N[rng.integers(k)] = 0.0
+    elif twist == "far":
+        P[rng.integers(k)] = 1e300
+    elif twist == "float32":
+        P, N = P.astype(np.float32), N.astype(np.float32)
+    name, mu, width = model
+
+    def make(points, normals):
+        try:
+            return CurvedRegion(points, normals, name, mu=mu, width=width)
+        except GraspError as err:
+            return str(err)
+
+    a, b = make(P, N), make(P.tolist(), N.tolist())
+    if isinstance(b, str):
+        assert a == b
+    else:
+        assert a == b and a.points.tobytes() == b.points.tobytes() and a.normals.tobytes() == b.normals.tobytes()

@@ -47,7 +47,7 @@ from .. import models as registry
 from ..models import MAX_LENGTH, MIN_LENGTH
 
 __all__ = ["MAX_CONTACTS", "MIN_NORMAL", "ABSENT", "UNKNOWN", "ContactData", "GraspData",
-           "Checked", "show", "show_repr", "number", "numbers", "contact_data", "grasp_data",
+           "Checked", "show", "show_repr", "number", "numbers", "contact_data", "contact_arrays", "grasp_data",
            "check_contacts", "check_grasps", "grasp_rules", "CheckedGrasps", "param_names", "TOP_LEVEL",
            "id_problem"]
 
@@ -187,6 +187,42 @@ def contact_data(values: Sequence[Any]) -> ContactData:
             data.given[name][j] = True
             data.raw[(j, name)] = c[name]
         data.errors[j] = error
+    return data
+
+
+def contact_arrays(p: np.ndarray, n: np.ndarray, model: str | None = None,
+                   params: Mapping[str, Any] | None = None) -> ContactData | None:
+    """Read contacts given as float arrays ``p`` and ``n`` (k, 2) or (k, 3), one model name (or
+    None: the default rule) and one value per parameter (None: not given) for every contact: the
+    data :func:`contact_data` reads from the equivalent mappings, without a Python value per
+    number. None when a value is not of those types (:func:`contact_data` then says which).
+
+    Examples
+    --------
+    >>> data = contact_arrays(np.array([[1.0, 0.0]]), np.array([[-1.0, 0.0]]), "point", {"mu": 0.5})
+    >>> check_contacts(data).params["mu"].tolist()
+    [0.5]
+    """
+    ok = (isinstance(p, np.ndarray) and isinstance(n, np.ndarray) and p.dtype.kind == "f" and n.dtype.kind == "f"
+          and p.ndim == 2 and p.shape == n.shape and p.shape[1] in (2, 3) and (model is None or isinstance(model, str)))
+    if not ok:
+        return None
+    k, d = p.shape
+    data = ContactData.empty(k)
+    data.p[:, :d], data.n[:, :d] = p, n
+    data.plen[:], data.nlen[:] = d, d
+    if model is not None:
+        names = registry.names()
+        data.names = [model] * k
+        data.model[:] = names.index(model) if model in names else UNKNOWN
+    for name, value in (params or {}).items():
+        if value is None:
+            continue
+        x = number(value)
+        if x is None or name not in data.params:
+            return None
+        data.params[name][:] = x
+        data.given[name][:] = True
     return data
 
 

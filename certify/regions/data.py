@@ -53,7 +53,7 @@ from .. import models as registry
 from ..errors import GraspError
 from ..core.grasp import Contact
 from ..models import MAX_LENGTH, MIN_LENGTH
-from ..core.validation import check_contacts, contact_data, number, numbers, param_names, show
+from ..core.validation import check_contacts, contact_arrays, contact_data, number, numbers, param_names, show
 
 __all__ = ["MAX_NORMAL_TOL", "MAX_TURN", "MAX_REGIONS", "MAX_POINTS", "StraightRegion", "CurvedRegion",
            "Region", "RegionTuple", "region_from_dict", "region_to_dict", "tuple_from_dict",
@@ -84,13 +84,40 @@ def _check_model(prefix: str, items: list[dict], names: Mapping[str, str]):
         raise GraspError(f"{prefix}{names.get((j, field), field)}:{rest}")
     if len(items) and (checked.dim != 2).any():
         raise GraspError(f"{prefix}model: regions are planar")
+    model = _without_planar_generators(checked)
+    if model is not None:
+        raise GraspError(f"{prefix}model: {model!r} contacts have no planar generators; "
+                         f"regions take {', '.join(_planar_models())}")
+    return checked
+
+
+def _without_planar_generators(checked) -> str | None:
+    """The name of a checked contacts' model (and variant) without planar generators, if any."""
     for code in set(checked.model.tolist()):
         model = registry.get(int(code))
         for variant in set(checked.variant[checked.model == code].tolist()):
             if model.generators(2, int(variant)) is None:
-                raise GraspError(f"{prefix}model: {model.name!r} contacts have no planar generators; "
-                                 f"regions take {', '.join(_planar_models())}")
-    return checked
+                return model.name
+    return None
+
+
+def _checked_arrays(points, normals, model, mu, width):
+    """``(P, checked)`` of a curved region given as float arrays that pass every rule, as the
+    reading of lists gives them; None otherwise (that reading then states the problem)."""
+    if not (isinstance(points, np.ndarray) and isinstance(points, type(normals)) and points.ndim == 2
+            and points.shape[1:] == (2,) and 1 <= len(points) <= MAX_POINTS):
+        return None
+    P = np.array(points, dtype=float)
+    if not (np.isfinite(P).all() and np.abs(P).max() <= MAX_LENGTH and np.isfinite(normals).all()):
+        return None
+    data = contact_arrays(P, np.asarray(normals), model, {"mu": mu, "width": width})
+    if data is None:
+        return None
+    checked = check_contacts(data)
+    if any(err is not None for err in checked.error) or (checked.dim != 2).any() \
+            or _without_planar_generators(checked) is not None:
+        return None
+    return P, checked
 
 
 def _planar_models() -> list[str]:
@@ -250,6 +277,16 @@ class CurvedRegion(_ModelParams):
 
     def __init__(self, points, normals, model: str | None = "frictionless", mu: float | None = None,
                  width: float | None = None, *, _prefix: str = "") -> None:
+        fast = _checked_arrays(points, normals, model, mu, width)
+        if fast is not None:  # valid float arrays (sub-curves of a boundary): no Python value per number
+            P, checked = fast
+            N = np.ascontiguousarray(checked.n[:, :2], dtype=float)
+            P.setflags(write=False)
+            N.setflags(write=False)
+            object.__setattr__(self, "points", P)
+            object.__setattr__(self, "normals", N)
+            _set_model(self, checked)
+            return
         if isinstance(points, np.ndarray):
             points = points.tolist()
         if isinstance(normals, np.ndarray):
