@@ -122,12 +122,10 @@ def _line(value) -> bytes:
         return b"{"
 
 
-@settings(max_examples=100, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large], deadline=None)
-@given(st.lists(st.one_of(grasps, json_values), min_size=50, max_size=50))
-def test_generated_lines_give_one_row_each(values):
-    """50 hostile values per example (5,000 with the default 100 examples): one row per value, an
-    error row exactly when the grasp reader refuses it, the certified row of certify_grasp when it
-    accepts it, and rows that can be written as strict JSON."""
+def _one_row_each(values):
+    """50 hostile values: one row per value, an error row exactly when the grasp reader refuses
+    it, the certified row of certify_grasp when it accepts it, and rows that can be written as
+    strict JSON."""
     lines = [_line(v) for v in values]
     parsed = [json.loads(line) if line != b"{" else CertifyError("malformed JSON") for line in lines]
     rows = certify_values(parsed, list(range(1, 51)), Options(quality=False))
@@ -144,6 +142,15 @@ def test_generated_lines_give_one_row_each(values):
         elif row["status"] != "error":  # an extra field that cannot be written back is an error row
             expected = certify_grasp(grasp, quality=False).row(line=row["line"])
             assert {k: row[k] for k in expected} == expected
+
+
+_LINES = st.lists(st.one_of(grasps, json_values), min_size=50, max_size=50)
+_HEALTH = [HealthCheck.too_slow, HealthCheck.data_too_large]
+#: 2,000 hostile values in the test command, 10,000 in the slow set.
+test_generated_lines_give_one_row_each = settings(max_examples=40, suppress_health_check=_HEALTH, deadline=None)(
+    given(_LINES)(_one_row_each))
+test_generated_lines_give_one_row_each_many = pytest.mark.slow(
+    settings(max_examples=200, suppress_health_check=_HEALTH, deadline=None)(given(_LINES)(_one_row_each)))
 
 
 @settings(max_examples=8, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,

@@ -102,10 +102,12 @@ def _run(code, cache=None):
     return out.stdout
 
 
+@pytest.mark.slow
 def test_rows_are_the_same_with_a_cold_and_a_warm_compile_cache(tmp_path):
     """The same grasps certified with quality (default time limit) in a process whose compile
     cache is empty (every kernel compiles, for tens of seconds) and in one whose cache is warm:
-    identical rows, none limited, per-grasp and columnar routes alike."""
+    identical rows, none limited, per-grasp and columnar routes alike. In the slow set (30 s of
+    compiling); the test command checks that no kernel compiles under quality's clock (below)."""
     cache = tmp_path / "numba"
     cache.mkdir()
     cold = json.loads(_run(_ROWS, cache))

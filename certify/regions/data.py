@@ -101,6 +101,37 @@ def _without_planar_generators(checked) -> str | None:
     return None
 
 
+def _checked_lists(points, normals, model, mu, width, prefix: str):
+    """``(P, checked)`` of a curved region given as sequences of points and normals; raises
+    GraspError naming the first value that breaks a rule."""
+    if isinstance(points, np.ndarray):
+        points = points.tolist()
+    if isinstance(normals, np.ndarray):
+        normals = normals.tolist()
+    if not isinstance(points, (list, tuple)) or not points:
+        raise GraspError(f"{prefix}points: expected a list of at least one [x, y] point, got {show(points)}")
+    if len(points) > MAX_POINTS:
+        raise GraspError(f"{prefix}points: {len(points)} points, more than the limit of {MAX_POINTS}")
+    if not isinstance(normals, (list, tuple)):
+        raise GraspError(f"{prefix}normals: expected a list of [nx, ny] normals, got {show(normals)}")
+    if len(normals) != len(points):
+        raise GraspError(f"{prefix}normals: {len(normals)} normals for {len(points)} points")
+    pts = [_point(prefix, f"points[{j}]", p) for j, p in enumerate(points)]
+    nrm = []
+    for j, v in enumerate(normals):
+        vec = numbers(v)
+        if vec is None or len(vec) != 2 or not all(math.isfinite(x) for x in vec):
+            raise GraspError(f"{prefix}normals[{j}]: expected 2 finite numbers, got {show(v)}")
+        nrm.append(vec)
+    items = [{"p": list(p), "n": list(v), "model": model, "mu": mu, "width": width} for p, v in zip(pts, nrm)]
+    names = {}
+    for j in range(len(items)):
+        names[(j, "p")], names[(j, " p")] = f"points[{j}]", f"points[{j}]"
+        names[(j, "n")] = f"normals[{j}]"
+    checked = _check_model(prefix, items, names)
+    return np.array(pts, dtype=float).reshape(-1, 2), checked
+
+
 def _checked_arrays(points, normals, model, mu, width):
     """``(P, checked)`` of a curved region given as float arrays that pass every rule, as the
     reading of lists gives them; None otherwise (that reading then states the problem)."""
@@ -277,42 +308,9 @@ class CurvedRegion(_ModelParams):
 
     def __init__(self, points, normals, model: str | None = "frictionless", mu: float | None = None,
                  width: float | None = None, *, _prefix: str = "") -> None:
-        fast = _checked_arrays(points, normals, model, mu, width)
-        if fast is not None:  # valid float arrays (sub-curves of a boundary): no Python value per number
-            P, checked = fast
-            N = np.ascontiguousarray(checked.n[:, :2], dtype=float)
-            P.setflags(write=False)
-            N.setflags(write=False)
-            object.__setattr__(self, "points", P)
-            object.__setattr__(self, "normals", N)
-            _set_model(self, checked)
-            return
-        if isinstance(points, np.ndarray):
-            points = points.tolist()
-        if isinstance(normals, np.ndarray):
-            normals = normals.tolist()
-        if not isinstance(points, (list, tuple)) or not points:
-            raise GraspError(f"{_prefix}points: expected a list of at least one [x, y] point, got {show(points)}")
-        if len(points) > MAX_POINTS:
-            raise GraspError(f"{_prefix}points: {len(points)} points, more than the limit of {MAX_POINTS}")
-        if not isinstance(normals, (list, tuple)):
-            raise GraspError(f"{_prefix}normals: expected a list of [nx, ny] normals, got {show(normals)}")
-        if len(normals) != len(points):
-            raise GraspError(f"{_prefix}normals: {len(normals)} normals for {len(points)} points")
-        pts = [_point(_prefix, f"points[{j}]", p) for j, p in enumerate(points)]
-        nrm = []
-        for j, v in enumerate(normals):
-            vec = numbers(v)
-            if vec is None or len(vec) != 2 or not all(math.isfinite(x) for x in vec):
-                raise GraspError(f"{_prefix}normals[{j}]: expected 2 finite numbers, got {show(v)}")
-            nrm.append(vec)
-        items = [{"p": list(p), "n": list(v), "model": model, "mu": mu, "width": width} for p, v in zip(pts, nrm)]
-        names = {}
-        for j in range(len(items)):
-            names[(j, "p")], names[(j, " p")] = f"points[{j}]", f"points[{j}]"
-            names[(j, "n")] = f"normals[{j}]"
-        checked = _check_model(_prefix, items, names)
-        P = np.array(pts, dtype=float).reshape(-1, 2)
+        # valid float arrays (the boundary's sub-curves) are read without a Python value per number
+        P, checked = (_checked_arrays(points, normals, model, mu, width)
+                      or _checked_lists(points, normals, model, mu, width, _prefix))
         N = np.ascontiguousarray(checked.n[:, :2], dtype=float)
         P.setflags(write=False)
         N.setflags(write=False)

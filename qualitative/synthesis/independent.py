@@ -341,8 +341,8 @@ def independent_file(image: ImageSource, grasps_path: str | Path, out_path: str 
     cache: dict = {}
     summary = IndependentSummary()
     with atomic_output(out_path, "-o", reads=reads) as tmp, tmp.open("w", encoding="utf-8") as fh:
-        for number, value in json_lines(grasps_path, "grasp set"):
-            row = _line_row(image, number, value, outline, contour, cache, alpha=alpha, finger_width=finger_width,
+        for line, value in json_lines(grasps_path, "grasp set"):
+            row = _line_row(image, line, value, outline, contour, cache, alpha=alpha, finger_width=finger_width,
                             margin=margin, scale=scale, symmetric=symmetric, tol=tol, budget=budget,
                             normal_tol=normal_tol)
             fh.write(json.dumps(row, allow_nan=False) + "\n")
