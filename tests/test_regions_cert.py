@@ -662,7 +662,7 @@ def test_cli_independent_regions(tmp_path):
 @given(st.integers(1, 40), st.integers(0, 2**32 - 1),
        st.sampled_from([("point", 0.5, None), ("frictionless", None, None), (None, 0.3, None), ("pad", 0.4, 0.02),
                         ("point", 0.0, None), ("soft", 0.5, None), ("point", -1.0, None), ("nope", None, None)]),
-       st.sampled_from(["ok", "nan", "zero-normal", "far", "float32"]))
+       st.sampled_from(["ok", "nan", "zero-normal", "far", "float32", "integers", "objects", "one-normal-less"]))
 def test_curved_regions_from_arrays_are_those_from_lists(k, seed, model, twist):
     """A curved region given as arrays (the boundary's sub-curves) is the region given as lists,
     bit for bit, or fails with the same message."""
@@ -676,6 +676,12 @@ def test_curved_regions_from_arrays_are_those_from_lists(k, seed, model, twist):
         P[rng.integers(k)] = 1e300
     elif twist == "float32":
         P, N = P.astype(np.float32), N.astype(np.float32)
+    elif twist == "integers":
+        P, N = np.round(10 * P).astype(np.int64), np.round(10 * N).astype(np.int64)
+    elif twist == "objects":
+        P, N = P.astype(object), N.astype(object)
+    elif twist == "one-normal-less":
+        N = N[1:]
     name, mu, width = model
 
     def make(points, normals):
@@ -684,7 +690,7 @@ def test_curved_regions_from_arrays_are_those_from_lists(k, seed, model, twist):
         except GraspError as err:
             return str(err)
 
-    a, b = make(P, N), make(P.tolist(), N.tolist())
+    a, b = make(P, N), make(P.tolist(), N.tolist())  # the reading of lists: the reference
     if isinstance(b, str):
         assert a == b
     else:

@@ -46,8 +46,9 @@ try:
 except ImportError:  # Windows: no flock, no compiling elsewhere
     fcntl = None
 
-__all__ = ["cache_dir", "source_fingerprint", "KERNEL_SOURCES", "kernel",
-           "precompile", "compile_elsewhere", "await_compiled", "compile_set", "mark_compiled", "WAIT_SECONDS", "F1", "F2", "F3", "I1", "I2", "INT", "FLOAT", "BOOL"]
+__all__ = ["cache_dir", "source_fingerprint", "KERNEL_SOURCES", "kernel", "precompile", "compiled_here",
+           "compile_elsewhere", "await_compiled", "compile_set", "mark_compiled", "WAIT_SECONDS",
+           "F1", "F2", "F3", "I1", "I2", "INT", "FLOAT", "BOOL"]
 
 #: Argument types as the callers pass them: C-contiguous float64 arrays of 1 to 3 dimensions and
 #: int64 arrays of 1 and 2, and Python's int, float and bool.
@@ -153,6 +154,12 @@ def precompile(signatures: Iterable[tuple[Callable, tuple]]) -> None:
         overloads = getattr(fn, "overloads", None)
         if overloads is not None and args not in overloads:
             fn.compile(args)
+
+
+def compiled_here(signatures: Iterable[tuple[Callable, tuple]]) -> bool:
+    """Whether this process has compiled (or loaded) every kernel of ``signatures`` for its
+    types, or runs without numba's JIT: then :func:`precompile` has nothing to do."""
+    return all(args in getattr(fn, "overloads", {args: None}) for fn, args in signatures)
 
 
 #: Longest wait (s) for another process compiling a kernel set (:func:`await_compiled`): past it

@@ -86,8 +86,8 @@ from scipy.spatial import ConvexHull, QhullError
 from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .._kernels.epsilon import planar_epsilon as epsilon_kernel
 from .._kernels.evidence import minkowski_sums, support_choices, surface_rows, vertex_sums
-from .._kernels.jit import (BOOL, F1, F2, F3, FLOAT, I1, I2, INT, await_compiled, compile_elsewhere, mark_compiled,
-                           precompile)
+from .._kernels.jit import (BOOL, F1, F2, F3, FLOAT, I1, I2, INT, await_compiled, compile_elsewhere, compiled_here,
+                           mark_compiled, precompile)
 from .._kernels.planar import planar_generators
 from .._kernels.surface import cycle_code, face_bounds, leibniz_tables
 from ..core.arguments import count_in, number_in, require
@@ -231,7 +231,9 @@ def compile_ahead(dims) -> None:
     >>> compile_ahead([2])   # the cache holds them: nothing to do
     """
     for dim in sorted({int(d) for d in dims} & {2, 3}):
-        compile_elsewhere(__name__, _set_name(dim))
+        name = _set_name(dim)
+        if not compiled_here(KERNEL_SETS[name]):
+            compile_elsewhere(__name__, name)
 
 
 def _after_compiling(deadline: float | None, dim: int) -> float | None:
@@ -239,8 +241,10 @@ def _after_compiling(deadline: float | None, dim: int) -> float | None:
     compiling it (:func:`compile_ahead`), and return ``deadline`` pushed back by the time that
     took: a time limit counts computation, never compilation, so that a cold compile cache cannot
     change a result."""
-    start = time.perf_counter()
     name = _set_name(dim)
+    if compiled_here(KERNEL_SETS[name]):  # every call after a process's first
+        return deadline
+    start = time.perf_counter()
     await_compiled(name)
     precompile(KERNEL_SETS[name])
     mark_compiled(name)

@@ -135,13 +135,14 @@ def _checked_lists(points, normals, model, mu, width, prefix: str):
 def _checked_arrays(points, normals, model, mu, width):
     """``(P, checked)`` of a curved region given as float arrays that pass every rule, as the
     reading of lists gives them; None otherwise (that reading then states the problem)."""
-    if not (isinstance(points, np.ndarray) and isinstance(points, type(normals)) and points.ndim == 2
-            and points.shape[1:] == (2,) and 1 <= len(points) <= MAX_POINTS):
+    if not (isinstance(points, np.ndarray) and isinstance(normals, np.ndarray) and points.dtype.kind == "f"
+            and normals.dtype.kind == "f" and points.ndim == 2 and points.shape[1:] == (2,)
+            and normals.shape == points.shape and 1 <= len(points) <= MAX_POINTS):
         return None
     P = np.array(points, dtype=float)
     if not (np.isfinite(P).all() and np.abs(P).max() <= MAX_LENGTH and np.isfinite(normals).all()):
         return None
-    data = contact_arrays(P, np.asarray(normals), model, {"mu": mu, "width": width})
+    data = contact_arrays(P, normals, model, {"mu": mu, "width": width})
     if data is None:
         return None
     checked = check_contacts(data)
