@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial import ConvexHull
 
-from qualgrasp.certify import Contact, Grasp, force_closure
+from qualgrasp.certify import Contact, Grasp, force_closure, grasp_from_dict
 from qualgrasp.certify.quality import epsilon
 from qualgrasp.experiments.bench import epsilon_linearised
 from qualgrasp.certify.batch import random_grasp, random_grasps
@@ -518,3 +518,24 @@ def test_spatial_epsilon_survives_qhull_precision_errors():
             "print(e.lo <= e.hi)")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0 and done.stdout.strip() == "True", (done.returncode, done.stderr[-500:])
+
+
+def test_spatial_epsilon_looks_off_a_flat_set_of_support_points():
+    """Three point contacts (a random grasp) whose first contact wins the L1 support only in a
+    narrow cone of directions: the coordinate and random starting directions all find support
+    points of the other two, which lie in a hyperplane, so no hull forms. Looking along that
+    hyperplane's normal finds the first contact's; before, the bounds stayed (0, hi)."""
+    grasp = grasp_from_dict(
+        {"contacts": [{"p": [0.9639672199247169, 0.09084107021170755, -0.07363865738953423],
+                       "n": [-0.9928341145295501, 0.09236101234501155, 0.07582786047970083], "model": "point",
+                       "mu": 0.34573080313781357},
+                      {"p": [-0.8963490673343812, -0.033303193512310744, -0.6719813428670721],
+                       "n": [0.8047984967123155, 0.35681752724729915, 0.4743212328567212], "model": "point",
+                       "mu": 0.8967106633239514},
+                      {"p": [0.7219464361652197, 0.23546073068432355, 0.44001300985748293],
+                       "n": [-0.9814322054498834, 0.03416767196159177, -0.18874161252490887], "model": "point",
+                       "mu": 0.9916831712923566}],
+         "center": [0.2631881962518518, 0.09766620246124012, -0.1018689967997078], "length": 1.2987331271147127})
+    report = certify_grasp(grasp)  # its evidence re-checked
+    e = report.epsilons["L1"]
+    assert report.verified and e.evidence.kind == "support" and 0 < e.lo <= e.hi and e.gap <= 0.01

@@ -43,10 +43,12 @@ Planar grasps: every contact model is polyhedral in the plane, so epsilon is exa
 Spatial grasps with exact cones: an inner and an outer approximation refined together. ``hi`` is
 the least ``h(u)`` found over directions ``u`` (the best of a fixed set of starting directions,
 refined by local minimisation, a tangent-plane SOCP solved by clarabel, and the normals of the
-polytope below). ``lo`` is the epsilon of an inscribed polytope: the hull of support points of
-the GWS (the contact wrenches maximising ``u . w``, pulled inside their cones and proved inside
-exactly, scaled by at most ``2^-14`` towards the origin to put them in general position), starting from the 12 coordinate directions, then adding the support points along the
-normals of its weakest faces, which pushes those faces out, until ``hi - lo <= rel_gap * hi``,
+polytope below). ``lo`` is the epsilon of an inscribed polytope: the hull of support points of the
+GWS (the contact wrenches maximising ``u . w``, pulled inside their cones and proved inside
+exactly, scaled by at most ``2^-14`` towards the origin to put them in general position), starting
+from the 12 coordinate directions (while the points lie in a hyperplane, adding those along its
+normal both ways, then along more fixed starting directions), then adding the support points along
+the normals of its weakest faces, which pushes those faces out, until ``hi - lo <= rel_gap * hi``,
 the polytope has ``MAX_VERTICES`` vertices or the work ``budget`` is spent. Each round costs
 ``O(m)`` per direction examined plus a hull of at most ``MAX_VERTICES`` points, whatever ``m``.
 
@@ -951,6 +953,7 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
     for v in np.vstack([np.eye(d), -np.eye(d), u_best[None]]):
         add(v)
     spare = iter(U[2 * d:])  # more starting directions while the hull is flat
+    looked: list = []  # normals of flat point sets already looked along
     rounds, hull, done = 0, None, 0
     while not limited:
         rounds += 1
@@ -970,6 +973,14 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
         if len(V) >= MAX_VERTICES or work >= budget:
             break
         if hull is None:
+            flat = _off_span(np.array(V)) if len(V) > d else None
+            if flat is not None and not any(np.array_equal(flat, t) for t in looked):
+                # the points lie in a hyperplane: the GWS extends beyond it on one side or both
+                looked.append(flat)
+                add(flat)
+                add(-flat)
+                work += 2
+                continue
             v = next(spare, None)
             if v is None:
                 break
@@ -1003,6 +1014,15 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
         lo, ev = l1.lo, Evidence("l1", direction)
     return Epsilon(norm, lo, hi, direction, tuple(grasp.center), grasp.length, lo == hi, rounds,
                    limited, ev)
+
+
+def _off_span(V: np.ndarray) -> np.ndarray | None:
+    """The unit normal of the hyperplane holding the points ``V`` (n, d), when they lie in one
+    (to within ``1e-9`` of their spread); None when they span the space."""
+    _, s, vt = np.linalg.svd(V - V.mean(axis=0))
+    if len(s) < V.shape[1] or s[-1] <= 1e-9 * s[0]:
+        return vt[-1]
+    return None
 
 
 def epsilon_of_points(points) -> float:
