@@ -151,15 +151,20 @@ def precompile(signatures: Iterable[tuple[Callable, tuple]]) -> None:
     True
     """
     for fn, args in signatures:
-        overloads = getattr(fn, "overloads", None)
-        if overloads is not None and args not in overloads:
+        if not _has(fn, args):
             fn.compile(args)
+
+
+def _has(fn: Callable, args: tuple) -> bool:
+    """Whether ``fn`` is compiled (or loaded) in this process for ``args``; True without JIT."""
+    overloads = getattr(fn, "overloads", None)
+    return overloads is None or args in overloads
 
 
 def compiled_here(signatures: Iterable[tuple[Callable, tuple]]) -> bool:
     """Whether this process has compiled (or loaded) every kernel of ``signatures`` for its
     types, or runs without numba's JIT: then :func:`precompile` has nothing to do."""
-    return all(args in getattr(fn, "overloads", {args: None}) for fn, args in signatures)
+    return all(_has(fn, args) for fn, args in signatures)
 
 
 #: Longest wait (s) for another process compiling a kernel set (:func:`await_compiled`): past it
@@ -167,9 +172,11 @@ def compiled_here(signatures: Iterable[tuple[Callable, tuple]]) -> bool:
 WAIT_SECONDS = 300.0
 
 
-def _set_file(name: str, suffix: str) -> str | None:
+def _set_files(name: str) -> tuple[str, str] | None:
+    """``NAME.lock`` and ``NAME.compiled`` in the cache folder; None without a cache, ``fcntl``
+    or numba's JIT."""
     path = cache_dir() if fcntl is not None and not config.DISABLE_JIT else None
-    return None if path is None else os.path.join(path, name + suffix)
+    return None if path is None else (os.path.join(path, name + ".lock"), os.path.join(path, name + ".compiled"))
 
 
 def compile_elsewhere(module: str, name: str) -> bool:
@@ -180,10 +187,10 @@ def compile_elsewhere(module: str, name: str) -> bool:
     The new process inherits the lock on ``NAME.lock`` taken here, so :func:`await_compiled`
     waits for it from the moment this returns; the lock ends with that process, however it ends.
     """
-    lock = _set_file(name, ".lock")
-    if lock is None or os.path.exists(_set_file(name, ".compiled")):
+    files = _set_files(name)
+    if files is None or os.path.exists(files[1]):
         return False
-    fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+    fd = os.open(files[0], os.O_RDWR | os.O_CREAT, 0o644)
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError:  # another process compiles it
@@ -203,11 +210,11 @@ def compile_elsewhere(module: str, name: str) -> bool:
 def await_compiled(name: str, timeout: float = WAIT_SECONDS) -> None:
     """Wait while another process compiles the kernel set ``name`` (holds ``NAME.lock``), at
     most ``timeout`` seconds; at once when none does."""
-    lock = _set_file(name, ".lock")
-    if lock is None:
+    files = _set_files(name)
+    if files is None:
         return
     try:
-        fd = os.open(lock, os.O_RDONLY)
+        fd = os.open(files[0], os.O_RDONLY)
     except OSError:  # no lock file: nobody compiles it
         return
     try:
@@ -227,10 +234,10 @@ def await_compiled(name: str, timeout: float = WAIT_SECONDS) -> None:
 def mark_compiled(name: str) -> None:
     """Record that the cache holds the kernel set ``name`` (``NAME.compiled``), so that no
     process compiles it elsewhere again."""
-    marker = _set_file(name, ".compiled")
-    if marker is not None and not os.path.exists(marker):
+    files = _set_files(name)
+    if files is not None and not os.path.exists(files[1]):
         try:
-            Path(marker).touch()
+            Path(files[1]).touch()
         except OSError:  # a cache that cannot take it: the set is compiled where needed
             pass
 

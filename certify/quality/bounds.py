@@ -953,7 +953,7 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
     for v in np.vstack([np.eye(d), -np.eye(d), u_best[None]]):
         add(v)
     spare = iter(U[2 * d:])  # more starting directions while the hull is flat
-    looked: list = []  # normals of flat point sets already looked along
+    looked = 0  # the number of points when the points' hyperplane was last looked off
     rounds, hull, done = 0, None, 0
     while not limited:
         rounds += 1
@@ -973,10 +973,10 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
         if len(V) >= MAX_VERTICES or work >= budget:
             break
         if hull is None:
-            flat = _off_span(np.array(V)) if len(V) > d else None
-            if flat is not None and not any(np.array_equal(flat, t) for t in looked):
+            flat = _off_span(np.array(V)) if len(V) > max(d, looked) else None
+            if flat is not None:
                 # the points lie in a hyperplane: the GWS extends beyond it on one side or both
-                looked.append(flat)
+                looked = len(V)
                 add(flat)
                 add(-flat)
                 work += 2

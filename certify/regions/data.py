@@ -133,23 +133,17 @@ def _checked_lists(points, normals, model, mu, width, prefix: str):
 
 
 def _checked_arrays(points, normals, model, mu, width):
-    """``(P, checked)`` of a curved region given as float arrays that pass every rule, as the
-    reading of lists gives them; None otherwise (that reading then states the problem)."""
-    if not (isinstance(points, np.ndarray) and isinstance(normals, np.ndarray) and points.dtype.kind == "f"
-            and normals.dtype.kind == "f" and points.ndim == 2 and points.shape[1:] == (2,)
-            and normals.shape == points.shape and 1 <= len(points) <= MAX_POINTS):
-        return None
-    P = np.array(points, dtype=float)
-    if not (np.isfinite(P).all() and np.abs(P).max() <= MAX_LENGTH and np.isfinite(normals).all()):
-        return None
-    data = contact_arrays(P, normals, model, {"mu": mu, "width": width})
-    if data is None:
+    """``(P, checked)`` of a curved region given as float arrays (:func:`contact_arrays`) of 1 to
+    :data:`MAX_POINTS` planar contacts that pass every rule, as the reading of lists gives them;
+    None otherwise (that reading then states the problem)."""
+    data = contact_arrays(points, normals, model, {"mu": mu, "width": width})
+    if data is None or not 1 <= len(data.plen) <= MAX_POINTS:
         return None
     checked = check_contacts(data)
     if any(err is not None for err in checked.error) or (checked.dim != 2).any() \
             or _without_planar_generators(checked) is not None:
         return None
-    return P, checked
+    return data.p[:, :2].copy(), checked
 
 
 def _planar_models() -> list[str]:
