@@ -132,3 +132,37 @@ def test_a_cold_cache_gets_a_kernel_set_compiled_by_another_process_once(tmp_pat
     for fn, _ in KERNEL_SETS["quality-spatial"]:  # each kernel's cache index, written there
         assert any(folder.rglob(f"*.{fn.__name__}-*.nbi")), fn.__name__
     assert not compile_elsewhere("qualgrasp.certify.quality.bounds", "quality-spatial")  # marked: not again
+
+
+# Compile (or load) one kernel, then print how many kernels numba compiled and where the package is.
+_COUNT = """
+from numba.core import event
+import numpy as np
+import qualgrasp
+from qualgrasp.certify._kernels.linalg import cross_unit
+with event.install_recorder("numba:compile") as rec:
+    cross_unit(np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
+print(len(rec.buffer) // 2, qualgrasp.__file__)  # a start and an end event per compiled function
+"""
+
+
+def test_a_copy_of_the_package_elsewhere_loads_the_kernels_it_compiled(tmp_path):
+    """The installed package and an editable checkout (or two virtual environments) hold the same
+    kernel sources at other paths: the second one loads what the first compiled."""
+    import shutil
+
+    copy = tmp_path / "site" / "qualgrasp"
+    copy.mkdir(parents=True)
+    shutil.copy(PACKAGE / "__init__.py", copy)
+    shutil.copytree(PACKAGE / "certify", copy / "certify", ignore=shutil.ignore_patterns("__pycache__"))
+    env = {k: v for k, v in os.environ.items() if k != "XDG_CACHE_HOME"}
+    env["NUMBA_CACHE_DIR"] = str(tmp_path / "cache")
+    runs = []
+    for path in ("", str(tmp_path / "site"), ""):
+        out = subprocess.run([sys.executable, "-c", _COUNT], env=dict(env, PYTHONPATH=path), capture_output=True,
+                             text=True, timeout=600, cwd=tmp_path)
+        assert out.returncode == 0, out.stderr[-3000:]
+        runs.append(out.stdout.split())
+    assert Path(runs[1][1]).parent == copy and Path(runs[0][1]).parent == PACKAGE  # two copies of the package
+    compiled = [int(n) for n, _ in runs]
+    assert compiled[0] > 0 and compiled[1:] == [0, 0]

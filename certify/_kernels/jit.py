@@ -10,7 +10,12 @@ is then a namespace package that shadows a later editable install of the project
 
 numba picks a function's cache folder once, when the function is decorated, from
 ``numba.config.CACHE_DIR``; :func:`kernel` sets that value for the decoration only and restores
-it, so numba behaves as before for the user's other code.
+it, so numba behaves as before for the user's other code. numba's own locator puts each source
+folder's cache in a subfolder named by that folder's path, so a copy of the same kernels elsewhere
+(the installed package and an editable checkout, two virtual environments) would compile them
+again. :func:`kernel` therefore also names its own locator class for the decoration
+(``numba.config.CACHE_LOCATOR_CLASSES``), which keeps the kernels directly in the cache folder,
+stamped by their source file's contents.
 
 numba's cache checks only the source file of the function it caches, not those of the functions
 it calls, which are compiled into it: a kernel cached before a change to a kernel it calls (in
@@ -39,14 +44,16 @@ import time
 from pathlib import Path
 from typing import Callable, Iterable, Sequence
 
+import numpy as np
 from numba import config, njit, types
+from numba.core.caching import UserProvidedCacheLocator
 
 try:
     import fcntl
 except ImportError:  # Windows: no flock, no compiling elsewhere
     fcntl = None
 
-__all__ = ["cache_dir", "source_fingerprint", "KERNEL_SOURCES", "kernel", "precompile", "compiled_here",
+__all__ = ["cache_dir", "source_fingerprint", "KERNEL_SOURCES", "kernel", "kernel_array", "precompile", "compiled_here",
            "compile_elsewhere", "await_compiled", "compile_set", "mark_compiled", "WAIT_SECONDS",
            "F1", "F2", "F3", "I1", "I2", "INT", "FLOAT", "BOOL"]
 
@@ -55,6 +62,25 @@ __all__ = ["cache_dir", "source_fingerprint", "KERNEL_SOURCES", "kernel", "preco
 F1, F2, F3 = types.float64[::1], types.float64[:, ::1], types.float64[:, :, ::1]
 I1, I2 = types.int64[::1], types.int64[:, ::1]
 INT, FLOAT, BOOL = types.int64, types.float64, types.boolean
+
+
+def kernel_array(a, dtype=np.float64) -> np.ndarray:
+    """``a`` as the kernels take an array: C-contiguous, of ``dtype``, and writable. numba compiles
+    a kernel anew for each array layout and for read-only arrays (Arrow's, ``numpy.broadcast_to``'s),
+    so a caller passing them would compile a large kernel a second time for the same work.
+
+    Examples
+    --------
+    >>> a = np.broadcast_to(np.ones(3), (2, 3))
+    >>> b = kernel_array(a)
+    >>> b.flags.writeable and b.flags.c_contiguous and not np.shares_memory(a, b)
+    True
+    >>> c = np.zeros(4)
+    >>> kernel_array(c) is c
+    True
+    """
+    a = np.ascontiguousarray(a, dtype=dtype)
+    return a if a.flags.writeable else a.copy()
 
 
 def _writable(path: str) -> bool:
@@ -124,18 +150,34 @@ def cache_dir(environ=os.environ) -> str | None:
     return path if _writable(path) else None
 
 
+class KernelLocator(UserProvidedCacheLocator):
+    """numba's cache locator for the kernels: the folder ``numba.config.CACHE_DIR`` itself (one per
+    :func:`source_fingerprint`), whatever the path of the source files, and the SHA-256 of the
+    source file as its stamp (numba before 0.68 stamps its modification time and size)."""
+
+    def __init__(self, py_func, py_file):
+        super().__init__(py_func, py_file)
+        self._cache_path = config.CACHE_DIR
+
+    def get_source_stamp(self):
+        return source_fingerprint((self._py_file,))
+
+
+_LOCATOR = f"{__name__}.KernelLocator"
+
+
 def kernel(fn: Callable) -> Callable:
     """``numba.njit`` with the on-disk cache in :func:`cache_dir` (module docstring); without
     a writable cache folder, ``njit`` without a cache."""
     path = cache_dir()
     if path is None:
         return njit(fn)
-    saved = config.CACHE_DIR
-    config.CACHE_DIR = path
+    saved = config.CACHE_DIR, config.CACHE_LOCATOR_CLASSES
+    config.CACHE_DIR, config.CACHE_LOCATOR_CLASSES = path, _LOCATOR
     try:
         return njit(cache=True)(fn)
     finally:
-        config.CACHE_DIR = saved
+        config.CACHE_DIR, config.CACHE_LOCATOR_CLASSES = saved
 
 
 def precompile(signatures: Iterable[tuple[Callable, tuple]]) -> None:

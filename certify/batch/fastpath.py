@@ -44,6 +44,7 @@ import scipy.sparse as sp
 
 from .._kernels.barrier import barrier_batch
 from .._kernels.evidence import generator_rows
+from .._kernels.jit import kernel_array
 from .._kernels.linalg import U as U_ROUND, projection_bound, world_values
 from .._kernels.planar import pair_null_rows, planar_batch, planar_generators, thin_screen
 from .._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
@@ -79,8 +80,7 @@ def _planar_kernel(P, N, mu, width, c, L, models, variants, tol: Tolerances, qua
     same = (np.array_equal(owner, owner_f) and np.array_equal(offset, offset_f)
             and np.array_equal(friction, friction_f))  # frictionless contacts only: form is force
     return planar_batch(
-        np.ascontiguousarray(P), np.ascontiguousarray(N), np.ascontiguousarray(mu),
-        np.ascontiguousarray(width), np.ascontiguousarray(c), np.ascontiguousarray(L),
+        kernel_array(P), kernel_array(N), kernel_array(mu), kernel_array(width), kernel_array(c), kernel_array(L),
         owner, offset, friction, bases(len(owner), 3), owner_f, offset_f, friction_f,
         bases(len(owner_f), 3), same, tol.margin, FEAS, tol.residual, quality)
 
