@@ -304,6 +304,10 @@ class World:
     time: float = 0.0
     targets: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
+    def __post_init__(self) -> None:
+        self._starts = [tuple(p) for p in np.asarray(self.starts, dtype=float).tolist()]
+        self._approaches = [tuple(n) for n in np.asarray(self.approaches, dtype=float).tolist()]
+
     def pose(self) -> tuple[float, float, float]:
         """Object position and angle ``(x, y, theta)``."""
         p = self.body.position
@@ -325,11 +329,13 @@ class World:
         k = ph.stiffness
         c = 2.0 * ph.damping * math.sqrt(k * ph.mass)
         depth = target / k
-        for f, start, n in zip(self.fingers, self.starts, self.approaches):
-            s = (f.position.x - start[0]) * n[0] + (f.position.y - start[1]) * n[1]
-            v = f.velocity.x * n[0] + f.velocity.y * n[1]
+        # Python floats and one read of each finger's state: this loop is most of a study's time
+        for f, (sx, sy), (nx, ny) in zip(self.fingers, self._starts, self._approaches):
+            (px, py), (vx, vy) = f.position, f.velocity
+            s = (px - sx) * nx + (py - sy) * ny
+            v = vx * nx + vy * ny
             force = min(max(k * (depth - s) - c * v, 0.0), ph.max_force)
-            f.apply_force_at_local_point((force * n[0], force * n[1]), (0.0, 0.0))
+            f.apply_force_at_local_point((force * nx, force * ny), (0.0, 0.0))
         if wrench is not None:
             self.body.apply_force_at_local_point((wrench[0], wrench[1]), self.body.center_of_gravity)
             self.body.torque += wrench[2]
@@ -489,13 +495,14 @@ def hold(obj: PlanarObject, fingers: Sequence[Finger], mu: float, wrench, physic
     steps = ramp + max(1, round(hold_time(magnitude, physics) / physics.dt))
     origin = world.pose()
     worst, t0 = 0.0, world.time
+    wx, wy, wt = w.tolist()
     for i in range(steps):
         a = min(1.0, (i + 1) / ramp)
-        applied = (a * w[0], a * w[1], a * w[2] * obj.length)
+        applied = (a * wx, a * wy, a * wt * obj.length)
         world.step(1.0, applied)
         worst = max(worst, _displacement(world.pose(), origin, obj.length))
         if frames is not None and i % record == 0:
-            frames.append((world.time, world.pose(), world.finger_positions(), (a * w[0], a * w[1], a * w[2])))
+            frames.append((world.time, world.pose(), world.finger_positions(), (a * wx, a * wy, a * wt)))
         if worst > physics.slip:
             if frames is None:
                 break
