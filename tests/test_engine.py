@@ -7,6 +7,8 @@ import sys
 
 import pyarrow.parquet as pq
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from qualgrasp.certify import Grasp
 from qualgrasp.certify.batch import certify_file, verify_file
@@ -112,3 +114,18 @@ def test_dask_local_cluster_matches_local_processes(grasp_files, tmp_path):
     certify_file(parquet, distributed, quality=True, eps_budget=20_000, chunk_size=40, workers=2,
                  dask="local")
     assert pq.read_table(local).equals(pq.read_table(distributed))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from(["closure", "no_closure", "degenerate", "error"]),
+                          st.sampled_from([True, False, None])), max_size=30))
+def test_status_counts_of_lists_equal_those_of_arrow_columns(rows):
+    """The engine counts a chunk's rows from lists (JSON Lines) or Arrow columns (Parquet)."""
+    import pyarrow as pa
+
+    from qualgrasp.certify.batch.chunk import status_counts
+
+    statuses, verified = [s for s, _ in rows], [v for _, v in rows]
+    arrow = status_counts(pa.array(statuses, pa.string()), pa.array(verified, pa.bool_()))
+    assert status_counts(statuses, verified) == arrow
+    assert status_counts(statuses) == (arrow[0], 0)

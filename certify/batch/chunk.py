@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections import Counter
 from dataclasses import dataclass, field, replace
 from typing import Any, Sequence
 
@@ -442,10 +443,11 @@ def verify_chunk(chunk: Chunk, results, tol: Tolerances = Tolerances()) -> tuple
 def status_counts(statuses, verified=None) -> tuple[dict[str, int], int]:
     """Rows per status, and rows (not errors) whose certificates were not verified, of Arrow
     columns or lists (``verified`` None: 0 unverified)."""
-    status = pa.array(statuses, pa.string()) if isinstance(statuses, list) else statuses
-    counts = {d["values"]: d["counts"] for d in pc.value_counts(status).to_pylist()}
+    if isinstance(statuses, list):  # counted here: pyarrow imports pandas for its first array from a list
+        bad = 0 if verified is None else sum(s != "error" and not v for s, v in zip(statuses, verified))
+        return dict(Counter(statuses)), bad
+    counts = {d["values"]: d["counts"] for d in pc.value_counts(statuses).to_pylist()}
     if verified is None:
         return counts, 0
-    ok = pa.array(verified, pa.bool_()) if isinstance(verified, list) else verified
-    bad = pc.and_(pc.not_equal(status, "error"), pc.invert(pc.fill_null(ok, False)))
+    bad = pc.and_(pc.not_equal(statuses, "error"), pc.invert(pc.fill_null(verified, False)))
     return counts, int(pc.sum(bad).as_py() or 0)
