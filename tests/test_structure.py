@@ -23,7 +23,8 @@ ROOT = pathlib.Path(qualgrasp.__file__).parent
 #: meshes' pose source in ``certify``'s command (trimesh and networkx: 0.2 s of every ``certify``
 #: start-up, for runs on a mesh only).
 LAZY = {"distributed", "resource", "qualgrasp.certify.solvers.reference", "h5py", "embreex",
-        "trimesh.ray.ray_pyembree", "pymunk", "mujoco", "coacd", "cvxopt", "qualgrasp.certify.meshes.source"}
+        "trimesh.ray.ray_pyembree", "pymunk", "mujoco", "coacd", "cvxopt", "qualgrasp.certify.meshes.source",
+        "scipy.optimize"}  # linprog: a benchmark's method and a fallback, 0.09 s of every certify's start-up
 
 MODULES = import_graph.modules(ROOT)
 

@@ -51,7 +51,6 @@ from typing import Any, Sequence
 import clarabel
 import numpy as np
 import scipy.sparse as sp
-from scipy.optimize import linprog
 
 from .. import models as registry
 from ..core.certificates import Check, verify
@@ -214,6 +213,8 @@ def solve_faces(G: np.ndarray, k: int) -> list[FaceSolution]:
         return _clarabel_faces(blocks, m)
     except SolverError:
         pass
+    from scipy.optimize import linprog  # clarabel failed (rare): scipy.optimize stays out of start-ups
+
     out = []
     for face, A, lo, hi in blocks:
         c = np.zeros(A.shape[1])

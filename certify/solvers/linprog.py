@@ -9,7 +9,6 @@ Cones are not handled.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import linprog
 
 from ..errors import SolverError
 from ..core.problem import ClosureProblem
@@ -22,6 +21,8 @@ class LinprogSolver:
     """Solve polyhedral closure programmes with ``scipy.optimize.linprog`` (HiGHS)."""
 
     def solve(self, problem: ClosureProblem) -> Solution:
+        from scipy.optimize import linprog  # a benchmark's method: scipy.optimize stays out of certify's start-up
+
         if problem.cones:
             raise ValueError("linprog solves polyhedral programmes only")
         d, k = problem.columns.shape
