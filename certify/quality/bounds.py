@@ -860,6 +860,7 @@ class _Pieces:
         for i, t in enumerate(rows):
             self.T[i, : len(t)] = t
         self.rank = [int(np.count_nonzero(np.abs(t).sum(axis=1))) for t in self.T]
+        self._programmes: dict = {}
 
     def h(self, V: np.ndarray, norm: str) -> np.ndarray:
         """Support function at the rows of ``V`` (n, d)."""
@@ -872,10 +873,27 @@ class _Pieces:
         built sparse, so its size is linear in the number of contacts); the unit minimiser, or
         None when clarabel fails. At a minimiser of ``h`` on the sphere the tangent-plane
         problem has the same solution, so iterating from ``u / norm(u)`` converges to it."""
+        A, where, P, q, b, cones = self._tangent_programme(norm)
+        A = A.copy()
+        A.data[where] = u0  # the plane's row: the one entry of each of the first d columns in row 0
+        sol = clarabel.DefaultSolver(P, q, A, b, cones, settings()).solve()
+        if str(sol.status) not in ("Solved", "AlmostSolved"):
+            return None
+        d = len(u0)
+        u = np.asarray(sol.x)[:d]
+        norm_u = np.linalg.norm(u)
+        return u / norm_u if norm_u > 0 else None
+
+    def _tangent_programme(self, norm: str):
+        """The tangent-plane SOCP of ``norm`` with the plane's row left to fill (built once per
+        norm: its building cost several times clarabel's solve): ``(A, positions of that row's
+        entries in A.data, P, q, b, cones)``."""
+        if norm in self._programmes:
+            return self._programmes[norm]
         nb, r, d = self.T.shape
         nt = 1 if norm == "L1" else nb
         n = d + nt
-        ri, ci, vals = [np.zeros(d, int)], [np.arange(d)], [u0]
+        ri, ci, vals = [np.zeros(d, int)], [np.arange(d)], [np.ones(d)]  # the plane's row, filled per call
         ri.append(1 + np.arange(nt)), ci.append(d + np.arange(nt)), vals.append(-np.ones(nt))
         cones = [clarabel.ZeroConeT(1), clarabel.NonnegativeConeT(nt)]
         row = 1 + nt
@@ -890,15 +908,14 @@ class _Pieces:
             cones.append(clarabel.SecondOrderConeT(1 + rk) if rk else clarabel.NonnegativeConeT(1))
             row += 1 + rk
         A = sp.csc_matrix((np.concatenate(vals), (np.concatenate(ri), np.concatenate(ci))), shape=(row, n))
+        A.sort_indices()  # row 0 first in each column: where the plane's entries are
+        where = A.indptr[:d]
+        assert np.all(A.indices[where] == 0)
         b = np.zeros(row)
         b[0] = 1.0
         q = np.r_[np.zeros(d), np.ones(nt)]
-        sol = clarabel.DefaultSolver(sp.csc_matrix((n, n)), q, A, b, cones, settings()).solve()
-        if str(sol.status) not in ("Solved", "AlmostSolved"):
-            return None
-        u = np.asarray(sol.x)[:d]
-        norm_u = np.linalg.norm(u)
-        return u / norm_u if norm_u > 0 else None
+        self._programmes[norm] = (A, where, sp.csc_matrix((n, n)), q, b, cones)
+        return self._programmes[norm]
 
     def local_minimum(self, u: np.ndarray, norm: str, iters: int = 8):
         """Refine ``u`` towards a local minimiser of ``h`` on the sphere; return ``(u, h(u),
