@@ -1,7 +1,6 @@
 """Meshes, rays, grippers and contacts from poses (qualgrasp.certify.meshes), on meshes made
 here with trimesh.creation, with answers known in closed form."""
 
-import json
 
 import numpy as np
 import pytest
@@ -9,7 +8,7 @@ import pytest
 trimesh = pytest.importorskip("trimesh")
 
 from qualgrasp.certify.errors import CertifyError
-from qualgrasp.certify.meshes.contacts import jaw_contacts, fingertip_contacts, pad_grid
+from qualgrasp.certify.meshes.contacts import jaw_contacts, fingertip_contacts
 from qualgrasp.certify.meshes.errors import GripperError, MeshError, PoseError
 from qualgrasp.certify.meshes.gripper import (builtin_grippers, check_pose, from_qualgrasp, gripper_from_dict,
                                               load_gripper, to_qualgrasp)

@@ -20,7 +20,7 @@ import pytest
 pytest.importorskip("trimesh")
 
 from qualgrasp.certify import Contact, Grasp
-from qualgrasp.certify.meshes.task import G, check_bound, check_holds, check_slips, hold_verdict, least_grip
+from qualgrasp.certify.meshes.task import check_bound, check_holds, check_slips, hold_verdict, least_grip
 
 MASS, MU, DOWN = 0.3, 0.5, (0.0, 0.0, -1.0)
 

@@ -12,7 +12,7 @@ from skimage import data
 
 from qualgrasp.qualitative.vision.edges import WEAK_EDGE, edge_contrast, edge_strength
 from qualgrasp.qualitative.errors import ContourError, ImageError, SegmentationError
-from qualgrasp.qualitative.objects import NAMES, render, shape
+from qualgrasp.qualitative.objects import NAMES, render
 from qualgrasp.qualitative.vision.outline import outline_image
 from qualgrasp.qualitative.vision.scales import outline_scales
 from qualgrasp.qualitative.vision.segmentation import METHODS, grabcut_rect

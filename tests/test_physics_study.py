@@ -139,7 +139,6 @@ def test_placements_inside_stay_on_the_certified_regions():
     sits on: a placement inside must stop at the edge's end, where its certified region stops."""
     import itertools
 
-    import numpy as np
     from shapely.geometry import LineString, Point
 
     from qualgrasp.certify.regions.boundary import Boundary

@@ -4,7 +4,6 @@ end, also when the study leaves out an image it cannot read."""
 import re
 
 import cv2
-import pytest
 from typer.testing import CliRunner
 
 from qualgrasp.cli import app

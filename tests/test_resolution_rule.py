@@ -32,11 +32,20 @@ def _rows(path):
         return list(csv.DictReader(fh))
 
 
-def test_no_route_counts_a_frictionless_closure_of_the_disc(tmp_path):
+def test_no_route_counts_a_frictionless_closure_of_the_disc(tmp_path, monkeypatch):
     """The baseline closes the disc's pixel polygon with four frictionless fingers (epsilon about
     0.005); no disc has such a grasp. The study reports those grasps as below resolution, in every
     table, and counts none as found."""
-    rows, grasp_rows = evaluate_object(subjects(["disc"])[0], QUICK)
+    evaluated = []  # the study's own rows of the disc (one process: workers=1), then its files
+
+    def spy(subject, settings):
+        evaluated.append(evaluate_object(subject, settings))
+        return evaluated[-1]
+
+    monkeypatch.setattr(study, "evaluate_object", spy)
+    result = compare(["disc"], tmp_path, settings=SMALL, plots=False)
+    assert SMALL.budget == QUICK.budget and len(evaluated) == 1
+    rows, grasp_rows = evaluated[0]
     by_route = {r["route"]: r for r in rows}
     base = by_route["Baseline 4"]
     assert base["certified"] > 0 and base["below_resolution"] == base["certified"]  # reported, not dropped
@@ -51,7 +60,6 @@ def test_no_route_counts_a_frictionless_closure_of_the_disc(tmp_path):
     assert overall["Baseline 4"]["objects_with_grasps"] == 0
     assert overall["Baseline 4"]["below_resolution"] == base["certified"]
     # the files written: a column per reason, in objects.csv, overall.csv and robustness.csv
-    result = compare(["disc"], tmp_path, settings=SMALL, plots=False)
     objects = {r["route"]: r for r in _rows(tmp_path / "objects.csv")}
     assert objects["Baseline 4"]["below_resolution"] == str(base["certified"]) and objects["Baseline 4"]["counted"] == "0"
     assert {r["route"]: r for r in _rows(tmp_path / "overall.csv")}["Baseline 4"]["objects_with_grasps"] == "0"
