@@ -48,6 +48,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any, ClassVar, Mapping, Sequence
 
 import numpy as np
@@ -142,7 +143,7 @@ class ContactModel:
 
     # --- declaration helpers -----------------------------------------------------------------
 
-    @property
+    @cached_property  # a class constant, asked for in every contact's checks
     def param_names(self) -> tuple[str, ...]:
         return tuple(p.name for p in self.params)
 
