@@ -74,6 +74,7 @@ one row per nominal grasp) and the plots of :mod:`qualgrasp.experiments.study_pl
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 import zlib
@@ -486,9 +487,10 @@ def _tasks(items: list[Subject], truths: dict, settings: Settings) -> list[tuple
     return tasks
 
 
+@functools.cache  # once per process: the first-call costs are paid then
 def warm_up() -> None:
     """Run every route once on a small image, so that first-call costs (loading the compiled
-    kernels, imports) do not count in the first object's time. Run in each worker process."""
+    kernels, imports) do not count in the first object's time. Run in each worker process, once."""
     image = render("polygon", size=160)
     small = Settings(budget=Budget(samples=24, extend=4, random=50, starts=2, rounds=1))
     for route in routes():
