@@ -14,8 +14,8 @@ it, so numba behaves as before for the user's other code. numba's own locator pu
 folder's cache in a subfolder named by that folder's path, so a copy of the same kernels elsewhere
 (the installed package and an editable checkout, two virtual environments) would compile them
 again. :func:`kernel` therefore also names its own locator class for the decoration
-(``numba.config.CACHE_LOCATOR_CLASSES``), which keeps the kernels directly in the cache folder,
-stamped by their source file's contents.
+(``numba.config.CACHE_LOCATOR_CLASSES``, :class:`KernelLocator`), which keeps the kernels in the
+cache folder by package name, stamped by their source file's contents.
 
 numba's cache checks only the source file of the function it caches, not those of the functions
 it calls, which are compiled into it: a kernel cached before a change to a kernel it calls (in
@@ -151,13 +151,14 @@ def cache_dir(environ=os.environ) -> str | None:
 
 
 class KernelLocator(UserProvidedCacheLocator):
-    """numba's cache locator for the kernels: the folder ``numba.config.CACHE_DIR`` itself (one per
-    :func:`source_fingerprint`), whatever the path of the source files, and the SHA-256 of the
-    source file as its stamp (numba before 0.68 stamps its modification time and size)."""
+    """numba's cache locator for the kernels: a subfolder of ``numba.config.CACHE_DIR`` (one per
+    :func:`source_fingerprint`) named by the kernel's package (``qualgrasp.certify._kernels``),
+    whatever the path of the source files, and the SHA-256 of the source file as its stamp (numba
+    before 0.68 stamps its modification time and size)."""
 
     def __init__(self, py_func, py_file):
         super().__init__(py_func, py_file)
-        self._cache_path = config.CACHE_DIR
+        self._cache_path = os.path.join(config.CACHE_DIR, py_func.__module__.rpartition(".")[0])
 
     def get_source_stamp(self):
         return source_fingerprint((self._py_file,))
