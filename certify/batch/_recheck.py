@@ -24,6 +24,7 @@ import numpy as np
 import pyarrow as pa
 
 from .. import models as registry
+from .._kernels.jit import kernel_array
 from .._kernels.planar import planar_generators
 from .._kernels.recheck import null_rows, verify_farkas_general, verify_interior_general
 from ..core.certificates import Tolerances, margin_of, margin_tolerance
@@ -94,9 +95,9 @@ def _group_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, tol: Tole
     if not all(registry.get(name).exact_in_floats for name in models):
         return np.zeros(len(rows), dtype=bool)  # float cone weights are not the exact ones: verify_row
     P, N, params = cols.contacts(rows)
-    P, N = np.ascontiguousarray(P[:, :, :dim]), np.ascontiguousarray(N[:, :, :dim])
+    P, N = kernel_array(P[:, :, :dim]), kernel_array(N[:, :, :dim])
     mu = params["mu"]
-    c, L = np.ascontiguousarray(cols.center[rows, :dim]), np.ascontiguousarray(cols.length[rows])
+    c, L = kernel_array(cols.center[rows, :dim]), kernel_array(cols.length[rows])
     cert = res.column("certificate").combine_chunks()
     status = np.asarray(res.column("status").to_numpy(zero_copy_only=False), dtype=object)[rows]
     form_status = np.asarray(res.column("form_status").to_numpy(zero_copy_only=False), dtype=object)[rows]

@@ -184,7 +184,8 @@ def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances
         # the per-grasp fast route solves these by the barrier method: both routes give its rows
         return np.zeros(len(rows), dtype=bool), {}
     P, N, params = cols.contacts(rows)
-    P, N, mu, width = P[:, :, :2], N[:, :, :2], params["mu"], registry.offset_lengths(models, params)
+    # the kernels' arrays once, for _planar_kernel and _planar_thin's per-row kernel calls alike
+    P, N, mu, width = kernel_array(P[:, :, :2]), kernel_array(N[:, :, :2]), params["mu"], registry.offset_lengths(models, params)
     c, L = cols.center[rows, :2], cols.length[rows]
     (code, t, lam, basis, y, code_f, t_f, lam_f, basis_f, y_f, _) = _planar_kernel(
         P, N, mu, width, c, L, models, variants, tol, False)

@@ -874,8 +874,7 @@ class _Pieces:
         None when clarabel fails. At a minimiser of ``h`` on the sphere the tangent-plane
         problem has the same solution, so iterating from ``u / norm(u)`` converges to it."""
         A, where, P, q, b, cones = self._tangent_programme(norm)
-        A = A.copy()
-        A.data[where] = u0  # the plane's row: the one entry of each of the first d columns in row 0
+        A.data[where] = u0  # the plane's row, in place: clarabel copies A when it builds the solver
         sol = clarabel.DefaultSolver(P, q, A, b, cones, settings()).solve()
         if str(sol.status) not in ("Solved", "AlmostSolved"):
             return None
