@@ -26,7 +26,8 @@ Planar grasps: every contact model is polyhedral in the plane, so epsilon is exa
 
 * L1: the grasp is in closure, so the origin is interior and the facets of the GWS are those of
   the hull of the generators: the compiled enumeration of triples for ``k <= L1_ENUMERATION_MAX``,
-  else qhull's hull (``O(k log k)``). The hull's triangles are the lower-bound evidence, so
+  else the hull of the generators (:func:`~qualgrasp.certify._kernels.hull.hull_faces`). The hull's
+  triangles are the lower-bound evidence, so
   ``lo = hi``.
 * L-infinity: every facet normal of a Minkowski sum in 3-D is normal to two edges of the summands:
   the compiled enumeration of pairs of edges for ``k <= LINF_ENUMERATION_MAX`` (``O(k^3)``), else
@@ -63,13 +64,13 @@ compiled (or loaded from numba's cache, or awaited from another process compilin
 cold cache: :func:`compile_ahead`) before it runs, so a cold compile cache never changes a result.
 
 Epsilon is 0 for grasps not in closure (and for degenerate ones): the closure verdict is decided
-first, so flat hulls and rank-deficient sets never reach qhull.
+first, so flat hulls and rank-deficient sets never reach a hull.
 
 Many planar grasps sharing one generator layout (the columnar batch path):
 :func:`planar_epsilon_rows` gives, row for row, what :func:`planar_epsilons` gives, with the
 epsilons, the sums and the rigorous float checks of every surface compiled for the whole batch
-(:mod:`qualgrasp.certify._kernels.evidence`); qhull (whose faces the evidence states) and the
-``support`` refinement run per row, and a row whose surfaces need exact arithmetic takes
+(:mod:`qualgrasp.certify._kernels.evidence`, :mod:`qualgrasp.certify._kernels.hull`); the ``support``
+refinement runs per row, and a row whose surfaces need exact arithmetic takes
 :func:`planar_epsilons` itself.
 """
 
@@ -88,6 +89,7 @@ from scipy.spatial import ConvexHull, QhullError
 from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .._kernels.epsilon import planar_epsilon as epsilon_kernel
 from .._kernels.evidence import minkowski_sums, support_choices, surface_rows, vertex_sums
+from .._kernels.hull import face_planes, hull_faces, hulls_faces
 from .._kernels.jit import (BOOL, F1, F2, F3, FLOAT, I1, I2, INT, await_compiled, compile_elsewhere, compiled_here,
                            mark_compiled, precompile)
 from .._kernels.planar import planar_generators
@@ -141,6 +143,9 @@ _PLANAR_KERNELS = _SURFACE_KERNELS + (
     (minkowski_sums, (F3, F3, I1, INT)),  # the vertices of sums and support evidence
     (support_choices, (F2, I1, INT, F2)),
     (vertex_sums, (F2, F2, I2)),
+    (hulls_faces, (F2, I1)),  # every planar surface's faces
+    (hull_faces, (F2,)),
+    (face_planes, (F2, I2)),
 )
 #: Those kernel sets by name (:func:`compile_ahead`; :mod:`qualgrasp.certify._kernels.jit`).
 KERNEL_SETS = {"quality-planar": _PLANAR_KERNELS, "quality-spatial": _SURFACE_KERNELS}
@@ -416,10 +421,10 @@ def planar_epsilon_rows(W, E, owner, m: int, *, time_limit: float | None = None,
     The epsilons (:func:`~qualgrasp.certify._kernels.epsilon.planar_epsilon`), the sums of
     ``sums`` evidence (:func:`~qualgrasp.certify._kernels.evidence.minkowski_sums`) and the
     rigorous float checks of every surface
-    (:func:`~qualgrasp.certify._kernels.evidence.surface_rows`) run on the whole batch; only the
-    hulls (qhull, whose faces the evidence states) and the ``support`` refinement (more than
-    :data:`SUMS_MAX` sums) are computed row by row. A row whose surfaces the float checks cannot
-    settle, whose hull qhull refuses, or with more than :data:`LINF_ENUMERATION_MAX` generators
+    (:func:`~qualgrasp.certify._kernels.evidence.surface_rows`) and the hulls whose faces the
+    evidence states (:func:`~qualgrasp.certify.quality.gws.surfaces_faces`) run on the whole batch;
+    only the ``support`` refinement (more than :data:`SUMS_MAX` sums) is computed row by row. A row
+    whose surfaces the float checks cannot settle, whose points span no hull, or with more than :data:`LINF_ENUMERATION_MAX` generators
     takes :func:`planar_epsilons` itself, so that every row is what the per-grasp route gives.
 
     Parameters
@@ -496,7 +501,7 @@ def _checked(V, EV, faces):
 
 def _l1_rows(W, E, owner, m, rows, slow):
     """L1 part of :func:`planar_epsilon_rows`: ``(lo, hi, direction, evidence, False)`` by row;
-    rows whose hull qhull refuses or whose surface the float checks cannot settle are marked
+    rows whose points span no hull or whose surface the float checks cannot settle are marked
     ``slow``."""
     k = W.shape[2]
     faces = dict(zip(rows, surfaces_faces([W[b].T for b in rows])))
@@ -655,9 +660,10 @@ def _support_vertex(R, gens):
 def _support_surface(W, E, owner, m, eps, u, deadline):
     """The vertices of ``support`` evidence: the hull of support points along the coordinate
     directions and ``u``, refined along the normals of its faces nearest the origin (each cut
-    adds a vertex of the GWS beyond the face) until qhull's hull reaches ``eps`` or ``4
+    adds a vertex of the GWS beyond the face) until the hull reaches ``eps`` or ``4
     MAX_VERTICES`` directions are used, or the ``deadline`` passes. Returns ``((directions,
-    vertices, their error bounds, generator choices) or None when qhull fails, limited)``."""
+    vertices, their error bounds, generator choices) or None when the points span no hull,
+    limited)``."""
     dirs = [np.array(v, dtype=float) for v in np.vstack([np.eye(3), -np.eye(3), u[None]])]
     seen = set()
     picks = []  # the generator choices of each direction kept
@@ -673,23 +679,22 @@ def _support_surface(W, E, owner, m, eps, u, deadline):
         return out
 
     dirs = fresh(dirs)
-    hull, done, limited, pts = None, 0, False, None
+    done, limited, pts = 0, False, None
     while True:
         # the new vertices, as planar_support_vertices gives them (each depends on its own row)
         new_pts = sum_rows(W, E, np.array(picks[done:]))[0]
         pts = np.vstack([pts, new_pts]) if done else new_pts
-        try:  # built anew: qhull's incremental mode ends the process on a precision error (scipy issue 4974)
-            hull = ConvexHull(pts)
-            done = len(dirs)
-        except (QhullError, ValueError):
+        faces = surface_faces(pts)
+        if faces is None:
             return None, limited
-        dist = -hull.equations[:, -1]
+        done = len(dirs)
+        normal, dist = face_planes(pts, faces)
         if dist.min() >= eps * (1 - EPS_TOL / 16) or len(dirs) >= 4 * MAX_VERTICES:
             break
         if _expired(deadline):
             limited = True
             break
-        new = fresh(list(hull.equations[np.argsort(dist, kind="stable")[:2 * _ADD], :-1]))
+        new = fresh(list(normal[np.argsort(dist, kind="stable")[:2 * _ADD]]))
         if not new:
             break
         dirs += new

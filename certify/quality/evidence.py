@@ -35,8 +35,8 @@ Vertices, by the evidence ``kind``:
     ``points`` holds one direction ``v`` (3 floats) per vertex; the vertex is the support point
     of the GWS along ``v``: for each contact its generator with the largest ``v . g`` (the first
     such, by :func:`~qualgrasp.certify.quality.gws.planar_support_choice`), or the origin when none is positive, summed.
-    The faces are not stored: the checker triangulates the vertices with qhull and then checks
-    that triangulation (see below).
+    The faces are not stored: the checker triangulates the vertices
+    (:func:`~qualgrasp.certify.quality.gws.surface_faces`) and then checks that triangulation (see below).
 ``support`` (spatial)
     ``points`` holds one direction ``v`` (6 floats) per vertex; the vertex is the support point
     of the GWS along ``v`` computed by :meth:`~qualgrasp.certify.quality.gws.ConicSupport.forces`, the contact forces (and

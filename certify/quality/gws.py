@@ -12,7 +12,8 @@ same functions, so that a vertex the evidence names is the vertex that was compu
 * spatial grasps with exact cones: the support forces of every contact (:class:`ConicSupport`),
   pulled inside their cones by :data:`SHRINK` and scaled towards the origin by
   :func:`vertex_scale`;
-* hulls: qhull's faces oriented about the origin (:func:`surface_faces`) and their float distances.
+* hulls: their faces oriented about the origin (:func:`surface_faces`; compiled in 3-D, qhull in 6-D) and
+  their float distances.
 """
 
 from __future__ import annotations
@@ -26,6 +27,8 @@ from scipy.spatial import ConvexHull, QhullError
 
 from .. import models as registry
 from .._kernels.evidence import support_choices, vertex_sums
+from .._kernels.hull import hull_faces, hulls_faces
+from .._kernels.jit import kernel_array
 from .._kernels.planar import planar_generators
 from ..core import cones
 from ..core.grasp import Grasp
@@ -43,16 +46,38 @@ SHRINK = 1.0 - 2.0**-30
 # --- surfaces ------------------------------------------------------------------------------------
 
 def surface_faces(points: np.ndarray) -> np.ndarray | None:
-    """Faces of the hull of ``points`` (n, d) from qhull, each ordered so that its float
-    determinant ``det(v_1, ..., v_d)`` is positive (outward about an interior origin); None when
-    qhull fails."""
+    """Faces of the hull of ``points`` (n, d), each ordered so that its float determinant
+    ``det(v_1, ..., v_d)`` is not negative (outward about an interior origin); None when the
+    points span no full-dimensional hull. In 3-D (planar grasps) the compiled hull of
+    :func:`~qualgrasp.certify._kernels.hull.hull_faces` gives them, qhull where that one declines;
+    in other dimensions qhull."""
+    if np.shape(points)[1:] == (3,):  # one set: without the batch's bookkeeping
+        faces = hull_faces(kernel_array(points))
+        if len(faces):
+            return faces
     return surfaces_faces([points])[0]
 
 
 def surfaces_faces(point_sets) -> list[np.ndarray | None]:
-    """:func:`surface_faces` of each of ``point_sets`` (arrays (n_i, d) of one ``d``): qhull
-    runs once per set, the orientation once for all (the determinant of each face is computed
-    as for a single set, so the faces are the same)."""
+    """:func:`surface_faces` of each of ``point_sets`` (arrays (n_i, d) of one ``d``)."""
+    if not point_sets:
+        return []
+    if np.shape(point_sets[0])[1] == 3:
+        V = kernel_array(np.concatenate(point_sets))
+        vstart = np.cumsum([0] + [len(p) for p in point_sets]).astype(np.int64)
+        faces, fstart = hulls_faces(V, vstart)
+        out = [faces[fstart[s]:fstart[s + 1]] if fstart[s + 1] > fstart[s] else None for s in range(len(point_sets))]
+        declined = [s for s, f in enumerate(out) if f is None]
+        for s, f in zip(declined, _qhull_faces([point_sets[s] for s in declined])):
+            out[s] = f
+        return out
+    return _qhull_faces(point_sets)
+
+
+def _qhull_faces(point_sets) -> list[np.ndarray | None]:
+    """:func:`surface_faces` of each of ``point_sets`` by qhull: qhull runs once per set, the
+    orientation once for all (the determinant of each face is computed as for a single set, so
+    the faces are the same)."""
     hulls, offset, points = [], 0, []
     for pts in point_sets:
         try:

@@ -1,0 +1,279 @@
+"""Convex hulls of small 3-D point sets, compiled (numba): the triangulated surface of the hull,
+each face oriented as the epsilon evidence states it, for many sets at once.
+
+The planar grasp wrench space lives in 3-D (``fx``, ``fy``, torque), and every planar epsilon
+row needs the hull of its generators and of their sums. qhull through
+:class:`scipy.spatial.ConvexHull` costs 25 to 35 us a call, mostly Python around it; this
+incremental hull costs a few microseconds for the tens of points a planar grasp gives.
+
+The hull is a guide, never a proof: :func:`~.surface.cycle_code` and :func:`~.surface.face_bounds`
+check every surface it gives, and a surface they cannot settle goes to exact arithmetic. Its
+floating-point decisions therefore only need to be sensible, not exact: a point within
+:data:`PLANE_TOL` times the sets's largest coordinate of a face's plane counts as on it (so
+coplanar points do not split a flat facet into slivers), and a set whose points all lie that
+close to one plane, or whose insertion meets an inconsistent horizon, is reported as failed
+for its caller to hand to qhull.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .jit import kernel
+from .order import stable_argsort
+
+__all__ = ["PLANE_TOL", "hull_faces", "hulls_faces", "face_planes"]
+
+#: Relative distance below which a point counts as on a face's plane (times the set's largest
+#: absolute coordinate).
+PLANE_TOL = 2.0**-40
+
+
+@kernel
+def _plane(P, a, b, c, out):
+    """Into ``out`` (4,): the normal ``(b - a) x (c - a)`` of the face ``a, b, c`` and its offset
+    ``n . P[a]``; returns ``|n|``."""
+    ux, uy, uz = P[b, 0] - P[a, 0], P[b, 1] - P[a, 1], P[b, 2] - P[a, 2]
+    vx, vy, vz = P[c, 0] - P[a, 0], P[c, 1] - P[a, 1], P[c, 2] - P[a, 2]
+    nx, ny, nz = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
+    out[0], out[1], out[2] = nx, ny, nz
+    out[3] = nx * P[a, 0] + ny * P[a, 1] + nz * P[a, 2]
+    return np.sqrt(nx * nx + ny * ny + nz * nz)
+
+
+@kernel
+def _start(P, tol):
+    """Four affinely independent points of ``P`` (an initial tetrahedron: the two farthest apart
+    along the axis of widest spread, the farthest from their line, the farthest from their
+    plane), or -1 in the first entry when the points lie within ``tol`` of a plane."""
+    n = P.shape[0]
+    out = np.full(4, -1, dtype=np.int64)
+    best, i0, i1 = -1.0, 0, 0
+    for r in range(3):
+        lo, hi = 0, 0
+        for i in range(n):
+            if P[i, r] < P[lo, r]:
+                lo = i
+            if P[i, r] > P[hi, r]:
+                hi = i
+        if P[hi, r] - P[lo, r] > best:
+            best, i0, i1 = P[hi, r] - P[lo, r], lo, hi
+    if not best > tol:
+        return out
+    dx, dy, dz = P[i1, 0] - P[i0, 0], P[i1, 1] - P[i0, 1], P[i1, 2] - P[i0, 2]
+    dd = np.sqrt(dx * dx + dy * dy + dz * dz)
+    best, i2 = -1.0, -1
+    for i in range(n):
+        wx, wy, wz = P[i, 0] - P[i0, 0], P[i, 1] - P[i0, 1], P[i, 2] - P[i0, 2]
+        cx, cy, cz = dy * wz - dz * wy, dz * wx - dx * wz, dx * wy - dy * wx
+        h = np.sqrt(cx * cx + cy * cy + cz * cz) / dd
+        if h > best:
+            best, i2 = h, i
+    if not best > tol:
+        return out
+    pl = np.empty(4)
+    nn = _plane(P, i0, i1, i2, pl)
+    best, i3 = -1.0, -1
+    for i in range(n):
+        h = abs(pl[0] * P[i, 0] + pl[1] * P[i, 1] + pl[2] * P[i, 2] - pl[3]) / nn
+        if h > best:
+            best, i3 = h, i
+    if not best > tol:
+        return out
+    out[0], out[1], out[2], out[3] = i0, i1, i2, i3
+    return out
+
+
+@kernel
+def hull_faces(P):
+    """Faces (F, 3) of the convex hull of ``P`` (n, 3), triangulated, each ordered so that its
+    float determinant ``det(v_1, v_2, v_3)`` is not negative (outward about an interior origin,
+    as :func:`qualgrasp.certify.quality.gws.orient_faces` orders qhull's); an empty (0, 3)
+    array when the points lie within :data:`PLANE_TOL` of a plane or the construction fails.
+
+    Points are inserted after an initial tetrahedron, farthest from its centre first; a point
+    sees the faces whose planes it lies more than the tolerance beyond, which are replaced by the
+    cone from the point to their horizon. A new face of (near) zero area declines the set.
+    """
+    n = P.shape[0]
+    empty = np.zeros((0, 3), dtype=np.int64)
+    if n < 4:
+        return empty
+    s = 0.0
+    for i in range(n):
+        for r in range(3):
+            if not abs(P[i, r]) <= 1e300:  # NaN or infinite
+                return empty
+            s = max(s, abs(P[i, r]))
+    tol = PLANE_TOL * s
+    first = _start(P, tol)
+    if first[0] < 0:
+        return empty
+    cap = 8 * n + 16
+    face = np.empty((cap, 3), dtype=np.int64)
+    plane = np.empty((cap, 4))
+    size = np.empty(cap)
+    alive = np.zeros(cap, dtype=np.bool_)
+    F = 0
+    quad = ((0, 1, 2, 3), (0, 1, 3, 2), (0, 2, 3, 1), (1, 2, 3, 0))
+    for a, b, c, d in quad:  # the tetrahedron's faces, each turned away from its fourth vertex
+        i, j, k, o = first[a], first[b], first[c], first[d]
+        nn = _plane(P, i, j, k, plane[F])
+        if plane[F, 0] * P[o, 0] + plane[F, 1] * P[o, 1] + plane[F, 2] * P[o, 2] - plane[F, 3] > 0.0:
+            j, k = k, j
+            nn = _plane(P, i, j, k, plane[F])
+        face[F, 0], face[F, 1], face[F, 2] = i, j, k
+        size[F] = nn
+        alive[F] = True
+        F += 1
+    taken = np.zeros(n, dtype=np.bool_)
+    for q in range(4):
+        taken[first[q]] = True
+    visible = np.empty(cap, dtype=np.int64)
+    edges = np.empty((3 * cap, 2), dtype=np.int64)
+    nxt = np.full(n, -1, dtype=np.int64)
+    far = np.empty(n)  # farthest from the tetrahedron's centre first: extreme points before the
+    for i in range(n):  # points on a facet or edge between them, which would make slivers
+        d2 = 0.0
+        for r in range(3):
+            x = P[i, r] - 0.25 * (P[first[0], r] + P[first[1], r] + P[first[2], r] + P[first[3], r])
+            d2 += x * x
+        far[i] = -d2
+    for p in stable_argsort(far):
+        if taken[p]:
+            continue
+        nv = 0
+        for f in range(F):
+            if alive[f]:
+                h = plane[f, 0] * P[p, 0] + plane[f, 1] * P[p, 1] + plane[f, 2] * P[p, 2] - plane[f, 3]
+                if h > tol * size[f]:
+                    visible[nv] = f
+                    nv += 1
+        if nv == 0:
+            continue
+        ne = 0
+        for q in range(nv):  # the horizon: edges of visible faces whose twin is not visible
+            f = visible[q]
+            for e in range(3):
+                a, b = face[f, e], face[f, (e + 1) % 3]
+                twin = False
+                for q2 in range(nv):
+                    g = visible[q2]
+                    for e2 in range(3):
+                        if face[g, e2] == b and face[g, (e2 + 1) % 3] == a:
+                            twin = True
+                if not twin:
+                    edges[ne, 0], edges[ne, 1] = a, b
+                    ne += 1
+        simple = ne >= 3
+        for q in range(ne):  # one simple cycle: each horizon vertex starts one edge, ...
+            if nxt[edges[q, 0]] >= 0:
+                simple = False
+            nxt[edges[q, 0]] = edges[q, 1]
+        v, steps = edges[0, 0], 0
+        while simple and steps < ne:  # ... and following them from one returns after all
+            v = nxt[v]
+            steps += 1
+            if v < 0:
+                simple = False
+            elif v == edges[0, 0] and steps < ne:
+                simple = False
+        if simple and v != edges[0, 0]:
+            simple = False
+        for q in range(ne):
+            nxt[edges[q, 0]] = -1
+        if not simple or F + ne > cap:
+            return empty
+        for q in range(nv):
+            alive[visible[q]] = False
+        for q in range(ne):
+            a, b = edges[q, 0], edges[q, 1]
+            nn = _plane(P, a, b, p, plane[F])
+            if not nn > tol * s:  # a sliver (the point on a horizon edge's line)
+                return empty
+            face[F, 0], face[F, 1], face[F, 2] = a, b, p
+            size[F] = nn
+            alive[F] = True
+            F += 1
+        taken[p] = True
+        if F > cap - 2 * n:  # compact: keep the live faces at the front
+            w = 0
+            for f in range(F):
+                if alive[f]:
+                    face[w] = face[f]
+                    plane[w] = plane[f]
+                    size[w] = size[f]
+                    alive[w] = True
+                    w += 1
+            for f in range(w, F):
+                alive[f] = False
+            F = w
+    count = 0
+    for f in range(F):
+        if alive[f]:
+            count += 1
+    out = np.empty((count, 3), dtype=np.int64)
+    w = 0
+    for f in range(F):
+        if alive[f]:
+            i, j, k = face[f, 0], face[f, 1], face[f, 2]
+            det = (P[i, 0] * (P[j, 1] * P[k, 2] - P[j, 2] * P[k, 1])
+                   - P[i, 1] * (P[j, 0] * P[k, 2] - P[j, 2] * P[k, 0])
+                   + P[i, 2] * (P[j, 0] * P[k, 1] - P[j, 1] * P[k, 0]))
+            if det < 0.0:
+                i, j = j, i
+            out[w, 0], out[w, 1], out[w, 2] = i, j, k
+            w += 1
+    return out
+
+
+@kernel
+def hulls_faces(V, vstart):
+    """:func:`hull_faces` of many sets: set ``s`` is ``V[vstart[s]:vstart[s + 1]]``. Returns the
+    faces of all sets one after another (indices local to each set) and ``fstart`` (S + 1,),
+    set ``s`` owning ``faces[fstart[s]:fstart[s + 1]]`` (none where its hull failed)."""
+    S = vstart.shape[0] - 1
+    parts = []
+    fstart = np.zeros(S + 1, dtype=np.int64)
+    for s in range(S):
+        f = hull_faces(V[vstart[s]:vstart[s + 1]])
+        parts.append(f)
+        fstart[s + 1] = fstart[s] + f.shape[0]
+    faces = np.empty((fstart[S], 3), dtype=np.int64)
+    for s in range(S):
+        faces[fstart[s]:fstart[s + 1]] = parts[s]
+    return faces, fstart
+
+
+@kernel
+def face_planes(P, faces):
+    """Unit normals (F, 3) of the ``faces`` of the hull of ``P`` (n, 3), turned away from the mean
+    of the faces' vertices, and each plane's signed distance from the origin (positive when the
+    origin is on the inner side), in floats: a guide, not a proof."""
+    F = faces.shape[0]
+    normal = np.empty((F, 3))
+    dist = np.empty(F)
+    used = np.zeros(P.shape[0], dtype=np.bool_)
+    for f in range(F):
+        for q in range(3):
+            used[faces[f, q]] = True
+    centre = np.zeros(3)
+    count = 0
+    for i in range(P.shape[0]):
+        if used[i]:
+            count += 1
+            for r in range(3):
+                centre[r] += P[i, r]
+    pl = np.empty(4)
+    for f in range(F):
+        a = faces[f, 0]
+        nn = _plane(P, a, faces[f, 1], faces[f, 2], pl)
+        side = 0.0
+        for r in range(3):
+            normal[f, r] = pl[r] / nn
+            side += normal[f, r] * (P[a, r] - centre[r] / count)
+        if side < 0.0:
+            for r in range(3):
+                normal[f, r] = -normal[f, r]
+        dist[f] = normal[f, 0] * P[a, 0] + normal[f, 1] * P[a, 1] + normal[f, 2] * P[a, 2]
+    return normal, dist

@@ -1,0 +1,109 @@
+"""The compiled 3-D hull of planar epsilon evidence against qhull, an independent route: the same
+facets on points in general position, and on points with coplanar and repeated ones (rounded
+coordinates, Minkowski sums) a closed surface that every point lies inside and whose vertices
+are extreme points of the set."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.spatial import ConvexHull
+
+from qualgrasp.certify._kernels.hull import PLANE_TOL, hull_faces, hulls_faces
+from qualgrasp.certify._kernels.surface import cycle_code
+
+
+def _canonical(faces):
+    """Faces as a sorted list, each rotated to start at its least index (orientation kept)."""
+    return sorted(tuple(np.roll(f, -int(np.argmin(f)))) for f in np.asarray(faces))
+
+
+def _qhull_oriented(P):
+    faces = np.array(ConvexHull(P).simplices, dtype=np.int64)
+    flip = np.linalg.det(P[faces]) < 0
+    faces[flip, 0], faces[flip, 1] = faces[flip, 1], faces[flip, 0].copy()
+    return faces
+
+
+def _a_hull_of(P, faces):
+    """Turned outward about an interior point, a closed oriented surface with every point inside
+    every face's plane, and every vertex on the boundary of qhull's hull (within the tolerance)."""
+    scale = np.abs(P).max()
+    centre = P[np.unique(faces)].mean(axis=0)  # the orientation about the origin is the caller's
+    a, b, c = P[faces[:, 0]], P[faces[:, 1]], P[faces[:, 2]]
+    n = np.cross(b - a, c - a)
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    inward = np.einsum("fr,fr->f", n, a - centre) < 0
+    n[inward] *= -1
+    turned = faces.copy()
+    turned[inward, 0], turned[inward, 1] = faces[inward, 1], faces[inward, 0]
+    assert cycle_code(turned, len(P)) == 0
+    height = (P @ n.T) - np.einsum("fr,fr->f", n, a)
+    assert height.max() <= 64 * PLANE_TOL * scale
+    eq = ConvexHull(P).equations
+    for v in np.unique(faces):
+        assert np.abs(eq[:, :3] @ P[v] + eq[:, 3]).min() <= 64 * PLANE_TOL * scale
+
+
+def test_general_position_gives_qhulls_facets():
+    rng = np.random.default_rng(1)
+    for n in (4, 6, 9, 27, 80, 300):
+        for _ in range(20):
+            P = rng.normal(size=(n, 3)) + rng.normal(size=3)
+            assert _canonical(hull_faces(P)) == _canonical(_qhull_oriented(P))
+
+
+def test_oriented_outward_about_an_interior_origin():
+    rng = np.random.default_rng(2)
+    P = rng.normal(size=(40, 3))
+    P -= P.mean(axis=0)
+    faces = hull_faces(P)
+    assert (np.linalg.det(P[faces]) > 0).all()
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(4, 40), st.integers(0, 2**32 - 1), st.sampled_from([1.0, 2.0, 1e-6, 1e6]))
+def test_coplanar_and_repeated_points_give_a_hull(n, seed, scale):
+    rng = np.random.default_rng(seed)
+    P = np.round(rng.normal(size=(n, 3)) * 1.5) * scale
+    if np.linalg.matrix_rank(P - P[0]) < 3:
+        assert len(hull_faces(P)) == 0  # flat: declined, for the caller's qhull to refuse too
+        return
+    faces = hull_faces(P)
+    if len(faces):  # declining is allowed (the caller asks qhull); a surface must be a hull
+        _a_hull_of(P, faces)
+
+
+def test_minkowski_sums_give_a_hull():
+    """The vertices of ``sums`` evidence: every sum of one generator (or none) per contact, whose
+    hull has parallelogram facets."""
+    rng = np.random.default_rng(3)
+    declined = 0
+    for _ in range(200):
+        G = rng.normal(size=(3, 2, 3))
+        choices = [np.vstack([np.zeros(3), g]) for g in G]
+        P = np.array([a + b + c for a in choices[0] for b in choices[1] for c in choices[2]])
+        faces = hull_faces(P)
+        if len(faces):
+            _a_hull_of(P, faces)
+        else:
+            declined += 1
+    assert declined == 0
+
+
+@pytest.mark.parametrize("P", [np.zeros((5, 3)), np.eye(3), np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0]]),
+                               np.array([[np.nan, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])])
+def test_degenerate_sets_are_declined(P):
+    assert hull_faces(P).shape == (0, 3)
+
+
+def test_many_sets_at_once():
+    rng = np.random.default_rng(5)
+    sets = [rng.normal(size=(n, 3)) for n in (4, 9, 30)]
+    sets.insert(1, np.c_[rng.normal(size=(6, 2)), np.zeros(6)])
+    V = np.ascontiguousarray(np.concatenate(sets))
+    vstart = np.cumsum([0] + [len(s) for s in sets]).astype(np.int64)
+    faces, fstart = hulls_faces(V, vstart)
+    for s, P in enumerate(sets):
+        assert np.array_equal(faces[fstart[s]:fstart[s + 1]], hull_faces(P))
+    assert fstart[2] == fstart[1]
