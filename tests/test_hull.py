@@ -1,7 +1,8 @@
 """The compiled 3-D hull of planar epsilon evidence against qhull, an independent route: the same
 facets on points in general position, and on points with coplanar and repeated ones (rounded
 coordinates, Minkowski sums) a closed surface that every point lies inside and whose vertices
-are extreme points of the set."""
+lie on the hull's boundary. Then the batch route's evidence held in columns, against the rows
+and the Arrow column built from their JSON dicts."""
 
 import numpy as np
 import pytest
@@ -11,6 +12,7 @@ from scipy.spatial import ConvexHull
 
 from qualgrasp.certify._kernels.hull import PLANE_TOL, hull_faces, hulls_faces
 from qualgrasp.certify._kernels.surface import cycle_code
+from qualgrasp.certify.quality.evidence import Evidence
 
 
 def _canonical(faces):
@@ -107,3 +109,52 @@ def test_many_sets_at_once():
     for s, P in enumerate(sets):
         assert np.array_equal(faces[fstart[s]:fstart[s + 1]], hull_faces(P))
     assert fstart[2] == fstart[1]
+
+
+# --- the evidence of many rows held in columns ----------------------------------------------------
+
+_kinds = st.sampled_from(["generators", "sums", "support", "l1"])
+_ints = st.lists(st.integers(-1, 40), max_size=12).map(tuple)
+_floats = st.lists(st.floats(-1e3, 1e3, allow_nan=False), max_size=9).map(tuple)
+_direction = st.one_of(st.none(), st.tuples(*[st.floats(-10, 10, allow_nan=False)] * 3))
+_evidence = st.builds(Evidence, _kinds, _direction, _ints, _floats, _ints)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.one_of(st.none(), st.tuples(_evidence, _evidence)), max_size=12), st.integers(1, 3))
+def test_evidence_columns_are_the_rows_and_their_arrow_column(pairs, split):
+    """Rows assembled from blocks give back each row's evidence, and their results column is the
+    one Arrow builds from the rows' JSON dicts (the route the columns replace)."""
+    import pyarrow as pa
+
+    from qualgrasp.certify.batch._arrow import evidence_array
+    from qualgrasp.certify.files.results import RESULT_SCHEMA
+    from qualgrasp.certify.quality.evidence import EvidenceColumns
+
+    at = np.array([i for i, p in enumerate(pairs) if p is not None], dtype=np.int64)
+    cols = []
+    for j in range(2):
+        local = np.arange(len(at))
+        blocks = [EvidenceColumns.block(part, [pairs[at[q]][j] for q in part]) for part in np.array_split(local, split)
+                  if len(part)]
+        cols.append(EvidenceColumns.assemble(len(at), blocks))
+        assert [cols[j].row(q) for q in local] == [pairs[i][j] for i in at]
+    got = evidence_array(cols[0], cols[1], at, len(pairs))
+    want = pa.array([None if p is None else {"l1": p[0].to_json(), "linf": p[1].to_json()} for p in pairs],
+                    type=RESULT_SCHEMA.field("eps_evidence").type)
+    assert got.equals(want)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.floats(0, 10), st.floats(0, 100), st.floats(0, 2))
+def test_lower_bounds_of_many_rows_are_each_rows(eps, d2, spread):
+    """The stated ``lo`` of many rows at once is :func:`_lower` of each, bit for bit (near the
+    tolerance's edges too)."""
+    from qualgrasp.certify.quality import bounds
+    from qualgrasp.certify.quality.evidence import EPS_TOL
+
+    x = eps * eps
+    rows = [(d2, d2 * (1 + spread)), (x, x), (x * (1 - EPS_TOL / 4), x * (1 + EPS_TOL / 4)),
+            (np.nextafter(x * (1 - EPS_TOL / 4), 0), x), (0.0, x), (x * 0.5, x * (1 + EPS_TOL / 4))]
+    lo = bounds._lowers(np.full(len(rows), eps), np.array([a for a, _ in rows]), np.array([b for _, b in rows]))
+    assert [float(v) for v in lo] == [bounds._lower(eps, r) for r in rows]

@@ -22,7 +22,7 @@ import numpy as np
 from .jit import kernel
 from .order import stable_argsort
 
-__all__ = ["PLANE_TOL", "hull_faces", "hulls_faces", "face_planes"]
+__all__ = ["PLANE_TOL", "hull_faces", "hulls_faces", "face_planes", "used_vertices"]
 
 #: Relative distance below which a point counts as on a face's plane (times the set's largest
 #: absolute coordinate).
@@ -277,3 +277,33 @@ def face_planes(P, faces):
                 normal[f, r] = -normal[f, r]
         dist[f] = normal[f, 0] * P[a, 0] + normal[f, 1] * P[a, 1] + normal[f, 2] * P[a, 2]
     return normal, dist
+
+
+@kernel
+def used_vertices(faces, fstart, vstart):
+    """The vertices the faces of each set use, for evidence that names only those: set ``s`` has
+    the points ``vstart[s]:vstart[s + 1]`` and the faces ``faces[fstart[s]:fstart[s + 1]]``
+    (indices local to its points). Returns ``used`` (each set's used local indices, ascending, as
+    :func:`numpy.unique` gives them), ``ustart`` (S + 1,) and the faces renumbered into ``used``."""
+    S = fstart.shape[0] - 1
+    local = np.empty_like(faces)
+    used = np.empty(faces.shape[0] * 3, dtype=np.int64)
+    ustart = np.zeros(S + 1, dtype=np.int64)
+    at = np.full(vstart[S] - vstart[0], -1, dtype=np.int64)
+    w = 0
+    for s in range(S):
+        n = vstart[s + 1] - vstart[s]
+        base = vstart[s] - vstart[0]
+        for f in range(fstart[s], fstart[s + 1]):
+            for q in range(3):
+                at[base + faces[f, q]] = 0
+        for i in range(n):
+            if at[base + i] == 0:
+                at[base + i] = w - ustart[s]
+                used[w] = i
+                w += 1
+        ustart[s + 1] = w
+        for f in range(fstart[s], fstart[s + 1]):
+            for q in range(3):
+                local[f, q] = at[base + faces[f, q]]
+    return used[:w], ustart, local

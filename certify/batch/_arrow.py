@@ -11,7 +11,7 @@ import pyarrow as pa
 from ..files.columns import GraspColumns, extra_columns
 from ..files.results import CERTIFICATE, RESULT_SCHEMA, carried_name, result_table
 
-__all__ = ["list_array", "certificates", "group_table", "assemble", "carry"]
+__all__ = ["list_array", "evidence_array", "certificates", "group_table", "assemble", "carry"]
 
 
 # built at first use: pyarrow imports pandas (when installed) for its first array, about 0.15 s
@@ -43,6 +43,32 @@ def list_array(values: np.ndarray, valid: np.ndarray | None, type_: pa.DataType)
     flat = values[valid].ravel()
     return pa.ListArray.from_arrays(pa.array(offsets), pa.array(flat, type=type_.value_type),
                                     mask=pa.array(~valid))
+
+
+def evidence_array(l1, linf, at: np.ndarray, n: int) -> pa.Array:
+    """The ``eps_evidence`` column of ``n`` rows from the evidence of each norm
+    (:class:`~qualgrasp.certify.quality.evidence.EvidenceColumns`) of the rows ``at``; null
+    elsewhere and where a row has no evidence."""
+    outer = RESULT_SCHEMA.field("eps_evidence").type
+    null = np.ones(n, dtype=bool)
+    null[at] = np.array([k is None for k in l1.kind], dtype=bool)
+    norms = []
+    for cols, field in zip((l1, linf), outer):
+        kind = np.full(n, None, dtype=object)
+        kind[at] = cols.kind
+        direction = np.zeros((n, cols.direction.shape[1]))
+        direction[at] = cols.direction
+        valid = ~null & ~np.isnan(direction).any(axis=1)
+        children = [pa.array(kind, type=pa.string()), list_array(direction, valid, field.type.field("direction").type)]
+        for name in ("ref", "points", "faces"):
+            lengths = np.zeros(n, dtype=np.int64)
+            lengths[at] = np.diff(getattr(cols, name + "_start"))
+            offsets = np.zeros(n + 1, dtype=np.int32)
+            np.cumsum(lengths, out=offsets[1:])
+            value_type = field.type.field(name).type.value_type
+            children.append(pa.ListArray.from_arrays(pa.array(offsets), pa.array(getattr(cols, name), type=value_type)))
+        norms.append(pa.StructArray.from_arrays(children, fields=list(field.type), mask=pa.array(null)))
+    return pa.StructArray.from_arrays(norms, fields=list(outer), mask=pa.array(null))
 
 
 def certificates(code: np.ndarray, lam: np.ndarray, basis: np.ndarray, y: np.ndarray,
@@ -97,12 +123,12 @@ def group_table(cols: GraspColumns, rows: np.ndarray, lines: np.ndarray, out, op
     if options.quality:  # spatial groups settle rows not in closure only: 0 there
         l1_lo, l1_hi, linf_lo, linf_hi, limited, evidence = out.get("eps") or (
             np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n, dtype=bool),
-            np.full(n, None, dtype=object))
+            None)
         for key, values in (("eps_l1_lo", l1_lo), ("eps_l1_hi", l1_hi), ("eps_linf_lo", linf_lo),
                             ("eps_linf_hi", linf_hi)):
             eps[key] = pa.array(values, type=pa.float64())
         eps["eps_limited"] = pa.array(limited, type=pa.bool_())
-        eps["eps_evidence"] = pa.array(list(evidence), type=RESULT_SCHEMA.field("eps_evidence").type)
+        eps["eps_evidence"] = pa.nulls(n, RESULT_SCHEMA.field("eps_evidence").type) if evidence is None else evidence
     return result_table({
         "id": cols.id_column(rows),
         "line": pa.array(lines, type=pa.int64()),

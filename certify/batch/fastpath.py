@@ -8,7 +8,7 @@ grouped by contact pattern (dimension, contact count, each contact's model and v
 * planar groups go through :func:`qualgrasp.certify._kernels.planar.planar_batch`: the LP (the
   same kernel the per-grasp path calls), the certificate and its rigorous re-check in floating
   point with error bounds; with quality, the exact planar epsilon and its evidence of every
-  closure row by :func:`qualgrasp.certify.quality.bounds.planar_epsilon_rows`, compiled for the
+  closure row by :func:`qualgrasp.certify.quality.bounds.planar_epsilon_columns`, compiled for the
   whole group and row for row what the per-grasp path's
   :func:`~qualgrasp.certify.quality.bounds.planar_epsilons` gives (rows its float checks cannot
   settle take that function);
@@ -56,13 +56,13 @@ from ..core.cones import LORENTZ
 from ..core.grasp import Contact, Grasp
 from ..core.problem import (Block, ClosureProblem, System, conic_block_arrays, conic_columns, grasp_problem,
                             grasp_system, ray_block_arrays)
-from ..quality.bounds import planar_epsilon_rows
+from ..quality.bounds import planar_epsilon_columns
 from ..solvers import BARRIER_NEAR_ZERO, FastSolver, make_solver
 from ..solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
 from ..solvers.enumeration import FEAS, bases
 from ..solvers.squeeze import squeeze_farkas
 from ..files.reader import rows_to_table
-from ._arrow import assemble, group_table
+from ._arrow import assemble, evidence_array, group_table
 from .. import models as registry
 from ..core.exact import dyadic_integers, unit_direction
 from ..core.wrench import (force_column_errors, force_columns, generator_columns, generator_layout,
@@ -432,26 +432,23 @@ def _solve_generators(solver, W):
 
 
 def _planar_quality(cols, rows, closure, P, N, mu, width, c, L, models, variants, options):
-    """Epsilon columns of a planar group: :func:`qualgrasp.certify.quality.bounds.planar_epsilon_rows`
+    """Epsilon columns of a planar group: :func:`qualgrasp.certify.quality.bounds.planar_epsilon_columns`
     (row for row what the per-grasp path's :func:`~qualgrasp.certify.quality.bounds.planar_epsilons`
     gives, on the same generator floats) for every closure row; 0 and no evidence elsewhere.
-    Returns ``(l1_lo, l1_hi, linf_lo, linf_hi, limited, evidence)``."""
+    Returns ``(l1_lo, l1_hi, linf_lo, linf_hi, limited, evidence)``, the evidence an Arrow column
+    (None: no row in closure)."""
     B, m = mu.shape
     owner, offset, friction = generator_layout(models, variants, 2)
     vals = np.zeros((B, 4))
     limited = np.zeros(B, dtype=bool)
-    evidence = np.full(B, None, dtype=object)
     at = np.flatnonzero(closure)
     if not len(at):
-        return vals[:, 0], vals[:, 1], vals[:, 2], vals[:, 3], limited, evidence
-    W, E = generator_rows(*(np.ascontiguousarray(a[at]) for a in (P, N, mu, width, c, L)), owner, offset, friction)
+        return vals[:, 0], vals[:, 1], vals[:, 2], vals[:, 3], limited, None
+    W, E = generator_rows(*(kernel_array(a[at]) for a in (P, N, mu, width, c, L)), owner, offset, friction)
     exact = lambda q: grasp_system(cols.grasps([rows[at[q]]])[0], exact=True).columns  # noqa: E731
-    for i, eps in zip(at, planar_epsilon_rows(W, E, owner, m, time_limit=options.eps_time, exact=exact)):
-        (a, b, _, ev1, lim1), (p, q, _, ev2, lim2) = eps["L1"], eps["Linf"]
-        vals[i] = a, b, p, q
-        limited[i] = lim1 or lim2
-        evidence[i] = {"l1": ev1.to_json(), "linf": ev2.to_json()}
-    return vals[:, 0], vals[:, 1], vals[:, 2], vals[:, 3], limited, evidence
+    found, cut, l1, linf = planar_epsilon_columns(W, E, owner, m, time_limit=options.eps_time, exact=exact)
+    vals[at], limited[at] = found, cut
+    return vals[:, 0], vals[:, 1], vals[:, 2], vals[:, 3], limited, evidence_array(l1, linf, at, B)
 
 
 def _polyhedral_rows(P, N, c, L, W, E, options, tol: Tolerances):
@@ -736,6 +733,8 @@ def certify_table(table: pa.Table, lines, options, tol: Tolerances = Tolerances(
 
 
 def _take(value, mask):
+    """The rows ``mask`` of a group's result: of each array in a tuple (Arrow arrays too)."""
     if isinstance(value, tuple):
-        return tuple(v[mask] if isinstance(v, np.ndarray) else v for v in value)
+        return tuple(v[mask] if isinstance(v, np.ndarray) else v.filter(pa.array(mask)) if isinstance(v, pa.Array)
+                     else v for v in value)
     return value[mask]

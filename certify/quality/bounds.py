@@ -89,23 +89,23 @@ from scipy.spatial import ConvexHull, QhullError
 from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .._kernels.epsilon import planar_epsilon as epsilon_kernel
 from .._kernels.evidence import minkowski_sums, support_choices, surface_rows, vertex_sums
-from .._kernels.hull import face_planes, hull_faces, hulls_faces
+from .._kernels.hull import face_planes, hull_faces, hulls_faces, used_vertices
 from .._kernels.jit import (BOOL, F1, F2, F3, FLOAT, I1, I2, INT, await_compiled, compile_elsewhere, compiled_here,
-                           mark_compiled, precompile)
+                           kernel_array, mark_compiled, precompile)
 from .._kernels.planar import planar_generators
 from .._kernels.surface import cycle_code, face_bounds, leibniz_tables
 from ..core.arguments import count_in, number_in, require
 from ..errors import ArgumentError
 from ..core.closure import Verdict, force_closure
-from .evidence import EPS_TOL, Evidence, stated_lo, surface_minimum
+from .evidence import EPS_TOL, Evidence, EvidenceColumns, stated_lo, surface_minimum
 from .gws import (ConicSupport, planar_generator_arrays, planar_support_choices,
-                  sum_rows, surface_faces, surfaces_faces)
+                  hull_rows, sum_rows, surface_faces, surfaces_faces)
 from ..core.grasp import Grasp
 from ..core.problem import System, grasp_system
 from ..solvers.clarabel_direct import settings
 
 __all__ = ["Norm", "NORMS", "Epsilon", "epsilon", "epsilons", "planar_epsilon", "planar_epsilons",
-           "planar_epsilon_rows", "epsilon_of_points", "check_norm", "L1_ENUMERATION_MAX",
+           "planar_epsilon_rows", "planar_epsilon_columns", "epsilon_of_points", "check_norm", "L1_ENUMERATION_MAX",
            "LINF_ENUMERATION_MAX", "SUMS_MAX", "MAX_VERTICES", "SOCP_COST", "KERNEL_SETS", "compile_ahead"]
 
 #: A norm of the grasp wrench space.
@@ -146,6 +146,7 @@ _PLANAR_KERNELS = _SURFACE_KERNELS + (
     (hulls_faces, (F2, I1)),  # every planar surface's faces
     (hull_faces, (F2,)),
     (face_planes, (F2, I2)),
+    (used_vertices, (I2, I1, I1)),
 )
 #: Those kernel sets by name (:func:`compile_ahead`; :mod:`qualgrasp.certify._kernels.jit`).
 KERNEL_SETS = {"quality-planar": _PLANAR_KERNELS, "quality-spatial": _SURFACE_KERNELS}
@@ -462,120 +463,158 @@ def planar_epsilon_rows(W, E, owner, m: int, *, time_limit: float | None = None,
     >>> round(row["L1"][0], 6), row["Linf"][3].kind
     (0.333333, 'sums')
     """
+    vals, limited, l1, linf = planar_epsilon_columns(W, E, owner, m, time_limit=time_limit, exact=exact)
+    out = []
+    for b in range(len(vals)):
+        a, c = l1.row(b), linf.row(b)
+        out.append({"L1": (float(vals[b, 0]), float(vals[b, 1]), a.direction, a, False),
+                    "Linf": (float(vals[b, 2]), float(vals[b, 3]), c.direction, c, bool(limited[b]))})
+    return out
+
+
+def planar_epsilon_columns(W, E, owner, m: int, *, time_limit: float | None = None, exact=None):
+    """:func:`planar_epsilon_rows` held in columns, as the batch path writes them: the same
+    values and evidence, without an object per row.
+
+    Returns
+    -------
+    values : ndarray, shape (B, 4)
+        L1 ``lo``, ``hi``, L-infinity ``lo``, ``hi`` of each row.
+    limited : ndarray of bool, shape (B,)
+        Whether the time limit cut a row's L-infinity bounds.
+    l1, linf : EvidenceColumns
+        The evidence of each norm.
+    """
     _after_compiling(None, 2)
     W = np.ascontiguousarray(W, dtype=float)
     E = np.ascontiguousarray(E, dtype=float)
     owner = np.ascontiguousarray(owner, dtype=np.int64)
     B, _, k = W.shape
-    slow = np.zeros(B, dtype=bool)
-    slow[:] = k > LINF_ENUMERATION_MAX
-    rows = np.flatnonzero(~slow)
-    out: list = [None] * B
-    l1 = _l1_rows(W, E, owner, m, rows, slow)
-    linf = _linf_rows(W, E, owner, m, rows, slow, l1, time_limit, exact)
-    for b in rows:
-        if not slow[b]:
-            out[b] = {"L1": l1[b], "Linf": linf[b]}
-    for b in np.flatnonzero(slow):
+    slow = np.full(B, k > LINF_ENUMERATION_MAX)
+    vals = np.zeros((B, 4))
+    limited = np.zeros(B, dtype=bool)
+    rows, directions, (lengths, items) = _l1_rows(W, E, owner, m, np.flatnonzero(~slow), slow, vals)
+    blocks2 = _linf_rows(W, E, owner, m, np.flatnonzero(~slow), slow, vals, limited, time_limit, exact)
+    keep = ~slow[rows]  # rows that L-infinity sent to the per-grasp route lose their L1 block
+    blocks1 = [(rows[keep], "generators", directions[keep], {"faces": (lengths[keep], items[np.repeat(keep, lengths)])})]
+    slow_rows = np.flatnonzero(slow)
+    evs1, evs2 = [], []
+    for b in slow_rows:
         deadline = None if time_limit is None else time.perf_counter() + time_limit
-        out[b] = planar_epsilons(W[b], E[b], owner, m, deadline=deadline,
-                                 exact=None if exact is None else (lambda b=b: exact(b)))
-    return out
+        row = planar_epsilons(W[b], E[b], owner, m, deadline=deadline,
+                              exact=None if exact is None else (lambda b=b: exact(b)))
+        (vals[b, 0], vals[b, 1], _, ev1, _), (vals[b, 2], vals[b, 3], _, ev2, limited[b]) = row["L1"], row["Linf"]
+        evs1.append(ev1)
+        evs2.append(ev2)
+    if len(slow_rows):
+        blocks1.append(EvidenceColumns.block(slow_rows, evs1))
+        blocks2.append(EvidenceColumns.block(slow_rows, evs2))
+    return vals, limited, EvidenceColumns.assemble(B, blocks1), EvidenceColumns.assemble(B, blocks2)
 
 
 def _checked(V, EV, faces):
-    """:func:`~qualgrasp.certify._kernels.evidence.surface_rows` of the surfaces ``faces`` (a list
-    of (F, 3) arrays, None for none) on the vertices ``V``, ``EV`` (lists of (n, 3) arrays): per
-    surface the proved bounds ``(d2_lo, d2_hi)`` of its squared distance, or None where the
-    float checks cannot settle it. The bounds are floats, which :func:`_lower` compares as
-    exactly as the Fractions :func:`_prove` gives."""
+    """:func:`_flat_checks` of the surfaces ``faces`` (a list of (F, 3) arrays, None for none) on
+    the vertices ``V``, ``EV`` (lists of (n, 3) arrays): per surface the proved bounds ``(d2_lo,
+    d2_hi)`` of its squared distance, or None where the float checks cannot settle it. The
+    bounds are floats, which :func:`_lower` compares as exactly as the Fractions :func:`_prove`
+    gives."""
     vstart = np.r_[0, np.cumsum([len(v) for v in V])].astype(np.int64)
     fs = [np.zeros((0, 3), dtype=np.int64) if f is None else f for f in faces]
     fstart = np.r_[0, np.cumsum([len(f) for f in fs])].astype(np.int64)
-    perms, signs = leibniz_tables(2)
-    cat = lambda a: np.ascontiguousarray(np.concatenate(a) if a else np.zeros((0, 3)))  # noqa: E731
-    decided, lo, hi = surface_rows(cat(V), cat(EV), vstart, cat(fs).astype(np.int64), fstart, perms,
-                                   signs, EPS_TOL / 8)
+    cat = lambda a: np.concatenate(a) if a else np.zeros((0, 3))  # noqa: E731
+    decided, lo, hi = _flat_checks(cat(V), cat(EV), vstart, kernel_array(cat(fs), np.int64), fstart)
     return [(float(a), float(b)) if ok else None for ok, a, b in zip(decided, lo, hi)]
 
 
-def _l1_rows(W, E, owner, m, rows, slow):
-    """L1 part of :func:`planar_epsilon_rows`: ``(lo, hi, direction, evidence, False)`` by row;
-    rows whose points span no hull or whose surface the float checks cannot settle are marked
-    ``slow``."""
+def _flat_checks(V, EV, vstart, faces, fstart):
+    """:func:`~qualgrasp.certify._kernels.evidence.surface_rows` of surfaces held flat (as
+    :func:`~qualgrasp.certify.quality.gws.hull_rows` gives them): per surface whether the float
+    checks settle it and the proved bounds ``(d2_lo, d2_hi)`` of its squared distance."""
+    perms, signs = leibniz_tables(2)
+    return surface_rows(kernel_array(V), kernel_array(EV), vstart, faces, fstart, perms, signs, EPS_TOL / 8)
+
+
+def _lowers(eps: np.ndarray, d2_lo: np.ndarray, d2_hi: np.ndarray) -> np.ndarray:
+    """:func:`_lower` of many rows, elementwise, in the same floating-point operations."""
+    x = eps * eps
+    tight = (d2_lo >= x * (1 - EPS_TOL / 4)) & (d2_hi <= x * (1 + EPS_TOL / 4))
+    stated = np.where(d2_lo > 0, np.sqrt(np.sqrt(np.maximum(d2_lo, 0)) * np.sqrt(np.maximum(d2_hi, 0))), 0.0)
+    return np.where(tight, eps, np.minimum(stated, eps))
+
+
+def _l1_rows(W, E, owner, m, rows, slow, vals):
+    """L1 part of :func:`planar_epsilon_columns`: fills ``lo`` and ``hi`` of the rows settled in
+    floats and returns them with their directions and faces ``(lengths, items)``; rows whose
+    points span no hull or whose surface the float checks cannot settle are marked ``slow``."""
     k = W.shape[2]
-    faces = dict(zip(rows, surfaces_faces([W[b].T for b in rows])))
-    todo = [b for b in rows if faces[b] is not None]
-    slow[[b for b in rows if faces[b] is None]] = True
+    V = W[rows].transpose(0, 2, 1).reshape(-1, 3)
+    EV = E[rows].transpose(0, 2, 1).reshape(-1, 3)
+    vstart = np.arange(len(rows) + 1, dtype=np.int64) * k
+    faces, fstart = hull_rows(V, vstart)
+    have = np.diff(fstart) > 0
     if k <= L1_ENUMERATION_MAX:
-        eps, arg = epsilon_kernel(W[todo], owner, m, False)
-        value = {b: (float(e), a) for b, e, a in zip(todo, eps, arg)}
+        eps, arg = epsilon_kernel(W[rows[have]], owner, m, False)
     else:
-        value = {b: _hull_minimum(W[b], owner, m, faces[b]) for b in todo}
-    proved = _checked([W[b].T for b in todo], [E[b].T for b in todo], [faces[b] for b in todo])
-    out = {}
-    for b, bounds in zip(todo, proved):
-        eps, u = value[b]
-        lo = None if bounds is None else _lower(eps, bounds)
-        if lo is None:
-            slow[b] = True
-            continue
-        direction = tuple(float(v) for v in u)
-        out[b] = (lo, eps, direction, Evidence("generators", direction, faces=tuple(faces[b].ravel().tolist())),
-                  False)
-    return out
+        found = [_hull_minimum(W[b], owner, m, faces[fstart[q]:fstart[q + 1]]) for q, b in enumerate(rows) if have[q]]
+        eps, arg = np.array([e for e, _ in found]).reshape(-1), np.array([u for _, u in found]).reshape(-1, 3)
+    decided, d2_lo, d2_hi = _flat_checks(V, EV, vstart, faces, fstart)
+    ok = decided[have]
+    slow[rows[~have]] = True
+    slow[rows[have][~ok]] = True
+    done = rows[have][ok]
+    vals[done, 0] = _lowers(eps[ok], d2_lo[have][ok], d2_hi[have][ok])
+    vals[done, 1] = eps[ok]
+    lengths = 3 * np.diff(fstart)
+    settled = np.zeros(len(rows), dtype=bool)
+    settled[np.flatnonzero(have)[ok]] = True
+    return done, np.asarray(arg, dtype=float)[ok], (lengths[settled], faces.ravel()[np.repeat(settled, lengths)])
 
 
-def _linf_rows(W, E, owner, m, rows, slow, l1, time_limit, exact):
-    """L-infinity part of :func:`planar_epsilon_rows` (``(lo, hi, direction, evidence,
-    limited)`` by row); rows not settled in floats are marked ``slow``."""
-    todo = np.array([b for b in rows if not slow[b]], dtype=np.int64)
-    out = {}
-    if not len(todo):
-        return out
-    eps, arg = epsilon_kernel(W[todo], owner, m, True)
+def _linf_rows(W, E, owner, m, rows, slow, vals, limited, time_limit, exact):
+    """L-infinity part of :func:`planar_epsilon_columns`: fills ``lo`` and ``hi`` of the rows
+    settled in floats (``vals[:, 0]`` holding their L1 ``lo``) and returns their evidence as
+    blocks of :meth:`EvidenceColumns.assemble`; rows not settled in floats are marked ``slow``."""
+    if not len(rows):
+        return []
+    eps, arg = epsilon_kernel(W[rows], owner, m, True)
     n = _sum_count(owner, m)
     if n > SUMS_MAX:
-        return _support_rows(W, E, owner, m, todo, eps, arg, l1, time_limit, exact)
+        return _support_rows(W, E, owner, m, rows, eps, arg, vals, limited, time_limit, exact)
+    blocks = []
     step = max(1, (1 << 20) // n)  # rows of sums held at once
-    for a in range(0, len(todo), step):
-        part = todo[a:a + step]
+    for a in range(0, len(rows), step):
+        part = rows[a:a + step]
+        e, u = eps[a:a + step], np.asarray(arg[a:a + step], dtype=float)
         pts, err, choice = minkowski_sums(W[part], E[part], owner, m)
-        faces = surfaces_faces(list(pts))
-        used = [None if f is None else np.unique(f) for f in faces]
-        local = []
-        for f, u in zip(faces, used):
-            if f is None:
-                local.append(None)
-                continue
-            remap = np.full(n, -1, dtype=np.int64)
-            remap[u] = np.arange(len(u))
-            local.append(remap[f])
-        have = [q for q in range(len(part)) if faces[q] is not None]
-        proved = dict(zip(have, _checked([pts[q][used[q]] for q in have], [err[q][used[q]] for q in have],
-                                         [local[q] for q in have])))
-        for q, b in enumerate(part):
-            e, direction = float(eps[a + q]), tuple(float(v) for v in arg[a + q])
-            l1_lo, ev = l1[b][0], None
-            if faces[q] is not None:
-                if proved[q] is None:
-                    slow[b] = True
-                    continue
-                lo = _lower(e, proved[q])
-                if lo >= l1_lo:
-                    ev = Evidence("sums", direction, ref=tuple(choice[used[q]].ravel().tolist()),
-                                  faces=tuple(local[q].ravel().tolist()))
-            if ev is None:
-                lo, ev = min(l1_lo, e), Evidence("l1", direction)
-            out[b] = (lo, e, direction, ev, False)
-    return out
+        vstart = np.arange(len(part) + 1, dtype=np.int64) * n
+        faces, fstart = hull_rows(pts.reshape(-1, 3), vstart)
+        used, ustart, local = used_vertices(faces, fstart, vstart)
+        at = used + np.repeat(vstart[:-1], np.diff(ustart))
+        decided, d2_lo, d2_hi = _flat_checks(pts.reshape(-1, 3)[at], err.reshape(-1, 3)[at], ustart, local, fstart)
+        has = np.diff(fstart) > 0
+        good = ~has | decided  # no hull: the L1 evidence; a hull the floats cannot settle: per grasp
+        slow[part[~good]] = True
+        l1_lo = vals[part, 0]
+        sums = has & decided
+        sums[sums] = _lowers(e[sums], d2_lo[sums], d2_hi[sums]) >= l1_lo[sums]
+        lo = np.minimum(l1_lo, e)
+        lo[sums] = _lowers(e[sums], d2_lo[sums], d2_hi[sums])
+        vals[part[good], 2] = lo[good]
+        vals[part[good], 3] = e[good]
+        nf = np.where(sums, 3 * np.diff(fstart), 0)
+        nr = np.where(sums, m * np.diff(ustart), 0)
+        lists = {"faces": (nf[good], local.ravel()[np.repeat(sums, 3 * np.diff(fstart))]),
+                 "ref": (nr[good], choice[used].ravel()[np.repeat(sums, m * np.diff(ustart))])}
+        blocks.append((part[good], np.where(sums, "sums", "l1")[good], u[good], lists))
+    return blocks
 
 
-def _support_rows(W, E, owner, m, todo, eps, arg, l1, time_limit, exact):
-    """The L-infinity part of :func:`planar_epsilon_rows` beyond :data:`SUMS_MAX` sums: each
+def _support_rows(W, E, owner, m, todo, eps, arg, vals, limited, time_limit, exact):
+    """The L-infinity part of :func:`planar_epsilon_columns` beyond :data:`SUMS_MAX` sums: each
     row's ``support`` surface refined on its own (:func:`_support_surface`), then the hulls'
     faces oriented and their float checks run for all rows at once; a surface those cannot
-    settle is proved as :func:`_planar_support` proves it."""
+    settle is proved as :func:`_planar_support` proves it. Fills ``vals`` and ``limited`` and
+    returns the evidence as one block of :meth:`EvidenceColumns.assemble`."""
     refined = []
     for b, e, u in zip(todo, eps, arg):
         deadline = None if time_limit is None else time.perf_counter() + time_limit
@@ -585,9 +624,9 @@ def _support_rows(W, E, owner, m, todo, eps, arg, l1, time_limit, exact):
     done = [q for q in have if faces[q] is not None]
     proved = dict(zip(done, _checked([refined[q][0][1] for q in done], [refined[q][0][2] for q in done],
                                      [faces[q] for q in done])))
-    out = {}
+    evs = []
     for q, (b, e, u) in enumerate(zip(todo, eps, arg)):
-        surface, limited = refined[q]
+        surface, cut = refined[q]
         found = None
         if surface is not None:
             dirs, V, EV, R = surface
@@ -597,8 +636,9 @@ def _support_rows(W, E, owner, m, todo, eps, arg, l1, time_limit, exact):
                 bounds = _prove(V, EV, faces[q], _support_vertex(R, gens))
             lo = _lower(float(e), bounds)
             found = None if lo is None else (lo, dirs)
-        out[b] = _support_result(float(e), u, l1[b][0], found, limited)
-    return out
+        vals[b, 2], vals[b, 3], _, ev, limited[b] = _support_result(float(e), u, vals[b, 0], found, cut)
+        evs.append(ev)
+    return [EvidenceColumns.block(todo, evs)]
 
 
 def _exact_once(exact):

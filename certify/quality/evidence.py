@@ -76,7 +76,7 @@ from ..core.grasp import Grasp
 from ..core.problem import grasp_system
 from .gws import ConicSupport, planar_generator_arrays, planar_support_vertices, sum_rows, surface_faces
 
-__all__ = ["EPS_TOL", "KINDS", "Evidence", "cycle_check", "exact_face", "surface_minimum", "stated_lo",
+__all__ = ["EPS_TOL", "KINDS", "Evidence", "EvidenceColumns", "cycle_check", "exact_face", "surface_minimum", "stated_lo",
            "planar_vertex_arrays", "spatial_vertex_arrays", "verify_bounds", "check_hi", "verify_epsilon",
            "EPS_COLUMNS"]
 
@@ -152,6 +152,88 @@ class Evidence:
         direction = numbers("direction", False)
         return cls(kind, direction, numbers("ref", True) or (), numbers("points", False) or (),
                    numbers("faces", True) or ())
+
+
+#: The list fields of :class:`Evidence` and the dtype each is held in by :class:`EvidenceColumns`.
+LIST_FIELDS = (("ref", np.int64), ("points", np.float64), ("faces", np.int64))
+
+
+def _positions(starts: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+    """Where the items of segments of ``lengths``, held one after another, go when segment ``i``
+    starts at ``starts[i]``."""
+    before = np.cumsum(lengths) - lengths
+    return np.repeat(starts - before, lengths) + np.arange(int(lengths.sum()))
+
+
+@dataclass(frozen=True, eq=False)
+class EvidenceColumns:
+    """The :class:`Evidence` of one norm for ``B`` rows, held flat (as a results column holds
+    it) instead of as ``B`` objects: row ``b`` has the kind ``kind[b]`` (None: no evidence), the
+    direction ``direction[b]`` (NaN: none) and the ``ref`` items
+    ``ref[ref_start[b]:ref_start[b + 1]]``, and likewise ``points`` and ``faces``.
+
+    Examples
+    --------
+    >>> a = Evidence("sums", (1.0, 0.0, 0.0), ref=(0, -1), faces=(0, 1, 2))
+    >>> cols = EvidenceColumns.assemble(3, [EvidenceColumns.block([2, 0], [a, Evidence("l1", (0.0, 1.0, 0.0))])])
+    >>> cols.row(2) == a, cols.row(1), cols.row(0).kind
+    (True, None, 'l1')
+    """
+
+    kind: np.ndarray
+    direction: np.ndarray
+    ref: np.ndarray
+    ref_start: np.ndarray
+    points: np.ndarray
+    points_start: np.ndarray
+    faces: np.ndarray
+    faces_start: np.ndarray
+
+    def row(self, b: int) -> Evidence | None:
+        """The evidence of row ``b`` as an :class:`Evidence` (None where there is none)."""
+        if self.kind[b] is None:
+            return None
+        d = self.direction[b]
+        lists = [tuple(getattr(self, name)[getattr(self, name + "_start")[b]:getattr(self, name + "_start")[b + 1]]
+                       .tolist()) for name, _ in LIST_FIELDS]
+        return Evidence(self.kind[b], None if np.isnan(d).any() else tuple(d.tolist()), *lists)
+
+    @staticmethod
+    def block(rows, evidences: Sequence[Evidence], width: int = 3) -> tuple:
+        """A block of :meth:`assemble` from :class:`Evidence` objects, one per row of ``rows``."""
+        lists = {}
+        for name, dtype in LIST_FIELDS:
+            parts = [getattr(e, name) for e in evidences]
+            lists[name] = (np.array([len(p) for p in parts], dtype=np.int64),
+                           np.array([x for p in parts for x in p], dtype=dtype))
+        direction = np.array([(np.nan,) * width if e.direction is None else e.direction for e in evidences],
+                             dtype=float).reshape(-1, width)
+        return np.asarray(rows, dtype=np.int64), [e.kind for e in evidences], direction, lists
+
+    @classmethod
+    def assemble(cls, B: int, blocks, width: int = 3) -> "EvidenceColumns":
+        """The columns of ``B`` rows from blocks ``(rows, kind, direction, lists)``: rows (r,),
+        their kinds (a string or r of them), directions (r, width) and, for some of ``ref``,
+        ``points`` and ``faces``, ``(lengths (r,), items of the rows one after another)``. Each
+        row is in at most one block; rows in none have no evidence."""
+        kind = np.full(B, None, dtype=object)
+        direction = np.full((B, width), np.nan)
+        lengths = {name: np.zeros(B, dtype=np.int64) for name, _ in LIST_FIELDS}
+        for rows, k, d, lists in blocks:
+            kind[rows] = k
+            direction[rows] = d
+            for name, (n, _) in lists.items():
+                lengths[name][rows] = n
+        out = {}
+        for name, dtype in LIST_FIELDS:
+            start = np.zeros(B + 1, dtype=np.int64)
+            np.cumsum(lengths[name], out=start[1:])
+            values = np.empty(int(start[-1]), dtype=dtype)
+            for rows, _, _, lists in blocks:
+                if name in lists and len(lists[name][1]):
+                    values[_positions(start[rows], lists[name][0])] = lists[name][1]
+            out[name], out[name + "_start"] = values, start
+        return cls(kind, direction, **out)
 
 
 # --- surfaces ------------------------------------------------------------------------------------

@@ -35,7 +35,7 @@ from ..core.grasp import Grasp
 from ..core.problem import grasp_system
 from ..core.wrench import force_column_errors, generator_layout, grasp_arrays, to_exact, variants_of
 
-__all__ = ["SHRINK", "surface_faces", "surfaces_faces", "orient_faces", "generalised_cross", "face_distances",
+__all__ = ["SHRINK", "surface_faces", "surfaces_faces", "hull_rows", "orient_faces", "generalised_cross", "face_distances",
            "planar_generator_arrays", "sum_errors", "planar_support_choice", "planar_support_choices",
            "planar_support_vertices",
            "sum_rows", "sqrt_bounds", "vertex_scale", "ConicSupport"]
@@ -63,15 +63,30 @@ def surfaces_faces(point_sets) -> list[np.ndarray | None]:
     if not point_sets:
         return []
     if np.shape(point_sets[0])[1] == 3:
-        V = kernel_array(np.concatenate(point_sets))
         vstart = np.cumsum([0] + [len(p) for p in point_sets]).astype(np.int64)
-        faces, fstart = hulls_faces(V, vstart)
-        out = [faces[fstart[s]:fstart[s + 1]] if fstart[s + 1] > fstart[s] else None for s in range(len(point_sets))]
-        declined = [s for s, f in enumerate(out) if f is None]
-        for s, f in zip(declined, _qhull_faces([point_sets[s] for s in declined])):
-            out[s] = f
-        return out
+        faces, fstart = hull_rows(np.concatenate(point_sets), vstart)
+        return [faces[fstart[s]:fstart[s + 1]] if fstart[s + 1] > fstart[s] else None for s in range(len(point_sets))]
     return _qhull_faces(point_sets)
+
+
+def hull_rows(V: np.ndarray, vstart: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`surface_faces` of many 3-D sets held flat: set ``s`` is ``V[vstart[s]:vstart[s + 1]]``.
+    Returns the faces of all sets one after another (indices local to each set) and ``fstart``,
+    set ``s`` owning ``faces[fstart[s]:fstart[s + 1]]`` (none where its points span no hull)."""
+    V = kernel_array(V)
+    vstart = kernel_array(vstart, np.int64)
+    faces, fstart = hulls_faces(V, vstart)
+    declined = np.flatnonzero(np.diff(fstart) == 0)
+    if not len(declined):
+        return faces, fstart
+    found = _qhull_faces([V[vstart[s]:vstart[s + 1]] for s in declined])
+    if all(f is None for f in found):
+        return faces, fstart
+    parts = [faces[fstart[s]:fstart[s + 1]] for s in range(len(fstart) - 1)]
+    for s, f in zip(declined, found):
+        if f is not None:
+            parts[s] = f
+    return np.concatenate(parts), np.cumsum([0] + [len(f) for f in parts]).astype(np.int64)
 
 
 def _qhull_faces(point_sets) -> list[np.ndarray | None]:
