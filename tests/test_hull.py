@@ -158,3 +158,36 @@ def test_lower_bounds_of_many_rows_are_each_rows(eps, d2, spread):
             (np.nextafter(x * (1 - EPS_TOL / 4), 0), x), (0.0, x), (x * 0.5, x * (1 + EPS_TOL / 4))]
     lo = bounds._lowers(np.full(len(rows), eps), np.array([a for a, _ in rows]), np.array([b for _, b in rows]))
     assert [float(v) for v in lo] == [bounds._lower(eps, r) for r in rows]
+
+
+# --- hulls in more dimensions: the spatial refinement's guide and the 6-D triangulation ------------
+
+def test_planes_in_six_dimensions_are_qhulls_equations():
+    """Facet normals and offsets in 4 and 6 dimensions, built at once and built incrementally
+    (points added to a hull of the first ones, as the spatial refinement adds them), against qhull."""
+    from qualgrasp.certify._kernels.hull import hull_facets, hull_planes, live_planes, planes_insert, planes_start
+
+    rng = np.random.default_rng(6)
+    for d, n, extra in ((4, 12, 3), (6, 20, 2), (6, 40, 5)):
+        for _ in range(10):
+            P = rng.normal(size=(n + extra, d)) + rng.normal(size=d)
+            want = ConvexHull(P).equations
+            verts, normal, off, alive, F, centre, ok = planes_start(np.ascontiguousarray(P[:n]))
+            assert ok
+            verts, normal, off, alive, F, ok = planes_insert(P, n, verts, normal, off, alive, F, centre)
+            assert ok
+            for normals, dist in (live_planes(normal, off, alive, F), hull_planes(P)):
+                got = np.c_[normals, -dist]
+                assert len(got) == len(want)
+                assert np.abs(got[:, None, :] - want[None, :, :]).max(axis=2).min(axis=1).max() < 1e-9
+            facets = hull_facets(P)
+            assert sorted(map(tuple, np.sort(facets, axis=1))) == sorted(map(tuple, np.sort(ConvexHull(P).simplices, axis=1)))
+
+
+def test_flat_sets_in_six_dimensions_are_declined():
+    from qualgrasp.certify._kernels.hull import hull_planes
+
+    rng = np.random.default_rng(7)
+    P = np.c_[rng.normal(size=(30, 5)), np.zeros(30)]
+    assert hull_planes(P)[0].shape == (0, 6)
+    assert hull_planes(rng.normal(size=(6, 6)))[0].shape == (0, 6)  # too few points

@@ -22,7 +22,8 @@ import numpy as np
 from .jit import kernel
 from .order import stable_argsort
 
-__all__ = ["PLANE_TOL", "hull_faces", "hulls_faces", "face_planes", "used_vertices"]
+__all__ = ["PLANE_TOL", "hull_faces", "hulls_faces", "face_planes", "used_vertices", "hull_planes", "planes_start",
+           "planes_insert", "live_planes", "hull_facets"]
 
 #: Relative distance below which a point counts as on a face's plane (times the set's largest
 #: absolute coordinate).
@@ -307,3 +308,351 @@ def used_vertices(faces, fstart, vstart):
             for q in range(3):
                 local[f, q] = at[base + faces[f, q]]
     return used[:w], ustart, local
+
+
+@kernel
+def _facet_plane(P, verts, centre, normal, work, x, col):
+    """Into ``normal`` (d,): the unit normal of the hyperplane through the ``d`` points
+    ``P[verts]``, turned away from ``centre``; returns its offset ``normal . P[verts[0]]``, or NaN
+    when the points are (numerically) affinely dependent. The normal spans the null space of the
+    edges from the first point (``work``, (d - 1, d)), found by Gaussian elimination with full
+    pivoting and back substitution (``x``, ``col``: scratch of length d)."""
+    d = P.shape[1]
+    a = verts[0]
+    for r in range(d):
+        col[r] = r
+    for i in range(d - 1):
+        for q in range(d):
+            work[i, q] = P[verts[i + 1], q] - P[a, q]
+    for k in range(d - 1):
+        pi, pj, best = k, k, 0.0
+        for i in range(k, d - 1):
+            for j in range(k, d):
+                if abs(work[i, j]) > best:
+                    pi, pj, best = i, j, abs(work[i, j])
+        if not best > 0.0:
+            return np.nan
+        if pi != k:
+            for q in range(d):
+                work[k, q], work[pi, q] = work[pi, q], work[k, q]
+        if pj != k:
+            for i in range(d - 1):
+                work[i, k], work[i, pj] = work[i, pj], work[i, k]
+            col[k], col[pj] = col[pj], col[k]
+        for i in range(k + 1, d - 1):
+            f = work[i, k] / work[k, k]
+            for q in range(k + 1, d):
+                work[i, q] -= f * work[k, q]
+    x[d - 1] = 1.0
+    for k in range(d - 2, -1, -1):
+        t = 0.0
+        for q in range(k + 1, d):
+            t += work[k, q] * x[q]
+        x[k] = -t / work[k, k]
+    nn = 0.0
+    for r in range(d):
+        nn += x[r] * x[r]
+    nn = np.sqrt(nn)
+    if not (nn > 0.0 and nn < np.inf):
+        return np.nan
+    off, side = 0.0, 0.0
+    for r in range(d):
+        normal[col[r]] = x[r] / nn
+    for r in range(d):
+        off += normal[r] * P[a, r]
+        side += normal[r] * centre[r]
+    if side > off:
+        for r in range(d):
+            normal[r] = -normal[r]
+        off = -off
+    return off
+
+
+@kernel
+def _simplex(P, tol):
+    """``d + 1`` affinely independent points of ``P`` (n, d), each the farthest from the affine
+    hull of those before (Gram-Schmidt), starting from the least first coordinate; -1 in the
+    first entry when every point lies within ``tol`` of a hyperplane."""
+    n, d = P.shape
+    out = np.full(d + 1, -1, dtype=np.int64)
+    i0 = 0
+    for i in range(n):
+        if P[i, 0] < P[i0, 0]:
+            i0 = i
+    Q = np.zeros((d, d))
+    x = np.empty(d)
+    chosen = np.empty(d + 1, dtype=np.int64)
+    chosen[0] = i0
+    for k in range(d):
+        best, arg = -1.0, -1
+        for i in range(n):
+            for r in range(d):
+                x[r] = P[i, r] - P[i0, r]
+            for j in range(k):
+                dot = 0.0
+                for r in range(d):
+                    dot += Q[j, r] * x[r]
+                for r in range(d):
+                    x[r] -= dot * Q[j, r]
+            h = 0.0
+            for r in range(d):
+                h += x[r] * x[r]
+            h = np.sqrt(h)
+            if h > best:
+                best, arg = h, i
+        if not best > tol:
+            return out
+        for r in range(d):
+            x[r] = P[arg, r] - P[i0, r]
+        for j in range(k):
+            dot = 0.0
+            for r in range(d):
+                dot += Q[j, r] * x[r]
+            for r in range(d):
+                x[r] -= dot * Q[j, r]
+        h = 0.0
+        for r in range(d):
+            h += x[r] * x[r]
+        h = np.sqrt(h)
+        for r in range(d):
+            Q[k, r] = x[r] / h
+        chosen[k + 1] = arg
+    out[:] = chosen
+    return out
+
+
+@kernel
+def _compact(verts, normal, off, alive, F):
+    """Move the live facets among the first ``F`` to the front; returns how many there are."""
+    w = 0
+    for f in range(F):
+        if alive[f]:
+            for r in range(verts.shape[1]):
+                verts[w, r], normal[w, r] = verts[f, r], normal[f, r]
+            off[w] = off[f]
+            alive[w] = True
+            w += 1
+    for f in range(w, F):
+        alive[f] = False
+    return w
+
+
+@kernel
+def _tolerance(P):
+    """:data:`PLANE_TOL` times the largest absolute coordinate of ``P``; NaN when one is not finite."""
+    s = 0.0
+    for i in range(P.shape[0]):
+        for r in range(P.shape[1]):
+            if not abs(P[i, r]) <= 1e300:
+                return np.nan
+            s = max(s, abs(P[i, r]))
+    return PLANE_TOL * s
+
+
+@kernel
+def planes_start(P):
+    """An incremental hull of ``P`` (n, d), ``d >= 3``, for :func:`planes_insert` and
+    :func:`live_planes`: ``(verts, normal, off, alive, F, centre, ok)``, the facets (simplices,
+    rows of ``verts``), their unit outward normals and offsets (``normal . x <= off`` inside), which
+    of the first ``F`` rows are live, and an interior point. ``ok`` is False when the points lie
+    within :data:`PLANE_TOL` of a hyperplane or the construction fails.
+
+    Points are inserted after an initial simplex, farthest from its centre first; the facets a
+    point lies more than the tolerance beyond are replaced by the cone from the point to their
+    horizon (the ridges they share with the other facets, found by sorting ridge keys). A guide
+    for the spatial epsilon's refinement, never a proof: the evidence is checked on a
+    triangulation of its own.
+    """
+    n, d = P.shape
+    cap = 64 * n + 64
+    verts = np.zeros((cap, d), dtype=np.int64)
+    normal = np.zeros((cap, d))
+    off = np.zeros(cap)
+    alive = np.zeros(cap, dtype=np.bool_)
+    centre = np.zeros(d)
+    tol = _tolerance(P)
+    if n <= d or not tol >= 0.0:
+        return verts, normal, off, alive, 0, centre, False
+    first = _simplex(P, tol)
+    if first[0] < 0:
+        return verts, normal, off, alive, 0, centre, False
+    for q in range(d + 1):
+        for r in range(d):
+            centre[r] += P[first[q], r] / (d + 1)
+    work = np.empty((d - 1, d))
+    x = np.empty(d)
+    col = np.empty(d, dtype=np.int64)
+    F = 0
+    for j in range(d + 1):  # the simplex's facets (vertices ascending, as every facet keeps them)
+        c = 0
+        for q in range(d + 1):
+            if q != j:
+                verts[F, c] = first[q]
+                c += 1
+        verts[F].sort()
+        off[F] = _facet_plane(P, verts[F], centre, normal[F], work, x, col)
+        if np.isnan(off[F]):
+            return verts, normal, off, alive, 0, centre, False
+        alive[F] = True
+        F += 1
+    far = np.empty(n)
+    for i in range(n):
+        d2 = 0.0
+        for r in range(d):
+            d2 += (P[i, r] - centre[r]) ** 2
+        far[i] = -d2
+    for q in range(d + 1):
+        far[first[q]] = np.inf  # taken: last, and skipped
+    for p in stable_argsort(far):
+        if far[p] == np.inf:
+            continue
+        verts, normal, off, alive, F, ok = _insert(P, p, verts, normal, off, alive, F, centre, tol, work, x, col)
+        if not ok:
+            return verts, normal, off, alive, 0, centre, False
+    return verts, normal, off, alive, F, centre, True
+
+
+@kernel
+def planes_insert(P, start, verts, normal, off, alive, F, centre):
+    """Insert the points ``P[start:]`` (in order) into the hull of :func:`planes_start` built on
+    the points before them. Returns ``(verts, normal, off, alive, F, ok)``, the arrays grown where
+    needed; ``ok`` False when the construction fails (build the hull anew)."""
+    tol = _tolerance(P)
+    if not tol >= 0.0:
+        return verts, normal, off, alive, F, False
+    work = np.empty((P.shape[1] - 1, P.shape[1]))
+    x = np.empty(P.shape[1])
+    col = np.empty(P.shape[1], dtype=np.int64)
+    for p in range(start, P.shape[0]):
+        verts, normal, off, alive, F, ok = _insert(P, p, verts, normal, off, alive, F, centre, tol, work, x, col)
+        if not ok:
+            return verts, normal, off, alive, F, False
+    return verts, normal, off, alive, F, True
+
+
+@kernel
+def live_planes(normal, off, alive, F):
+    """The live facets' unit outward normals (L, d) and offsets (L,), in facet order."""
+    count = 0
+    for f in range(F):
+        if alive[f]:
+            count += 1
+    normals = np.empty((count, normal.shape[1]))
+    dist = np.empty(count)
+    w = 0
+    for f in range(F):
+        if alive[f]:
+            normals[w] = normal[f]
+            dist[w] = off[f]
+            w += 1
+    return normals, dist
+
+
+@kernel
+def hull_planes(P):
+    """The facets of the convex hull of ``P`` (n, d), ``d >= 3``, as unit outward normals
+    (F, d) and each facet's offset (the distance of its plane from the origin, negative when the
+    origin is outside), as qhull's ``equations`` give them (``normal``, ``-offset``; a facet
+    holding more than ``d`` points comes in simplices); empty arrays where :func:`planes_start`
+    fails."""
+    verts, normal, off, alive, F, centre, ok = planes_start(P)
+    return live_planes(normal, off, alive, F if ok else 0)
+
+
+@kernel
+def hull_facets(P):
+    """The facets of the convex hull of ``P`` (n, d), ``d >= 3``, as rows of ``d`` vertex indices
+    (a triangulation of its boundary into simplices), in the order :func:`live_planes` gives
+    their planes; an empty (0, d) array where :func:`planes_start` fails."""
+    verts, normal, off, alive, F, centre, ok = planes_start(P)
+    if not ok:
+        F = 0
+    count = 0
+    for f in range(F):
+        if alive[f]:
+            count += 1
+    out = np.empty((count, P.shape[1]), dtype=np.int64)
+    w = 0
+    for f in range(F):
+        if alive[f]:
+            out[w] = verts[f]
+            w += 1
+    return out
+
+
+@kernel
+def _insert(P, p, verts, normal, off, alive, F, centre, tol, work, x, col):
+    """Insert the point ``P[p]``: returns ``(verts, normal, off, alive, F, ok)``. Every facet keeps
+    its vertices ascending, so that dropping one gives a ridge's sorted key."""
+    n, d = P.shape
+    nv = 0
+    visible = np.empty(F, dtype=np.int64)
+    for f in range(F):
+        if alive[f]:
+            h = -off[f]
+            for r in range(d):
+                h += normal[f, r] * P[p, r]
+            if h > tol:
+                visible[nv] = f
+                nv += 1
+    if nv == 0:
+        return verts, normal, off, alive, F, True
+    keys = np.empty(nv * d, dtype=np.int64)
+    for q in range(nv):  # every ridge of the visible facets, as a key of its (sorted) vertices
+        f = visible[q]
+        for j in range(d):
+            key = 0
+            for t in range(d):
+                if t != j:
+                    key = key * n + verts[f, t]
+            keys[q * d + j] = key
+    order = stable_argsort(keys)
+    horizon = np.empty(nv * d, dtype=np.int64)  # positions (q * d + j) of the ridges seen once
+    nh, i = 0, 0
+    while i < nv * d:
+        j = i
+        while j + 1 < nv * d and keys[order[j + 1]] == keys[order[i]]:
+            j += 1
+        if j == i:
+            horizon[nh] = order[i]
+            nh += 1
+        elif j - i > 1:
+            return verts, normal, off, alive, F, False  # a ridge in three facets: not a manifold
+        i = j + 1
+    if nh < d:
+        return verts, normal, off, alive, F, False
+    new_verts = np.empty((nh, d), dtype=np.int64)
+    for q in range(nh):  # the ridge and the point, ascending
+        f, j = visible[horizon[q] // d], horizon[q] % d
+        c, put = 0, False
+        for t in range(d):
+            if t != j:
+                v = verts[f, t]
+                if not put and p < v:
+                    new_verts[q, c] = p
+                    c += 1
+                    put = True
+                new_verts[q, c] = v
+                c += 1
+        if not put:
+            new_verts[q, c] = p
+    for q in range(nv):
+        alive[visible[q]] = False
+    if F + nh > alive.shape[0]:  # compact the live facets to the front, then grow if short of room
+        F = _compact(verts, normal, off, alive, F)
+        if F + nh > alive.shape[0]:
+            cap = 2 * (F + nh)
+            verts2 = np.zeros((cap, d), dtype=np.int64)
+            normal2 = np.zeros((cap, d))
+            off2 = np.zeros(cap)
+            alive2 = np.zeros(cap, dtype=np.bool_)
+            verts2[:F], normal2[:F], off2[:F], alive2[:F] = verts[:F], normal[:F], off[:F], alive[:F]
+            verts, normal, off, alive = verts2, normal2, off2, alive2
+    for q in range(nh):
+        verts[F] = new_verts[q]
+        off[F] = _facet_plane(P, verts[F], centre, normal[F], work, x, col)
+        if np.isnan(off[F]):
+            return verts, normal, off, alive, F, False
+        alive[F] = True
+        F += 1
+    return verts, normal, off, alive, F, True

@@ -55,12 +55,13 @@ except ImportError:  # Windows: no flock, no compiling elsewhere
 
 __all__ = ["cache_dir", "source_fingerprint", "KERNEL_SOURCES", "kernel", "kernel_array", "precompile", "compiled_here",
            "compile_elsewhere", "await_compiled", "compile_set", "mark_compiled", "WAIT_SECONDS",
-           "F1", "F2", "F3", "I1", "I2", "INT", "FLOAT", "BOOL"]
+           "F1", "F2", "F3", "I1", "I2", "B1", "INT", "FLOAT", "BOOL"]
 
-#: Argument types as the callers pass them: C-contiguous float64 arrays of 1 to 3 dimensions and
-#: int64 arrays of 1 and 2, and Python's int, float and bool.
+#: Argument types as the callers pass them: C-contiguous float64 arrays of 1 to 3 dimensions,
+#: int64 arrays of 1 and 2 and boolean arrays of 1, and Python's int, float and bool.
 F1, F2, F3 = types.float64[::1], types.float64[:, ::1], types.float64[:, :, ::1]
 I1, I2 = types.int64[::1], types.int64[:, ::1]
+B1 = types.boolean[::1]
 INT, FLOAT, BOOL = types.int64, types.float64, types.boolean
 
 

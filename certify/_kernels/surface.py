@@ -12,6 +12,7 @@ Higham's ``gamma_n`` of the sum of magnitudes.
 
 from __future__ import annotations
 
+import functools
 from itertools import permutations
 
 import numpy as np
@@ -23,8 +24,10 @@ from .order import stable_argsort
 __all__ = ["face_bounds", "leibniz_tables", "planar_h_bounds", "cycle_code"]
 
 
+@functools.lru_cache(maxsize=None)
 def leibniz_tables(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Permutations of ``range(n)`` (rows) and their signs, for :func:`face_bounds`."""
+    """Permutations of ``range(n)`` (rows) and their signs, for :func:`face_bounds`; computed once
+    per ``n`` and shared (callers pass them on, never change them)."""
     perms = np.array(list(permutations(range(n))), dtype=np.int64).reshape(-1, n)
     signs = np.array([(-1.0) ** sum(p[i] > p[j] for i in range(n) for j in range(i + 1, n))
                       for p in perms])

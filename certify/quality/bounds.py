@@ -89,8 +89,9 @@ from scipy.spatial import ConvexHull, QhullError
 from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .._kernels.epsilon import planar_epsilon as epsilon_kernel
 from .._kernels.evidence import minkowski_sums, support_choices, surface_rows, vertex_sums
-from .._kernels.hull import face_planes, hull_faces, hulls_faces, used_vertices
-from .._kernels.jit import (BOOL, F1, F2, F3, FLOAT, I1, I2, INT, await_compiled, compile_elsewhere, compiled_here,
+from .._kernels.hull import (face_planes, hull_faces, hull_facets, hulls_faces, live_planes, planes_insert, planes_start,
+                             used_vertices)
+from .._kernels.jit import (B1, BOOL, F1, F2, F3, FLOAT, I1, I2, INT, await_compiled, compile_elsewhere, compiled_here,
                            kernel_array, mark_compiled, precompile)
 from .._kernels.planar import planar_generators
 from .._kernels.surface import cycle_code, face_bounds, leibniz_tables
@@ -132,7 +133,9 @@ _SWEEP_BATCH = 64
 _ADD = 2
 #: The kernels the epsilon of spatial grasps calls (those checking surfaces), with the argument
 #: types it calls them with: compiled before the time limit's clock runs (:func:`_after_compiling`).
-_SURFACE_KERNELS = ((face_bounds, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)))
+_SURFACE_KERNELS = ((face_bounds, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)), (planes_start, (F2,)),
+                    (planes_insert, (F2, INT, I2, F2, F1, B1, INT, F1)), (live_planes, (F2, F1, B1, INT)),
+                    (hull_facets, (F2,)))
 #: The same for planar grasps.
 _PLANAR_KERNELS = _SURFACE_KERNELS + (
     (planar_generators, (F2, F2, F1, F1, F1, FLOAT, I1, F1, F1, F2, F2)),
@@ -978,6 +981,38 @@ class _Pieces:
         return u, h_u, steps
 
 
+class _Guide:
+    """The hull of the spatial refinement's points, kept from round to round: the compiled
+    incremental hull (:func:`~qualgrasp.certify._kernels.hull.planes_start`,
+    :func:`~qualgrasp.certify._kernels.hull.planes_insert`), each round adding only its new points;
+    qhull built anew where that hull declines (not qhull's own incremental mode, whose precision
+    errors end the process: scipy issue 4974, exit code 7, no exception)."""
+
+    def __init__(self) -> None:
+        self.state = None
+        self.done = 0
+
+    def planes(self, V: np.ndarray):
+        """Unit outward normals (F, d) and offsets (F,) of the facets of the hull of ``V`` (the
+        points of the last call and new ones after them), or None when ``V`` spans no hull."""
+        V = np.ascontiguousarray(V, dtype=float)
+        if self.state is not None and len(V) > self.done:
+            verts, normal, off, alive, F, centre = self.state
+            verts, normal, off, alive, F, ok = planes_insert(V, self.done, verts, normal, off, alive, F, centre)
+            self.state = (verts, normal, off, alive, F, centre) if ok else None
+        if self.state is None:
+            verts, normal, off, alive, F, centre, ok = planes_start(V)
+            self.state = (verts, normal, off, alive, F, centre) if ok else None
+        if self.state is not None:
+            self.done = len(V)
+            return live_planes(self.state[1], self.state[2], self.state[3], self.state[4])
+        try:
+            eq = ConvexHull(V).equations
+        except (QhullError, ValueError):
+            return None
+        return np.ascontiguousarray(eq[:, :-1]), -eq[:, -1]
+
+
 def _initial_directions(d: int) -> np.ndarray:
     rng = np.random.default_rng(0)  # fixed: results are reproducible
     R = rng.normal(size=(16 * d, d))
@@ -1015,17 +1050,14 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
         add(v)
     spare = iter(U[2 * d:])  # more starting directions while the hull is flat
     looked = 0  # the number of points when the points' hyperplane was last looked off
-    rounds, hull, done = 0, None, 0
+    rounds, hull, done, guide = 0, None, 0, _Guide()
     while not limited:
         rounds += 1
-        try:  # built anew, not with qhull's incremental mode, whose precision errors end the process
-            if len(V) > d and (hull is None or len(V) > done):  # (scipy issue 4974: exit code 7, no exception)
-                hull = ConvexHull(np.array(V))
-                done = len(V)
-        except (QhullError, ValueError):  # a flat or degenerate set: more directions first
-            hull = None
+        if len(V) > d and (hull is None or len(V) > done):
+            hull = guide.planes(np.array(V))  # None: a flat or degenerate set, more directions first
+            done = len(V)
         if hull is not None:
-            dist = -hull.equations[:, -1]  # qhull's unit outward normals: a guide, not a proof
+            outward, dist = hull  # unit outward normals and offsets: a guide, not a proof
             if hi - dist.min() <= rel_gap * hi:
                 break
         if _expired(deadline):
@@ -1048,7 +1080,7 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
             add(v)
             work += 1
             continue
-        normals = hull.equations[np.argsort(dist, kind="stable")[:_ADD], :-1]
+        normals = outward[np.argsort(dist, kind="stable")[:_ADD]]
         hv = pieces.h(normals, norm)
         work += len(normals)
         j = int(np.argmin(hv))

@@ -48,7 +48,8 @@ Vertices, by the evidence ``kind``:
     ``ref`` names the one contact of each vertex; for L-infinity every contact whose term is
     positive along ``v`` is summed.
     The faces are not stored (a 6-D hull has many more faces than vertices): the checker
-    triangulates the vertices with qhull and then checks that triangulation exactly, so a
+    triangulates the vertices (:func:`~qualgrasp.certify.quality.gws.surface_faces`: a compiled hull, qhull
+    where that declines) and then checks that triangulation exactly, so a
     wrong triangulation can only make the check fail, never pass.
 ``l1`` (L-infinity)
     The L1 GWS lies inside the L-infinity one, so the L1 evidence proves the L1 ``lo`` for
@@ -318,7 +319,7 @@ def surface_minimum(V: np.ndarray, EV: np.ndarray, faces: np.ndarray, exact_vert
     if reason:
         return reason, Fraction(0), Fraction(0)
     d = V.shape[1]
-    perms, signs = _LEIBNIZ.setdefault(d - 1, leibniz_tables(d - 1))
+    perms, signs = leibniz_tables(d - 1)
     ok, lo, hi = face_bounds(np.ascontiguousarray(V, dtype=float), np.ascontiguousarray(EV, dtype=float),
                              np.ascontiguousarray(faces, dtype=np.int64), perms, signs)
     exact: dict[int, Fraction] = {}  # faces settled exactly: their squared distance
@@ -352,8 +353,6 @@ def surface_minimum(V: np.ndarray, EV: np.ndarray, faces: np.ndarray, exact_vert
         highs.append(Fraction(float(hi[open_].min())))
     return None, min(lows), min(highs)
 
-
-_LEIBNIZ: dict[int, tuple] = {}
 
 
 def stated_lo(d2_lo: Fraction, d2_hi: Fraction) -> float:

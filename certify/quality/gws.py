@@ -12,8 +12,8 @@ same functions, so that a vertex the evidence names is the vertex that was compu
 * spatial grasps with exact cones: the support forces of every contact (:class:`ConicSupport`),
   pulled inside their cones by :data:`SHRINK` and scaled towards the origin by
   :func:`vertex_scale`;
-* hulls: their faces oriented about the origin (:func:`surface_faces`; compiled in 3-D, qhull in 6-D) and
-  their float distances.
+* hulls: their faces oriented about the origin (:func:`surface_faces`, compiled hulls) and their float
+  distances.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from scipy.spatial import ConvexHull, QhullError
 
 from .. import models as registry
 from .._kernels.evidence import support_choices, vertex_sums
-from .._kernels.hull import hull_faces, hulls_faces
+from .._kernels.hull import hull_facets, hull_faces, hulls_faces
 from .._kernels.jit import kernel_array
 from .._kernels.planar import planar_generators
 from ..core import cones
@@ -48,9 +48,10 @@ SHRINK = 1.0 - 2.0**-30
 def surface_faces(points: np.ndarray) -> np.ndarray | None:
     """Faces of the hull of ``points`` (n, d), each ordered so that its float determinant
     ``det(v_1, ..., v_d)`` is not negative (outward about an interior origin); None when the
-    points span no full-dimensional hull. In 3-D (planar grasps) the compiled hull of
-    :func:`~qualgrasp.certify._kernels.hull.hull_faces` gives them, qhull where that one declines;
-    in other dimensions qhull."""
+    points span no full-dimensional hull. Compiled hulls give them, qhull where those decline: in
+    3-D (planar grasps) :func:`~qualgrasp.certify._kernels.hull.hull_faces`, in other dimensions
+    (6-D, spatial grasps) the facets of :func:`~qualgrasp.certify._kernels.hull.hull_facets`,
+    simplices, ordered by :func:`orient_faces`."""
     if np.shape(points)[1:] == (3,):  # one set: without the batch's bookkeeping
         faces = hull_faces(kernel_array(points))
         if len(faces):
@@ -66,7 +67,12 @@ def surfaces_faces(point_sets) -> list[np.ndarray | None]:
         vstart = np.cumsum([0] + [len(p) for p in point_sets]).astype(np.int64)
         faces, fstart = hull_rows(np.concatenate(point_sets), vstart)
         return [faces[fstart[s]:fstart[s + 1]] if fstart[s + 1] > fstart[s] else None for s in range(len(point_sets))]
-    return _qhull_faces(point_sets)
+    out = []
+    for pts in point_sets:
+        pts = kernel_array(pts)
+        facets = hull_facets(pts) if pts.ndim == 2 and pts.shape[1] > 3 else np.zeros((0, 0), dtype=np.int64)
+        out.append(orient_faces(pts, facets) if len(facets) else _qhull_faces([pts])[0])
+    return out
 
 
 def hull_rows(V: np.ndarray, vstart: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
