@@ -31,6 +31,24 @@ PLANE_TOL = 2.0**-40
 
 
 @kernel
+def _farthest_first(d2):
+    """Indices of ``d2`` (squared distances; negative for points to leave out) from the largest
+    down, ties in index order, the negative ones last (selection: the sets are small, and this
+    compiles in a fraction of a sort)."""
+    n = d2.shape[0]
+    order = np.empty(n, dtype=np.int64)
+    left = d2.copy()
+    for k in range(n):
+        best = 0
+        for i in range(1, n):
+            if left[i] > left[best]:
+                best = i
+        order[k] = best
+        left[best] = -np.inf
+    return order
+
+
+@kernel
 def _plane(P, a, b, c, out):
     """Into ``out`` (4,): the normal ``(b - a) x (c - a)`` of the face ``a, b, c`` and its offset
     ``n . P[a]``; returns ``|n|``."""
@@ -116,9 +134,8 @@ def hull_faces(P):
     size = np.empty(cap)
     alive = np.zeros(cap, dtype=np.bool_)
     F = 0
-    quad = ((0, 1, 2, 3), (0, 1, 3, 2), (0, 2, 3, 1), (1, 2, 3, 0))
-    for a, b, c, d in quad:  # the tetrahedron's faces, each turned away from its fourth vertex
-        i, j, k, o = first[a], first[b], first[c], first[d]
+    for o4 in range(4):  # the tetrahedron's faces, each turned away from its fourth vertex
+        i, j, k, o = first[0 if o4 > 0 else 1], first[1 if o4 > 1 else 2], first[2 if o4 > 2 else 3], first[o4]
         nn = _plane(P, i, j, k, plane[F])
         if plane[F, 0] * P[o, 0] + plane[F, 1] * P[o, 1] + plane[F, 2] * P[o, 2] - plane[F, 3] > 0.0:
             j, k = k, j
@@ -139,8 +156,8 @@ def hull_faces(P):
         for r in range(3):
             x = P[i, r] - 0.25 * (P[first[0], r] + P[first[1], r] + P[first[2], r] + P[first[3], r])
             d2 += x * x
-        far[i] = -d2
-    for p in stable_argsort(far):
+        far[i] = d2
+    for p in _farthest_first(far):
         if taken[p]:
             continue
         nv = 0
@@ -201,8 +218,10 @@ def hull_faces(P):
             w = 0
             for f in range(F):
                 if alive[f]:
-                    face[w] = face[f]
-                    plane[w] = plane[f]
+                    for r in range(3):
+                        face[w, r] = face[f, r]
+                    for r in range(4):
+                        plane[w, r] = plane[f, r]
                     size[w] = size[f]
                     alive[w] = True
                     w += 1
@@ -234,16 +253,31 @@ def hulls_faces(V, vstart):
     faces of all sets one after another (indices local to each set) and ``fstart`` (S + 1,),
     set ``s`` owning ``faces[fstart[s]:fstart[s + 1]]`` (none where its hull failed)."""
     S = vstart.shape[0] - 1
-    parts = []
     fstart = np.zeros(S + 1, dtype=np.int64)
+    faces = np.empty((max(16, 2 * (vstart[S] - vstart[0])), 3), dtype=np.int64)
     for s in range(S):
-        f = hull_faces(V[vstart[s]:vstart[s + 1]])
-        parts.append(f)
-        fstart[s + 1] = fstart[s] + f.shape[0]
-    faces = np.empty((fstart[S], 3), dtype=np.int64)
-    for s in range(S):
-        faces[fstart[s]:fstart[s + 1]] = parts[s]
-    return faces, fstart
+        n = vstart[s + 1] - vstart[s]
+        P = np.empty((n, 3))  # a copy in C order: the one specialisation of hull_faces
+        for i in range(n):
+            for r in range(3):
+                P[i, r] = V[vstart[s] + i, r]
+        f = hull_faces(P)
+        end = fstart[s] + f.shape[0]
+        if end > faces.shape[0]:  # room for twice as many
+            grown = np.empty((2 * end, 3), dtype=np.int64)
+            for i in range(fstart[s]):
+                for r in range(3):
+                    grown[i, r] = faces[i, r]
+            faces = grown
+        for i in range(f.shape[0]):
+            for r in range(3):
+                faces[fstart[s] + i, r] = f[i, r]
+        fstart[s + 1] = end
+    out = np.empty((fstart[S], 3), dtype=np.int64)
+    for i in range(fstart[S]):
+        for r in range(3):
+            out[i, r] = faces[i, r]
+    return out, fstart
 
 
 @kernel
@@ -417,7 +451,8 @@ def _simplex(P, tol):
         for r in range(d):
             Q[k, r] = x[r] / h
         chosen[k + 1] = arg
-    out[:] = chosen
+    for q in range(d + 1):
+        out[q] = chosen[q]
     return out
 
 
@@ -489,7 +524,11 @@ def planes_start(P):
             if q != j:
                 verts[F, c] = first[q]
                 c += 1
-        verts[F].sort()
+        for i in range(1, d):  # ascending (insertion sort)
+            t = i
+            while t > 0 and verts[F, t - 1] > verts[F, t]:
+                verts[F, t - 1], verts[F, t] = verts[F, t], verts[F, t - 1]
+                t -= 1
         off[F] = _facet_plane(P, verts[F], centre, normal[F], work, x, col)
         if np.isnan(off[F]):
             return verts, normal, off, alive, 0, centre, False
@@ -500,11 +539,11 @@ def planes_start(P):
         d2 = 0.0
         for r in range(d):
             d2 += (P[i, r] - centre[r]) ** 2
-        far[i] = -d2
+        far[i] = d2
     for q in range(d + 1):
-        far[first[q]] = np.inf  # taken: last, and skipped
-    for p in stable_argsort(far):
-        if far[p] == np.inf:
+        far[first[q]] = -1.0  # taken: last, and skipped
+    for p in _farthest_first(far):
+        if far[p] < 0.0:
             continue
         verts, normal, off, alive, F, ok = _insert(P, p, verts, normal, off, alive, F, centre, tol, work, x, col)
         if not ok:
@@ -542,7 +581,8 @@ def live_planes(normal, off, alive, F):
     w = 0
     for f in range(F):
         if alive[f]:
-            normals[w] = normal[f]
+            for r in range(normal.shape[1]):
+                normals[w, r] = normal[f, r]
             dist[w] = off[f]
             w += 1
     return normals, dist
@@ -575,7 +615,8 @@ def hull_facets(P):
     w = 0
     for f in range(F):
         if alive[f]:
-            out[w] = verts[f]
+            for r in range(verts.shape[1]):
+                out[w, r] = verts[f, r]
             w += 1
     return out
 
@@ -646,10 +687,14 @@ def _insert(P, p, verts, normal, off, alive, F, centre, tol, work, x, col):
             normal2 = np.zeros((cap, d))
             off2 = np.zeros(cap)
             alive2 = np.zeros(cap, dtype=np.bool_)
-            verts2[:F], normal2[:F], off2[:F], alive2[:F] = verts[:F], normal[:F], off[:F], alive[:F]
+            for f in range(F):
+                for r in range(d):
+                    verts2[f, r], normal2[f, r] = verts[f, r], normal[f, r]
+                off2[f], alive2[f] = off[f], alive[f]
             verts, normal, off, alive = verts2, normal2, off2, alive2
     for q in range(nh):
-        verts[F] = new_verts[q]
+        for r in range(d):
+            verts[F, r] = new_verts[q, r]
         off[F] = _facet_plane(P, verts[F], centre, normal[F], work, x, col)
         if np.isnan(off[F]):
             return verts, normal, off, alive, F, False

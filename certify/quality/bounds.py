@@ -131,13 +131,16 @@ _TOP = 16
 _SWEEP_BATCH = 64
 #: Weakest faces whose normals are added per round of the spatial refinement.
 _ADD = 2
-#: The kernels the epsilon of spatial grasps calls (those checking surfaces), with the argument
-#: types it calls them with: compiled before the time limit's clock runs (:func:`_after_compiling`).
-_SURFACE_KERNELS = ((face_bounds, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)), (planes_start, (F2,)),
-                    (planes_insert, (F2, INT, I2, F2, F1, B1, INT, F1)), (live_planes, (F2, F1, B1, INT)),
-                    (hull_facets, (F2,)))
-#: The same for planar grasps.
-_PLANAR_KERNELS = _SURFACE_KERNELS + (
+#: The kernels checking surfaces, with the argument types the epsilons call them with: compiled
+#: before the time limit's clock runs (:func:`_after_compiling`).
+_CHECK_KERNELS = ((face_bounds, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)))
+#: The kernels the epsilon of spatial grasps calls: the checks and the 6-D hulls.
+_SURFACE_KERNELS = _CHECK_KERNELS + (
+    (planes_start, (F2,)), (planes_insert, (F2, INT, I2, F2, F1, B1, INT, F1)), (live_planes, (F2, F1, B1, INT)),
+    (hull_facets, (F2,)))
+#: The same for planar grasps, in two sets: these, compiled in another process on a cold cache
+#: (:func:`compile_ahead`), ...
+_PLANAR_KERNELS = _CHECK_KERNELS + (
     (planar_generators, (F2, F2, F1, F1, F1, FLOAT, I1, F1, F1, F2, F2)),
     (planar_epsilon_one, (F2, I1, INT, BOOL)),
     (support_rows, (F2, I1, INT, F2, BOOL)),
@@ -146,13 +149,20 @@ _PLANAR_KERNELS = _SURFACE_KERNELS + (
     (minkowski_sums, (F3, F3, I1, INT)),  # the vertices of sums and support evidence
     (support_choices, (F2, I1, INT, F2)),
     (vertex_sums, (F2, F2, I2)),
-    (hulls_faces, (F2, I1)),  # every planar surface's faces
-    (hull_faces, (F2,)),
     (face_planes, (F2, I2)),
     (used_vertices, (I2, I1, I1)),
 )
+#: ... and the 3-D hulls, compiled here meanwhile, once closure's kernels are (the two take about
+#: as long).
+_HULL_KERNELS = (
+    (hulls_faces, (F2, I1)),  # every planar surface's faces
+    (hull_faces, (F2,)),
+)
 #: Those kernel sets by name (:func:`compile_ahead`; :mod:`qualgrasp.certify._kernels.jit`).
-KERNEL_SETS = {"quality-planar": _PLANAR_KERNELS, "quality-spatial": _SURFACE_KERNELS}
+KERNEL_SETS = {"quality-planar": _PLANAR_KERNELS, "quality-hulls": _HULL_KERNELS, "quality-spatial": _SURFACE_KERNELS}
+#: The sets the epsilons of each dimension need: the first is compiled elsewhere on a cold cache,
+#: the others here.
+_SETS = {2: ("quality-planar", "quality-hulls"), 3: ("quality-spatial",)}
 
 
 @dataclass(frozen=True)
@@ -227,10 +237,6 @@ def _expired(deadline: float | None) -> bool:
     return deadline is not None and time.perf_counter() > deadline
 
 
-def _set_name(dim: int) -> str:
-    return "quality-planar" if dim == 2 else "quality-spatial"
-
-
 def compile_ahead(dims) -> None:
     """Have another process compile quality's kernels for grasps of ``dims`` (2, 3) into the
     compile cache when it lacks them, while this one certifies closure: on a cold cache two cores
@@ -242,23 +248,25 @@ def compile_ahead(dims) -> None:
     >>> compile_ahead([2])   # the cache holds them: nothing to do
     """
     for dim in sorted({int(d) for d in dims} & {2, 3}):
-        name = _set_name(dim)
+        name = _SETS[dim][0]
         if not compiled_here(KERNEL_SETS[name]):
             compile_elsewhere(__name__, name)
 
 
 def _after_compiling(deadline: float | None, dim: int) -> float | None:
-    """Compile the kernel set of ``dim`` (:data:`KERNEL_SETS`), first waiting for another process
-    compiling it (:func:`compile_ahead`), and return ``deadline`` pushed back by the time that
-    took: a time limit counts computation, never compilation, so that a cold compile cache cannot
-    change a result."""
-    name = _set_name(dim)
-    if compiled_here(KERNEL_SETS[name]):  # every call after a process's first
+    """Compile the kernel sets of ``dim`` (:data:`KERNEL_SETS`): those no other process compiles
+    first, then the one :func:`compile_ahead` may have another process compiling, waiting for it;
+    and return ``deadline`` pushed back by the time that took: a time limit counts computation,
+    never compilation, so that a cold compile cache cannot change a result."""
+    names = _SETS[dim]
+    if all(compiled_here(KERNEL_SETS[name]) for name in names):  # every call after a process's first
         return deadline
     start = time.perf_counter()
-    await_compiled(name)
-    precompile(KERNEL_SETS[name])
-    mark_compiled(name)
+    for name in names[1:] + names[:1]:
+        if not compiled_here(KERNEL_SETS[name]):
+            await_compiled(name)
+            precompile(KERNEL_SETS[name])
+            mark_compiled(name)
     return None if deadline is None else deadline + (time.perf_counter() - start)
 
 
