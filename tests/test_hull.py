@@ -181,7 +181,8 @@ def test_planes_in_six_dimensions_are_qhulls_equations():
                 assert len(got) == len(want)
                 assert np.abs(got[:, None, :] - want[None, :, :]).max(axis=2).min(axis=1).max() < 1e-9
             facets = hull_facets(P)
-            assert sorted(map(tuple, np.sort(facets, axis=1))) == sorted(map(tuple, np.sort(ConvexHull(P).simplices, axis=1)))
+            want_facets = np.sort(ConvexHull(P).simplices, axis=1)
+            assert sorted(map(tuple, np.sort(facets, axis=1))) == sorted(map(tuple, want_facets))
 
 
 def test_flat_sets_in_six_dimensions_are_declined():
@@ -191,3 +192,48 @@ def test_flat_sets_in_six_dimensions_are_declined():
     P = np.c_[rng.normal(size=(30, 5)), np.zeros(30)]
     assert hull_planes(P)[0].shape == (0, 6)
     assert hull_planes(rng.normal(size=(6, 6)))[0].shape == (0, 6)  # too few points
+
+
+def test_six_dimensional_face_bounds_hold_the_exact_distance():
+    """The float checks of 6-D faces (cofactors from shared Laplace minors) bound the exact squared
+    distance of each face's hyperplane (rational arithmetic on the float vertices, taken as
+    exact), prove the orientation only where the exact determinant is positive, and stay tight."""
+    from fractions import Fraction
+
+    from qualgrasp.certify._kernels.surface import face_bounds, leibniz_tables
+
+    def exact(P):
+        D = [[Fraction(P[q][r]) - Fraction(P[0][r]) for r in range(6)] for q in range(1, 6)]
+
+        def det(M):
+            M, s = [row[:] for row in M], Fraction(1)
+            for c in range(len(M)):
+                p = next((r for r in range(c, len(M)) if M[r][c] != 0), None)
+                if p is None:
+                    return Fraction(0)
+                if p != c:
+                    M[c], M[p], s = M[p], M[c], -s
+                s *= M[c][c]
+                for r in range(c + 1, len(M)):
+                    f = M[r][c] / M[c][c]
+                    M[r] = [a - f * b for a, b in zip(M[r], M[c])]
+            return s
+
+        n = [(-1) ** r * det([[row[q] for q in range(6) if q != r] for row in D]) for r in range(6)]
+        dt = sum(n[r] * Fraction(P[0][r]) for r in range(6))
+        return dt, dt * dt / sum(x * x for x in n)
+
+    rng = np.random.default_rng(8)
+    perms, signs = leibniz_tables(5)
+    widths = []
+    for t in range(60):
+        P = (rng.normal(size=(6, 6)) + 3 * rng.normal(size=6)) * 10.0 ** rng.integers(-3, 4)
+        EV = np.zeros_like(P) if t % 2 else np.abs(rng.normal(size=P.shape)) * 1e-13 * np.abs(P).max()
+        ok, lo, hi = face_bounds(P, EV, np.arange(6, dtype=np.int64)[None], perms, signs)
+        dt, d2 = exact(P.tolist())
+        assert not ok[0] or dt > 0
+        if ok[0]:
+            assert Fraction(float(lo[0])) <= d2 <= Fraction(float(hi[0]))
+            if not EV.any():
+                widths.append((hi[0] - lo[0]) / hi[0])
+    assert widths and max(widths) < 1e-8

@@ -89,8 +89,8 @@ from scipy.spatial import ConvexHull, QhullError
 from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .._kernels.epsilon import planar_epsilon as epsilon_kernel
 from .._kernels.evidence import minkowski_sums, support_choices, surface_rows, vertex_sums
-from .._kernels.hull import (face_planes, hull_faces, hull_facets, hulls_faces, live_planes, planes_insert, planes_start,
-                             used_vertices)
+from .._kernels.hull import (face_planes, hull_faces, hull_facets, hulls_faces, live_planes, planes_insert,
+                             planes_start, used_vertices)
 from .._kernels.jit import (B1, BOOL, F1, F2, F3, FLOAT, I1, I2, INT, await_compiled, compile_elsewhere, compiled_here,
                            kernel_array, mark_compiled, precompile)
 from .._kernels.planar import planar_generators
@@ -436,8 +436,9 @@ def planar_epsilon_rows(W, E, owner, m: int, *, time_limit: float | None = None,
     (:func:`~qualgrasp.certify._kernels.evidence.surface_rows`) and the hulls whose faces the
     evidence states (:func:`~qualgrasp.certify.quality.gws.surfaces_faces`) run on the whole batch;
     only the ``support`` refinement (more than :data:`SUMS_MAX` sums) is computed row by row. A row
-    whose surfaces the float checks cannot settle, whose points span no hull, or with more than :data:`LINF_ENUMERATION_MAX` generators
-    takes :func:`planar_epsilons` itself, so that every row is what the per-grasp route gives.
+    whose surfaces the float checks cannot settle, whose points span no hull, or with more than
+    :data:`LINF_ENUMERATION_MAX` generators takes :func:`planar_epsilons` itself, so that every row
+    is what the per-grasp route gives.
 
     Parameters
     ----------
@@ -507,7 +508,8 @@ def planar_epsilon_columns(W, E, owner, m: int, *, time_limit: float | None = No
     rows, directions, (lengths, items) = _l1_rows(W, E, owner, m, np.flatnonzero(~slow), slow, vals)
     blocks2 = _linf_rows(W, E, owner, m, np.flatnonzero(~slow), slow, vals, limited, time_limit, exact)
     keep = ~slow[rows]  # rows that L-infinity sent to the per-grasp route lose their L1 block
-    blocks1 = [(rows[keep], "generators", directions[keep], {"faces": (lengths[keep], items[np.repeat(keep, lengths)])})]
+    faces = (lengths[keep], items[np.repeat(keep, lengths)])
+    blocks1 = [(rows[keep], "generators", directions[keep], {"faces": faces})]
     slow_rows = np.flatnonzero(slow)
     evs1, evs2 = [], []
     for b in slow_rows:

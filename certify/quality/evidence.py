@@ -77,7 +77,8 @@ from ..core.grasp import Grasp
 from ..core.problem import grasp_system
 from .gws import ConicSupport, planar_generator_arrays, planar_support_vertices, sum_rows, surface_faces
 
-__all__ = ["EPS_TOL", "KINDS", "Evidence", "EvidenceColumns", "cycle_check", "exact_face", "surface_minimum", "stated_lo",
+__all__ = ["EPS_TOL", "KINDS", "Evidence", "EvidenceColumns", "cycle_check", "exact_face", "surface_minimum",
+           "stated_lo",
            "planar_vertex_arrays", "spatial_vertex_arrays", "verify_bounds", "check_hi", "verify_epsilon",
            "EPS_COLUMNS"]
 

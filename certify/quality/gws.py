@@ -35,7 +35,8 @@ from ..core.grasp import Grasp
 from ..core.problem import grasp_system
 from ..core.wrench import force_column_errors, generator_layout, grasp_arrays, to_exact, variants_of
 
-__all__ = ["SHRINK", "surface_faces", "surfaces_faces", "hull_rows", "orient_faces", "generalised_cross", "face_distances",
+__all__ = ["SHRINK", "surface_faces", "surfaces_faces", "hull_rows", "orient_faces", "generalised_cross",
+           "face_distances",
            "planar_generator_arrays", "sum_errors", "planar_support_choice", "planar_support_choices",
            "planar_support_vertices",
            "sum_rows", "sqrt_bounds", "vertex_scale", "ConicSupport"]
