@@ -197,10 +197,11 @@ def test_flat_sets_in_six_dimensions_are_declined():
 def test_six_dimensional_face_bounds_hold_the_exact_distance():
     """The float checks of 6-D faces (cofactors from shared Laplace minors) bound the exact squared
     distance of each face's hyperplane (rational arithmetic on the float vertices, taken as
-    exact), prove the orientation only where the exact determinant is positive, and stay tight."""
+    exact), prove the orientation only where the exact determinant is positive, stay tight, and
+    agree with Leibniz's sums."""
     from fractions import Fraction
 
-    from qualgrasp.certify._kernels.surface import face_bounds, leibniz_tables
+    from qualgrasp.certify._kernels.surface import face_bounds, face_bounds_laplace, leibniz_tables
 
     def exact(P):
         D = [[Fraction(P[q][r]) - Fraction(P[0][r]) for r in range(6)] for q in range(1, 6)]
@@ -229,7 +230,10 @@ def test_six_dimensional_face_bounds_hold_the_exact_distance():
     for t in range(60):
         P = (rng.normal(size=(6, 6)) + 3 * rng.normal(size=6)) * 10.0 ** rng.integers(-3, 4)
         EV = np.zeros_like(P) if t % 2 else np.abs(rng.normal(size=P.shape)) * 1e-13 * np.abs(P).max()
-        ok, lo, hi = face_bounds(P, EV, np.arange(6, dtype=np.int64)[None], perms, signs)
+        face = np.arange(6, dtype=np.int64)[None]
+        ok, lo, hi = face_bounds_laplace(P, EV, face, perms, signs)
+        leibniz = face_bounds(P, EV, face, perms, signs)
+        assert ok[0] == leibniz[0][0] and np.allclose([lo[0], hi[0]], [leibniz[1][0], leibniz[2][0]], rtol=1e-8)
         dt, d2 = exact(P.tolist())
         assert not ok[0] or dt > 0
         if ok[0]:

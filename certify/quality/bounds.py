@@ -94,7 +94,7 @@ from .._kernels.hull import (face_planes, hull_faces, hull_facets, hulls_faces, 
 from .._kernels.jit import (B1, BOOL, F1, F2, F3, FLOAT, I1, I2, INT, await_compiled, compile_elsewhere, compiled_here,
                            kernel_array, mark_compiled, precompile)
 from .._kernels.planar import planar_generators
-from .._kernels.surface import cycle_code, face_bounds, leibniz_tables
+from .._kernels.surface import cycle_code, face_bounds, face_bounds_laplace, leibniz_tables
 from ..core.arguments import count_in, number_in, require
 from ..errors import ArgumentError
 from ..core.closure import Verdict, force_closure
@@ -131,37 +131,41 @@ _TOP = 16
 _SWEEP_BATCH = 64
 #: Weakest faces whose normals are added per round of the spatial refinement.
 _ADD = 2
-#: The kernels checking surfaces, with the argument types the epsilons call them with: compiled
-#: before the time limit's clock runs (:func:`_after_compiling`).
+#: The kernels checking planar surfaces, with the argument types the epsilons call them with:
+#: compiled before the time limit's clock runs (:func:`_after_compiling`).
 _CHECK_KERNELS = ((face_bounds, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)))
-#: The kernels the epsilon of spatial grasps calls: the checks and the 6-D hulls.
-_SURFACE_KERNELS = _CHECK_KERNELS + (
-    (planes_start, (F2,)), (planes_insert, (F2, INT, I2, F2, F1, B1, INT, F1)), (live_planes, (F2, F1, B1, INT)),
-    (hull_facets, (F2,)))
-#: The same for planar grasps, in two sets: these, compiled in another process on a cold cache
-#: (:func:`compile_ahead`), ...
+#: The kernels the epsilon of spatial grasps calls: the checks of 6-D faces and the 6-D hulls.
+_SURFACE_KERNELS = (
+    (face_bounds_laplace, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)), (planes_start, (F2,)),
+    (planes_insert, (F2, INT, I2, F2, F1, B1, INT, F1)), (live_planes, (F2, F1, B1, INT)), (hull_facets, (F2,)))
+#: The same for planar grasps, in three sets: these, ...
 _PLANAR_KERNELS = _CHECK_KERNELS + (
     (planar_generators, (F2, F2, F1, F1, F1, FLOAT, I1, F1, F1, F2, F2)),
     (planar_epsilon_one, (F2, I1, INT, BOOL)),
-    (support_rows, (F2, I1, INT, F2, BOOL)),
-    (planar_edges, (F2, I1)),
-    (linf_sweep, (F2, I1, INT, F2, INT, INT, F1, F2)),
     (minkowski_sums, (F3, F3, I1, INT)),  # the vertices of sums and support evidence
-    (support_choices, (F2, I1, INT, F2)),
-    (vertex_sums, (F2, F2, I2)),
-    (face_planes, (F2, I2)),
     (used_vertices, (I2, I1, I1)),
 )
-#: ... and the 3-D hulls, compiled here meanwhile, once closure's kernels are (the two take about
-#: as long).
+#: ... the 3-D hulls (each of the two compiled in a process of its own on a cold cache, while
+#: this one compiles closure's: :func:`compile_ahead`), ...
 _HULL_KERNELS = (
     (hulls_faces, (F2, I1)),  # every planar surface's faces
     (hull_faces, (F2,)),
 )
+#: ... and those of grasps with more than :data:`L1_ENUMERATION_MAX` generators or
+#: :data:`SUMS_MAX` sums (the L1 hull minimum, the L-infinity sweep, ``support`` evidence),
+#: compiled here when a grasp first needs them.
+_LARGE_KERNELS = (
+    (support_rows, (F2, I1, INT, F2, BOOL)),
+    (planar_edges, (F2, I1)),
+    (linf_sweep, (F2, I1, INT, F2, INT, INT, F1, F2)),
+    (support_choices, (F2, I1, INT, F2)),
+    (vertex_sums, (F2, F2, I2)),
+    (face_planes, (F2, I2)),
+)
 #: Those kernel sets by name (:func:`compile_ahead`; :mod:`qualgrasp.certify._kernels.jit`).
-KERNEL_SETS = {"quality-planar": _PLANAR_KERNELS, "quality-hulls": _HULL_KERNELS, "quality-spatial": _SURFACE_KERNELS}
-#: The sets the epsilons of each dimension need: the first is compiled elsewhere on a cold cache,
-#: the others here.
+KERNEL_SETS = {"quality-planar": _PLANAR_KERNELS, "quality-hulls": _HULL_KERNELS, "quality-planar-large": _LARGE_KERNELS,
+               "quality-spatial": _SURFACE_KERNELS}
+#: The sets the epsilons of each dimension need.
 _SETS = {2: ("quality-planar", "quality-hulls"), 3: ("quality-spatial",)}
 
 
@@ -238,31 +242,32 @@ def _expired(deadline: float | None) -> bool:
 
 
 def compile_ahead(dims) -> None:
-    """Have another process compile quality's kernels for grasps of ``dims`` (2, 3) into the
-    compile cache when it lacks them, while this one certifies closure: on a cold cache two cores
-    compile at once (:func:`qualgrasp.certify._kernels.jit.compile_elsewhere`). A no-op on a warm
-    cache, and the results are the same either way.
+    """Have other processes compile quality's kernels for grasps of ``dims`` (2, 3) into the
+    compile cache when it lacks them, one per kernel set, while this one certifies closure: on a
+    cold cache the cores compile at once (:func:`qualgrasp.certify._kernels.jit.compile_elsewhere`).
+    A no-op on a warm cache, and the results are the same either way.
 
     Examples
     --------
     >>> compile_ahead([2])   # the cache holds them: nothing to do
     """
     for dim in sorted({int(d) for d in dims} & {2, 3}):
-        name = _SETS[dim][0]
-        if not compiled_here(KERNEL_SETS[name]):
-            compile_elsewhere(__name__, name)
+        for name in _SETS[dim]:
+            if not compiled_here(KERNEL_SETS[name]):
+                compile_elsewhere(__name__, name)
 
 
-def _after_compiling(deadline: float | None, dim: int) -> float | None:
-    """Compile the kernel sets of ``dim`` (:data:`KERNEL_SETS`): those no other process compiles
-    first, then the one :func:`compile_ahead` may have another process compiling, waiting for it;
-    and return ``deadline`` pushed back by the time that took: a time limit counts computation,
-    never compilation, so that a cold compile cache cannot change a result."""
-    names = _SETS[dim]
+def _after_compiling(deadline: float | None, dim: int, large: bool = False) -> float | None:
+    """Compile (or load) the kernel sets of ``dim`` (:data:`KERNEL_SETS`; with ``large``, planar
+    grasps' large set too), first waiting for another process compiling a set
+    (:func:`compile_ahead`), and return ``deadline`` pushed back by the time that took: a time
+    limit counts computation, never compilation, so that a cold compile cache cannot change a
+    result."""
+    names = _SETS[dim] + (("quality-planar-large",) if large and dim == 2 else ())
     if all(compiled_here(KERNEL_SETS[name]) for name in names):  # every call after a process's first
         return deadline
     start = time.perf_counter()
-    for name in names[1:] + names[:1]:
+    for name in names:
         if not compiled_here(KERNEL_SETS[name]):
             await_compiled(name)
             precompile(KERNEL_SETS[name])
@@ -324,6 +329,12 @@ def _hull_minimum(W, owner, m, faces):
     return float(h[j]), U[j]
 
 
+def _large(k: int, owner, m: int) -> bool:
+    """Whether a planar grasp of ``k`` generators (contacts ``owner``) needs the large kernel set:
+    more than :data:`L1_ENUMERATION_MAX` generators, or more than :data:`SUMS_MAX` sums."""
+    return k > L1_ENUMERATION_MAX or _sum_count(np.asarray(owner), m) > SUMS_MAX
+
+
 def _sum_count(owner, m: int) -> int:
     """Number of sums of one point per contact polytope (the origin or a generator)."""
     return math.prod(int(s) + 1 for s in np.bincount(owner, minlength=m))
@@ -366,7 +377,7 @@ def planar_epsilons(W, E, owner, m: int, *, deadline: float | None = None, exact
     dict
         ``{"L1": (lo, hi, direction, evidence, limited), "Linf": (...)}``.
     """
-    deadline = _after_compiling(deadline, 2)
+    deadline = _after_compiling(deadline, 2, _large(np.shape(W)[1], owner, m))
     W = np.ascontiguousarray(W, dtype=float)
     E = np.ascontiguousarray(E, dtype=float)
     owner = np.ascontiguousarray(owner, dtype=np.int64)
@@ -497,7 +508,7 @@ def planar_epsilon_columns(W, E, owner, m: int, *, time_limit: float | None = No
     l1, linf : EvidenceColumns
         The evidence of each norm.
     """
-    _after_compiling(None, 2)
+    _after_compiling(None, 2, _large(np.shape(W)[2], owner, m))
     W = np.ascontiguousarray(W, dtype=float)
     E = np.ascontiguousarray(E, dtype=float)
     owner = np.ascontiguousarray(owner, dtype=np.int64)

@@ -71,7 +71,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .._kernels.surface import cycle_code, face_bounds, leibniz_tables, planar_h_bounds
+from .._kernels.surface import cycle_code, face_bounds, face_bounds_laplace, leibniz_tables, planar_h_bounds
 from ..core.certificates import Check
 from ..core.grasp import Grasp
 from ..core.problem import grasp_system
@@ -313,7 +313,8 @@ def surface_minimum(V: np.ndarray, EV: np.ndarray, faces: np.ndarray, exact_vert
     """Check conditions (i) to (iii) of the module docstring for ``faces`` on the vertices whose
     float values ``V`` (nv, d) are within ``EV`` of the exact ones, and bound the smallest face
     distance ``D``: ``(reason or None, lo, hi)`` with ``lo <= D^2 <= hi``, ``hi <= (1 + tight)
-    lo``. Rigorous float bounds (:func:`qualgrasp.certify._kernels.surface.face_bounds`) decide
+    lo``. Rigorous float bounds (:func:`qualgrasp.certify._kernels.surface.face_bounds`, or
+    :func:`~qualgrasp.certify._kernels.surface.face_bounds_laplace` beyond 3-D) decide
     every face they can; ``exact_vertex(i)`` (exact coordinates of vertex ``i``) is asked only
     for the faces they leave undecided, or too loosely bounded to tell the minimum."""
     reason = cycle_check(faces, len(V))
@@ -321,8 +322,9 @@ def surface_minimum(V: np.ndarray, EV: np.ndarray, faces: np.ndarray, exact_vert
         return reason, Fraction(0), Fraction(0)
     d = V.shape[1]
     perms, signs = leibniz_tables(d - 1)
-    ok, lo, hi = face_bounds(np.ascontiguousarray(V, dtype=float), np.ascontiguousarray(EV, dtype=float),
-                             np.ascontiguousarray(faces, dtype=np.int64), perms, signs)
+    checks = face_bounds if d <= 3 else face_bounds_laplace  # the same bounds; shared minors in 6-D
+    ok, lo, hi = checks(np.ascontiguousarray(V, dtype=float), np.ascontiguousarray(EV, dtype=float),
+                        np.ascontiguousarray(faces, dtype=np.int64), perms, signs)
     exact: dict[int, Fraction] = {}  # faces settled exactly: their squared distance
     cache: dict[int, Any] = {}
 
