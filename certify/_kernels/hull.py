@@ -403,6 +403,25 @@ def _facet_plane(P, verts, centre, normal, work, x, col):
 
 
 @kernel
+def _residual(P, i, i0, Q, k, x):
+    """Into ``x``: ``P[i] - P[i0]`` less its projection on the first ``k`` rows of ``Q``
+    (orthonormal, Gram-Schmidt); returns its length."""
+    d = P.shape[1]
+    for r in range(d):
+        x[r] = P[i, r] - P[i0, r]
+    for j in range(k):
+        dot = 0.0
+        for r in range(d):
+            dot += Q[j, r] * x[r]
+        for r in range(d):
+            x[r] -= dot * Q[j, r]
+    h = 0.0
+    for r in range(d):
+        h += x[r] * x[r]
+    return np.sqrt(h)
+
+
+@kernel
 def _simplex(P, tol):
     """``d + 1`` affinely independent points of ``P`` (n, d), each the farthest from the affine
     hull of those before (Gram-Schmidt), starting from the least first coordinate; -1 in the
@@ -420,34 +439,12 @@ def _simplex(P, tol):
     for k in range(d):
         best, arg = -1.0, -1
         for i in range(n):
-            for r in range(d):
-                x[r] = P[i, r] - P[i0, r]
-            for j in range(k):
-                dot = 0.0
-                for r in range(d):
-                    dot += Q[j, r] * x[r]
-                for r in range(d):
-                    x[r] -= dot * Q[j, r]
-            h = 0.0
-            for r in range(d):
-                h += x[r] * x[r]
-            h = np.sqrt(h)
+            h = _residual(P, i, i0, Q, k, x)
             if h > best:
                 best, arg = h, i
         if not best > tol:
             return out
-        for r in range(d):
-            x[r] = P[arg, r] - P[i0, r]
-        for j in range(k):
-            dot = 0.0
-            for r in range(d):
-                dot += Q[j, r] * x[r]
-            for r in range(d):
-                x[r] -= dot * Q[j, r]
-        h = 0.0
-        for r in range(d):
-            h += x[r] * x[r]
-        h = np.sqrt(h)
+        h = _residual(P, arg, i0, Q, k, x)
         for r in range(d):
             Q[k, r] = x[r] / h
         chosen[k + 1] = arg
