@@ -124,14 +124,14 @@ def test_a_cold_cache_gets_a_kernel_set_compiled_by_another_process_once(tmp_pat
     from qualgrasp.certify._kernels.jit import await_compiled, cache_dir, compile_elsewhere
     from qualgrasp.certify.quality.bounds import KERNEL_SETS
 
-    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))  # the smallest set: the mechanism is the same
     folder = Path(cache_dir())
-    assert compile_elsewhere("qualgrasp.certify.quality.bounds", "quality-spatial")
-    await_compiled("quality-spatial")
-    assert (folder / "quality-spatial.compiled").exists()
-    for fn, _ in KERNEL_SETS["quality-spatial"]:  # each kernel's cache index, written there
+    assert compile_elsewhere("qualgrasp.certify.quality.bounds", "quality-hulls")
+    await_compiled("quality-hulls")
+    assert (folder / "quality-hulls.compiled").exists()
+    for fn, _ in KERNEL_SETS["quality-hulls"]:  # each kernel's cache index, written there
         assert any(folder.rglob(f"*.{fn.__name__}-*.nbi")), fn.__name__
-    assert not compile_elsewhere("qualgrasp.certify.quality.bounds", "quality-spatial")  # marked: not again
+    assert not compile_elsewhere("qualgrasp.certify.quality.bounds", "quality-hulls")  # marked: not again
 
 
 # Compile (or load) one kernel, then print how many kernels numba compiled and where the package is.
