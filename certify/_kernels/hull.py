@@ -104,6 +104,18 @@ def _start(P, tol):
 
 
 @kernel
+def _tolerance(P):
+    """:data:`PLANE_TOL` times the largest absolute coordinate of ``P``; NaN when one is not finite."""
+    s = 0.0
+    for i in range(P.shape[0]):
+        for r in range(P.shape[1]):
+            if not abs(P[i, r]) <= 1e300:
+                return np.nan
+            s = max(s, abs(P[i, r]))
+    return PLANE_TOL * s
+
+
+@kernel
 def hull_faces(P):
     """Faces (F, 3) of the convex hull of ``P`` (n, 3), triangulated, each ordered so that its
     float determinant ``det(v_1, v_2, v_3)`` is not negative (outward about an interior origin,
@@ -116,15 +128,10 @@ def hull_faces(P):
     """
     n = P.shape[0]
     empty = np.zeros((0, 3), dtype=np.int64)
-    if n < 4:
+    tol = _tolerance(P)
+    if n < 4 or not tol >= 0.0:  # too few points, or one not finite
         return empty
-    s = 0.0
-    for i in range(n):
-        for r in range(3):
-            if not abs(P[i, r]) <= 1e300:  # NaN or infinite
-                return empty
-            s = max(s, abs(P[i, r]))
-    tol = PLANE_TOL * s
+    s = tol / PLANE_TOL  # the largest absolute coordinate (exact: PLANE_TOL is a power of 2)
     first = _start(P, tol)
     if first[0] < 0:
         return empty
@@ -467,18 +474,6 @@ def _compact(verts, normal, off, alive, F):
     for f in range(w, F):
         alive[f] = False
     return w
-
-
-@kernel
-def _tolerance(P):
-    """:data:`PLANE_TOL` times the largest absolute coordinate of ``P``; NaN when one is not finite."""
-    s = 0.0
-    for i in range(P.shape[0]):
-        for r in range(P.shape[1]):
-            if not abs(P[i, r]) <= 1e300:
-                return np.nan
-            s = max(s, abs(P[i, r]))
-    return PLANE_TOL * s
 
 
 @kernel
