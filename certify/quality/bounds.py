@@ -86,6 +86,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import ConvexHull, QhullError
 
+from .._kernels.conic import support_points
 from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .._kernels.epsilon import planar_epsilon as epsilon_kernel
 from .._kernels.evidence import minkowski_sums, support_choices, surface_rows, vertex_sums
@@ -134,8 +135,10 @@ _ADD = 2
 #: The kernels checking planar surfaces, with the argument types the epsilons call them with:
 #: compiled before the time limit's clock runs (:func:`_after_compiling`).
 _CHECK_KERNELS = ((face_bounds, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)))
-#: The kernels the epsilon of spatial grasps calls: the checks of 6-D faces and the 6-D hulls.
+#: The kernels the epsilon of spatial grasps calls: the support points, the checks of 6-D faces
+#: and the 6-D hulls.
 _SURFACE_KERNELS = (
+    (support_points, (F2, F2, F2, F2, I1, I1, BOOL, B1, I1, I2, I1, F2, F2, F1, F1, F1, F1)),
     (face_bounds_laplace, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)), (planes_start, (F2,)),
     (planes_insert, (F2, INT, I2, F2, F1, B1, INT, F1)), (live_planes, (F2, F1, B1, INT)), (hull_facets, (F2,)))
 #: The same for planar grasps, in three sets: these, ...

@@ -39,7 +39,9 @@ Vertices, by the evidence ``kind``:
     (:func:`~qualgrasp.certify.quality.gws.surface_faces`) and then checks that triangulation (see below).
 ``support`` (spatial)
     ``points`` holds one direction ``v`` (6 floats) per vertex; the vertex is the support point
-    of the GWS along ``v`` computed by :meth:`~qualgrasp.certify.quality.gws.ConicSupport.forces`, the contact forces (and
+    of the GWS along ``v`` computed by :meth:`~qualgrasp.certify.quality.gws.ConicSupport.vertices` (compiled, a
+    fixed sequence of float operations that uses no BLAS, so that it gives the same bits on every
+    machine), the contact forces (and
     moments) that maximise ``v . w`` with unit normal force, pulled inside the cone by the
     factor :data:`~qualgrasp.certify.quality.gws.SHRINK` and proved inside it exactly, then scaled towards the origin by the
     factor :func:`~qualgrasp.certify.quality.gws.vertex_scale` of the vertex's position (in ``[1 - 2^-14, 1]``: the GWS is
@@ -418,19 +420,16 @@ def spatial_vertex_arrays(sup: ConicSupport, ev: Evidence, norm: str):
     if N <= d:
         return "too few vertices"
     P = np.array(ev.points, dtype=float).reshape(N, d)
-    V, EV, parts = np.empty((N, d)), np.empty((N, d)), []
-    for i in range(N):
-        ref = None
-        if norm == "L1":
-            ref = ev.ref[i]
-            if not 0 <= ref < len(sup.blocks):
-                return f"vertex {i} names no contact"
-        out = sup.vertex(P[i], norm, i, ref)
-        if out is None:
-            return f"vertex {i}: a support force is not inside its cone"
-        V[i], EV[i], x = out
-        parts.append(x)
-    return V, EV, parts
+    ref = None
+    if norm == "L1":
+        ref = np.array(ev.ref, dtype=np.int64)
+        bad = np.flatnonzero((ref < 0) | (ref >= len(sup.blocks)))
+        if len(bad):
+            return f"vertex {bad[0]} names no contact"
+    V, EV, X, ok = sup.vertices(P, norm, np.arange(N), ref)
+    if not ok.all():
+        return f"vertex {np.flatnonzero(~ok)[0]}: a support force is not inside its cone"
+    return V, EV, list(X)
 
 
 def _planar_h2(Cx, owner: np.ndarray, m: int, u: Sequence[float], norm: str) -> Fraction | None:

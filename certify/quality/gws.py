@@ -26,6 +26,7 @@ import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
 from .. import models as registry
+from .._kernels.conic import SHRINK, support_points
 from .._kernels.evidence import support_choices, vertex_sums
 from .._kernels.hull import hull_facets, hull_faces, hulls_faces
 from .._kernels.jit import kernel_array
@@ -41,8 +42,6 @@ __all__ = ["SHRINK", "surface_faces", "surfaces_faces", "hull_rows", "orient_fac
            "planar_support_vertices",
            "sum_rows", "sqrt_bounds", "vertex_scale", "ConicSupport"]
 
-#: Support forces are pulled this far inside their cones (tangential part times ``SHRINK``).
-SHRINK = 1.0 - 2.0**-30
 
 # --- surfaces ------------------------------------------------------------------------------------
 
@@ -258,36 +257,34 @@ class ConicSupport:
     def __init__(self, grasp: Grasp) -> None:
         system = grasp_system(grasp, socp=True)
         self.grasp = grasp
-        self.C = np.asarray(system.columns, dtype=float)
+        self.C = np.ascontiguousarray(system.columns, dtype=float)
         self.absC = np.abs(self.C)
         self.blocks = system.blocks
         self._Cx = None
         P, N, mu, params, c, L = grasp_arrays(grasp)
         models = tuple(ct.model for ct in grasp.contacts)
-        self.errors = force_column_errors(P[None], N[None], models, c[None], np.array([L]))[0]
+        self.errors = np.ascontiguousarray(force_column_errors(P[None], N[None], models, c[None], np.array([L]))[0])
         self.data = []
-        ray, lor = [], []
+        nb = len(self.blocks)
+        self.ray, self.col0, self.m_col = np.zeros(nb, dtype=bool), np.zeros(nb, np.int64), np.full(nb, -1, np.int64)
+        self.f_col = np.zeros((nb, 3), dtype=np.int64)
+        self.n, self.nh = np.zeros((nb, 3)), np.zeros((nb, 3))
+        self.nn, self.mu, self.g, self.gr = np.zeros(nb), np.zeros(nb), np.zeros(nb), np.zeros(nb)
         for i, b in enumerate(self.blocks):
             cols = np.array(b.cols)
+            self.col0[i] = cols[0]
             if b.cone == "ray":
                 self.data.append((cols, None, None, 0.0, 0.0, 0.0))
-                ray.append(i)
+                self.ray[i] = True
+                self.f_col[i] = cols[0]
                 continue
             n = np.asarray(b.n, dtype=float)
             rn = math.sqrt(float(n @ n))
             self.data.append((cols, n, n / rn, float(b.mu), float(b.g), rn))
-            lor.append(i)
-        self.ray = np.array(ray, dtype=np.int64)
-        self.ray_col = np.array([self.data[i][0][0] for i in ray], dtype=np.int64)
-        self.lor = np.array(lor, dtype=np.int64)
-        self.f_col = np.array([self.data[i][0][:3] for i in lor], dtype=np.int64).reshape(-1, 3)
-        self.m_col = np.array([self.data[i][0][3] if len(self.data[i][0]) > 3 else -1 for i in lor],
-                              dtype=np.int64)
-        self.n = np.array([self.data[i][1] for i in lor]).reshape(-1, 3)
-        self.nh = np.array([self.data[i][2] for i in lor]).reshape(-1, 3)
-        self.mu = np.array([self.data[i][3] for i in lor])
-        self.g = np.array([self.data[i][4] for i in lor])
-        self.gr = np.array([self.data[i][4] / self.data[i][5] for i in lor])
+            self.f_col[i] = cols[:3]
+            if len(cols) > 3:
+                self.m_col[i] = cols[3]
+            self.n[i], self.nh[i], self.mu[i], self.g[i], self.gr[i] = n, n / rn, float(b.mu), float(b.g), float(b.g) / rn
         self.nn = np.einsum("bi,bi->b", self.n, self.n)
 
     @property
@@ -296,30 +293,6 @@ class ConicSupport:
         if self._Cx is None:
             self._Cx = grasp_system(self.grasp, socp=True, exact=True).columns
         return self._Cx
-
-    def forces(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Each block's support value ``c_b(v)`` (the largest ``v . w`` over its wrenches with
-        unit normal force) and the values on every column (forces, moments) reaching them,
-        pulled inside by :data:`SHRINK`: ``f = n/|n| + SHRINK mu z_t / |z|``, ``m = (g / |n|)
-        SHRINK mu z_m / |z|`` with ``z = (a_t, a_m g / |n|)``, ``a`` the functional ``C_b' v``; a
-        ray's value is 1. A fixed float formula, so producer and checker compute the same."""
-        a = self.C.T @ v
-        c = np.empty(len(self.blocks))
-        X = np.zeros(self.C.shape[1])
-        c[self.ray] = a[self.ray_col]
-        X[self.ray_col] = 1.0
-        if len(self.lor):
-            af = a[self.f_col]
-            an = np.einsum("bi,bi->b", af, self.nh)
-            at = af - an[:, None] * self.nh
-            am = np.where(self.m_col >= 0, a[self.m_col] * self.gr, 0.0)
-            nz = np.sqrt(np.einsum("bi,bi->b", at, at) + am * am)
-            c[self.lor] = an + self.mu * nz
-            k = np.divide(SHRINK * self.mu, nz, out=np.zeros_like(nz), where=nz > 0)
-            X[self.f_col] = self.nh + k[:, None] * at
-            has_m = self.m_col >= 0
-            X[self.m_col[has_m]] = (k * am * self.gr)[has_m]
-        return c, X
 
     def inside(self, b: int, x: np.ndarray) -> bool:
         """Is the block value ``x`` strictly inside block ``b``'s cone? Exact
@@ -330,49 +303,33 @@ class ConicSupport:
         blk = self.blocks[b]
         return cones.inside(blk.cone, list(to_exact(x)), list(to_exact(n)), Fraction(mu), Fraction(g))
 
-    def _inside_all(self, X: np.ndarray, use: np.ndarray) -> bool:
-        """Every used block's values strictly inside its cone: a float test with a rigorous
-        margin (the rounding of ``|n|^2 |f|^2 - (f . n)^2 + (m |n|^2 / g)^2`` is far below
-        ``1e-14`` of its terms), then the exact test for the blocks it leaves open."""
-        sel = np.zeros(len(self.blocks), dtype=bool)
-        sel[use] = True
-        if not (X[self.ray_col[sel[self.ray]]] > 0).all():
-            return False
-        on = sel[self.lor]
-        f = X[self.f_col[on]]
-        fn = np.einsum("bi,bi->b", f, self.n[on])
-        ff = np.einsum("bi,bi->b", f, f)
-        nn = self.nn[on]
-        mcol = self.m_col[on]
-        extra = np.where(mcol >= 0, (X[mcol] * nn / np.where(self.g[on] > 0, self.g[on], 1.0)) ** 2, 0.0)
-        tang = nn * ff - fn * fn + extra
-        mu2 = self.mu[on] ** 2 * fn * fn
-        err = 1e-14 * (nn * ff + fn * fn + extra + mu2)
-        good = (fn > 0) & (tang + err < mu2 - err)
-        for b in self.lor[on][~good]:
-            if not self.inside(int(b), X[self.data[b][0]]):
-                return False
-        return True
+    def vertices(self, P: np.ndarray, norm: str, index: np.ndarray, ref: np.ndarray | None = None):
+        """Vertices ``index`` of ``support`` evidence along the rows of ``P`` (n, d): the support
+        points scaled by :func:`vertex_scale`, as ``(W, EW, X, ok)``: float wrenches (n, d),
+        bounds on their distance to the exact ones, the values on every column (0 off the blocks
+        they sum) and whether every value was proved inside its cone (a float test with a rigorous
+        margin, :func:`~qualgrasp.certify._kernels.conic.support_points`, then the exact test for
+        the values it leaves open). Each block's value along ``v``: ``f = n/|n| + SHRINK mu z_t /
+        |z|``, ``m = (g / |n|) SHRINK mu z_m / |z|`` with ``z = (a_t, a_m g / |n|)``, ``a`` the
+        functional ``C' v``; a ray's value is 1; a fixed float formula, so producer and checker
+        compute the same. ``ref`` (L1): the contact to use for each row (-1, the default: the one
+        with the largest support value)."""
+        P = kernel_array(np.atleast_2d(P))
+        index = kernel_array(index, np.int64)
+        ref = np.full(len(P), -1, np.int64) if ref is None else kernel_array(ref, np.int64)
+        W, EW, X, used, open_, ok = support_points(
+            self.C, self.errors, self.absC, P, index, ref, norm == "L1", self.ray, self.col0, self.f_col,
+            self.m_col, self.n, self.nh, self.nn, self.mu, self.g, self.gr)
+        for q, b in zip(*np.nonzero(open_ & ok[:, None])):
+            if ok[q] and not self.inside(int(b), X[q, self.data[b][0]]):
+                ok[q] = False
+        return W, EW, X, ok
 
     def vertex(self, v: np.ndarray, norm: str, index: int, ref: int | None = None):
-        """Vertex ``index`` of ``support`` evidence: the support point along ``v`` scaled by
-        :func:`vertex_scale`, as ``(w, err, x)``: float wrench, bound on its distance to the
-        exact one, and the values on every column (0 off the blocks it sums); None when a value
-        could not be proved inside its cone. ``ref`` (L1): the contact to use (default: the one
-        with the largest term)."""
-        c, X = self.forces(v)
-        if norm == "L1":
-            use = np.array([int(np.argmax(c)) if ref is None else ref])
-        else:
-            use = np.flatnonzero(c > 0)
-        keep = np.zeros(self.C.shape[1], dtype=bool)
-        for b in use:
-            keep[self.data[b][0]] = True
-        x = np.where(keep, X * vertex_scale(index), 0.0)
-        if not self._inside_all(x, use):
-            return None
-        ax = np.abs(x)
-        return self.C @ x, sum_errors(self.errors @ ax, self.absC @ ax, int(keep.sum())), x
+        """Vertex ``index`` of ``support`` evidence along ``v`` (:meth:`vertices`) as ``(w, err,
+        x)``, or None when a value could not be proved inside its cone."""
+        W, EW, X, ok = self.vertices(v, norm, np.array([index]), None if ref is None else np.array([ref]))
+        return (W[0], EW[0], X[0]) if ok[0] else None
 
     def exact_vertex(self, x: np.ndarray) -> list[Fraction]:
         """The exact wrench of the column values ``x``."""
