@@ -11,8 +11,9 @@ from hypothesis import strategies as st
 from scipy.spatial import ConvexHull
 
 from qualgrasp.certify._kernels.hull import PLANE_TOL, hull_faces, hulls_faces
-from qualgrasp.certify._kernels.surface import cycle_code
+from qualgrasp.certify._kernels.surface import cycle_code, orient_cycle
 from qualgrasp.certify.quality.evidence import Evidence
+from qualgrasp.certify.quality.gws import orient_faces, surfaces_faces
 
 
 def _canonical(faces):
@@ -241,3 +242,31 @@ def test_six_dimensional_face_bounds_hold_the_exact_distance():
             if not EV.any():
                 widths.append((hi[0] - lo[0]) / hi[0])
     assert widths and max(widths) < 1e-8
+
+
+@pytest.mark.parametrize("d", [3, 6])
+def test_orientation_propagates_across_ridges_from_the_surest_face(d):
+    """qhull's simplices of random points about the origin, each turned over at random: the
+    propagated orientation closes the cycle and agrees with every determinant's sign; a face
+    whose sign is forced wrong (a sliver whose rounding flipped) is put right by its neighbours;
+    faces that are not a closed surface keep their own signs and are reported open."""
+    rng = np.random.default_rng(d)
+    for _ in range(5):
+        P = rng.normal(size=(3 * d + 8, d))
+        faces = np.array(ConvexHull(P).simplices, dtype=np.int64)
+        turn = rng.random(len(faces)) < 0.5
+        faces[turn, 0], faces[turn, 1] = faces[turn, 1], faces[turn, 0].copy()
+        oriented = orient_faces(P, faces)
+        assert cycle_code(oriented, len(P)) == 0
+        assert (np.linalg.det(P[oriented]) > 0).all()
+        sliver = int(np.argmin(np.abs(np.linalg.det(P[faces]))))
+        wrong = np.linalg.det(P[faces]) < 0
+        wrong[sliver] = not wrong[sliver]
+        seed = int(np.argmax(np.abs(np.linalg.det(P[faces]))))
+        flip, reached = orient_cycle(faces, len(P), seed, bool(wrong[seed]))
+        assert reached.all() and flip[sliver] != wrong[sliver] and (flip == (np.linalg.det(P[faces]) < 0)).all()
+        open_ = faces[1:]
+        flip, reached = orient_cycle(open_, len(P), 0, False)
+        assert not reached.any()
+        assert (np.linalg.det(P[orient_faces(P, open_)]) >= 0).all()
+        assert cycle_code(surfaces_faces([P])[0], len(P)) == 0

@@ -21,7 +21,7 @@ from .jit import kernel
 from .linalg import U, gamma
 from .order import stable_argsort
 
-__all__ = ["face_bounds", "face_bounds_laplace", "leibniz_tables", "planar_h_bounds", "cycle_code"]
+__all__ = ["face_bounds", "face_bounds_laplace", "leibniz_tables", "planar_h_bounds", "cycle_code", "orient_cycle"]
 
 
 @functools.lru_cache(maxsize=None)
@@ -216,15 +216,12 @@ def planar_h_bounds(W, EW, owner, m, u, linf):
 
 
 @kernel
-def cycle_code(faces, nv):
-    """Whether ``faces`` (F, d) on ``nv`` vertices form a closed oriented cycle: 0 yes; 1 an
-    index out of range; 2 a face repeating a vertex; 3 a ridge not in exactly two faces; 4 two
-    faces sharing a ridge with the same orientation. Ridges (a face without its ``k``-th
-    vertex, sign ``(-1)^k`` times the parity of sorting the rest) are encoded as integers in
-    base ``nv`` (the caller keeps ``nv^(d-1)`` below ``2^62``)."""
+def _ridge_keys(faces, nv, keys, sgn):
+    """Into ``keys`` and ``sgn`` (F * d): each ridge of ``faces`` (face ``f`` without its ``k``-th
+    vertex, at ``f * d + k``) as an integer in base ``nv`` of its sorted vertices, and its sign,
+    ``(-1)^k`` times the parity of sorting them. Returns 0, or 1 for an index out of range, 2 for a
+    face repeating a vertex."""
     F, d = faces.shape
-    keys = np.empty(F * d, dtype=np.int64)
-    sgn = np.empty(F * d, dtype=np.int64)
     r = np.empty(d - 1, dtype=np.int64)
     for f in range(F):
         for q in range(d):
@@ -253,16 +250,79 @@ def cycle_code(faces, nv):
             keys[f * d + k] = key
             s = 1 if k % 2 == 0 else -1
             sgn[f * d + k] = s if parity % 2 == 0 else -s
+    return 0
+
+
+@kernel
+def _paired(keys):
+    """The ridges sorted by key, or an empty array when a ridge is not in exactly two faces."""
     order = stable_argsort(keys)
-    n = F * d
+    n = keys.shape[0]
     if n % 2:
-        return 3
+        return order[:0]
     for i in range(0, n, 2):
         a, b = order[i], order[i + 1]
-        if keys[a] != keys[b]:
-            return 3
-        if i + 2 < n and keys[order[i + 2]] == keys[a]:
-            return 3
-        if sgn[a] + sgn[b] != 0:
+        if keys[a] != keys[b] or (i + 2 < n and keys[order[i + 2]] == keys[a]):
+            return order[:0]
+    return order
+
+
+@kernel
+def cycle_code(faces, nv):
+    """Whether ``faces`` (F, d) on ``nv`` vertices form a closed oriented cycle: 0 yes; 1 an
+    index out of range; 2 a face repeating a vertex; 3 a ridge not in exactly two faces; 4 two
+    faces sharing a ridge with the same orientation. Ridges (a face without its ``k``-th
+    vertex, sign ``(-1)^k`` times the parity of sorting the rest) are encoded as integers in
+    base ``nv`` (the caller keeps ``nv^(d-1)`` below ``2^62``)."""
+    F, d = faces.shape
+    keys = np.empty(F * d, dtype=np.int64)
+    sgn = np.empty(F * d, dtype=np.int64)
+    code = _ridge_keys(faces, nv, keys, sgn)
+    if code:
+        return code
+    order = _paired(keys)
+    if order.shape[0] < F * d:
+        return 3
+    for i in range(0, F * d, 2):
+        if sgn[order[i]] + sgn[order[i + 1]] != 0:
             return 4
     return 0
+
+
+@kernel
+def orient_cycle(faces, nv, seed, flip_seed):
+    """Which faces of a closed surface to turn over (swap two vertices of) so that every two
+    faces sharing a ridge are oppositely oriented (:func:`cycle_code`), the face ``seed`` turned
+    over when ``flip_seed``: propagated from it across the ridges, so the orientation is decided
+    once, not by a sign of each face. Returns ``(flip, reached)``; nothing is reached when the
+    faces are not a closed surface on ``nv`` vertices."""
+    F, d = faces.shape
+    flip = np.zeros(F, dtype=np.bool_)
+    reached = np.zeros(F, dtype=np.bool_)
+    keys = np.empty(F * d, dtype=np.int64)
+    sgn = np.empty(F * d, dtype=np.int64)
+    if F == 0 or _ridge_keys(faces, nv, keys, sgn):
+        return flip, reached
+    order = _paired(keys)
+    if order.shape[0] < F * d:
+        return flip, reached
+    partner = np.empty(F * d, dtype=np.int64)
+    for i in range(0, F * d, 2):
+        partner[order[i]], partner[order[i + 1]] = order[i + 1], order[i]
+    stack = np.empty(F, dtype=np.int64)
+    stack[0], top = seed, 1
+    flip[seed], reached[seed] = flip_seed, True
+    while top:
+        top -= 1
+        f = stack[top]
+        for k in range(d):
+            a = f * d + k
+            b = partner[a]
+            g = b // d
+            if not reached[g]:
+                # opposite induced signs after turning: turned faces negate every ridge's sign
+                flip[g] = flip[f] != (sgn[a] == sgn[b])
+                reached[g] = True
+                stack[top] = g
+                top += 1
+    return flip, reached

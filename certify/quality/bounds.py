@@ -95,7 +95,7 @@ from .._kernels.hull import (face_planes, hull_faces, hull_facets, hulls_faces, 
 from .._kernels.jit import (B1, BOOL, F1, F2, F3, FLOAT, I1, I2, INT, await_compiled, compile_elsewhere, compiled_here,
                            kernel_array, mark_compiled, precompile)
 from .._kernels.planar import planar_generators
-from .._kernels.surface import cycle_code, face_bounds, face_bounds_laplace, leibniz_tables
+from .._kernels.surface import cycle_code, face_bounds, face_bounds_laplace, leibniz_tables, orient_cycle
 from ..core.arguments import count_in, number_in, require
 from ..errors import ArgumentError
 from ..core.closure import Verdict, force_closure
@@ -140,7 +140,8 @@ _CHECK_KERNELS = ((face_bounds, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)))
 _SURFACE_KERNELS = (
     (support_points, (F2, F2, F2, F2, I1, I1, BOOL, B1, I1, I2, I1, F2, F2, F1, F1, F1, F1)),
     (face_bounds_laplace, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)), (planes_start, (F2,)),
-    (planes_insert, (F2, INT, I2, F2, F1, B1, INT, F1)), (live_planes, (F2, F1, B1, INT)), (hull_facets, (F2,)))
+    (planes_insert, (F2, INT, I2, F2, F1, B1, INT, F1)), (live_planes, (F2, F1, B1, INT)), (hull_facets, (F2,)),
+    (orient_cycle, (I2, INT, INT, BOOL)))
 #: The same for planar grasps, in three sets: these, ...
 _PLANAR_KERNELS = _CHECK_KERNELS + (
     (planar_generators, (F2, F2, F1, F1, F1, FLOAT, I1, F1, F1, F2, F2)),
@@ -153,6 +154,7 @@ _PLANAR_KERNELS = _CHECK_KERNELS + (
 _HULL_KERNELS = (
     (hulls_faces, (F2, I1)),  # every planar surface's faces
     (hull_faces, (F2,)),
+    (orient_cycle, (I2, INT, INT, BOOL)),  # the faces of qhull's, where those decline
 )
 #: ... and those of grasps with more than :data:`L1_ENUMERATION_MAX` generators or
 #: :data:`SUMS_MAX` sums (the L1 hull minimum, the L-infinity sweep, ``support`` evidence),

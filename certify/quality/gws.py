@@ -31,6 +31,7 @@ from .._kernels.evidence import support_choices, vertex_sums
 from .._kernels.hull import hull_facets, hull_faces, hulls_faces
 from .._kernels.jit import kernel_array
 from .._kernels.planar import planar_generators
+from .._kernels.surface import orient_cycle
 from ..core import cones
 from ..core.grasp import Grasp
 from ..core.problem import grasp_system
@@ -51,7 +52,7 @@ def surface_faces(points: np.ndarray) -> np.ndarray | None:
     points span no full-dimensional hull. Compiled hulls give them, qhull where those decline: in
     3-D (planar grasps) :func:`~qualgrasp.certify._kernels.hull.hull_faces`, in other dimensions
     (6-D, spatial grasps) the facets of :func:`~qualgrasp.certify._kernels.hull.hull_facets`,
-    simplices, ordered by :func:`orient_faces`."""
+    simplices, ordered by :func:`orient_faces` (qhull's where they do not close up)."""
     if np.shape(points)[1:] == (3,):  # one set: without the batch's bookkeeping
         faces = hull_faces(kernel_array(points))
         if len(faces):
@@ -71,7 +72,8 @@ def surfaces_faces(point_sets) -> list[np.ndarray | None]:
     for pts in point_sets:
         pts = kernel_array(pts)
         facets = hull_facets(pts) if pts.ndim == 2 and pts.shape[1] > 3 else np.zeros((0, 0), dtype=np.int64)
-        out.append(orient_faces(pts, facets) if len(facets) else _qhull_faces([pts])[0])
+        faces, closed = _oriented(pts, facets) if len(facets) else (None, False)
+        out.append(faces if closed else _qhull_faces([pts])[0])  # qhull too where rounding broke the surface
     return out
 
 
@@ -125,12 +127,26 @@ def _qhull_faces(point_sets) -> list[np.ndarray | None]:
 
 
 def orient_faces(points: np.ndarray, simplices: np.ndarray) -> np.ndarray:
-    """``simplices`` with the first two vertices swapped where the float determinant of the
-    vertices is negative."""
+    """``simplices`` with the first two vertices swapped where needed so that their float
+    determinants are not negative: the face with the largest determinant by its sign, the others
+    by propagation across shared ridges (:func:`~qualgrasp.certify._kernels.surface.orient_cycle`),
+    so that a sliver face, whose determinant's sign rounding can flip, still closes the cycle (its
+    own sign is then the exact check's to settle); each face by its own sign where the simplices
+    are not a closed surface."""
+    return _oriented(points, simplices)[0]
+
+
+def _oriented(points: np.ndarray, simplices: np.ndarray) -> tuple[np.ndarray, bool]:
+    """:func:`orient_faces` and whether the simplices form a closed surface."""
     faces = np.array(simplices, dtype=np.int64)
-    flip = np.linalg.det(points[faces]) < 0
+    det = np.linalg.det(points[faces])
+    flip, closed = det < 0, False
+    if len(faces) and (faces.shape[1] - 1) * math.log2(max(len(points), 2)) < 62:  # ridge keys fit int64
+        seed = int(np.argmax(np.abs(det)))
+        turn, reached = orient_cycle(kernel_array(faces, np.int64), len(points), seed, bool(flip[seed]))
+        flip, closed = np.where(reached, turn, flip), bool(reached.all())
     faces[flip, 0], faces[flip, 1] = faces[flip, 1], faces[flip, 0].copy()
-    return faces
+    return faces, closed
 
 
 def generalised_cross(simplices: np.ndarray) -> np.ndarray:
