@@ -23,7 +23,7 @@ from .jit import kernel
 from .order import stable_argsort
 
 __all__ = ["PLANE_TOL", "hull_faces", "hulls_faces", "face_planes", "used_vertices", "hull_planes", "planes_start",
-           "planes_insert", "live_planes", "hull_facets"]
+           "planes_insert", "live_planes", "weakest_plane", "hull_facets"]
 
 #: Relative distance below which a point counts as on a face's plane (times the set's largest
 #: absolute coordinate).
@@ -578,6 +578,22 @@ def live_planes(normal, off, alive, F):
             dist[w] = off[f]
             w += 1
     return normals, dist
+
+
+@kernel
+def weakest_plane(normal, off, alive, F):
+    """The live facet with the least offset (the first in facet order on ties): its unit outward
+    normal (d,) and offset, as the smallest of :func:`live_planes` without building them all."""
+    best = -1
+    for f in range(F):
+        if alive[f] and (best < 0 or off[f] < off[best]):
+            best = f
+    u = np.empty(normal.shape[1])
+    if best < 0:
+        return u, np.nan
+    for r in range(normal.shape[1]):
+        u[r] = normal[best, r]
+    return u, off[best]
 
 
 @kernel

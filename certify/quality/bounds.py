@@ -37,7 +37,7 @@ Planar grasps: every contact model is polyhedral in the plane, so epsilon is exa
   ``lo = hi``); beyond that the hull of support points of the GWS (each the sum of every contact's
   generator furthest along a direction), refined along the normals of its faces nearest the
   origin until it proves ``hi`` (each cut adds a vertex of the GWS beyond the face, so this
-  ends), stored as its directions. If that does not succeed within ``4 MAX_VERTICES`` vertices
+  ends), stored as its directions. If that does not succeed within 640 vertices
   or the time limit, the L1 GWS, which lies inside the L-infinity one, proves the L1 epsilon
   (``lo < hi``, honestly reported).
 
@@ -49,7 +49,7 @@ GWS (the contact wrenches maximising ``u . w``, pulled inside their cones and pr
 exactly, scaled by at most ``2^-14`` towards the origin to put them in general position), starting
 from the 12 coordinate directions (while the points lie in a hyperplane, adding those along its
 normal both ways, then along more fixed starting directions), then adding the support points along
-the normals of its weakest faces, which pushes those faces out, until ``hi - lo <= rel_gap * hi``,
+the normal of its weakest face, which pushes that face out, until ``hi - lo <= rel_gap * hi``,
 the polytope has ``MAX_VERTICES`` vertices or the work ``budget`` is spent. Each round costs
 ``O(m)`` per direction examined plus a hull of at most ``MAX_VERTICES`` points, whatever ``m``.
 
@@ -90,8 +90,8 @@ from .._kernels.conic import support_points
 from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .._kernels.epsilon import planar_epsilon as epsilon_kernel
 from .._kernels.evidence import minkowski_sums, support_choices, surface_rows, vertex_sums
-from .._kernels.hull import (face_planes, hull_faces, hull_facets, hulls_faces, live_planes, planes_insert,
-                             planes_start, used_vertices)
+from .._kernels.hull import (face_planes, hull_faces, hull_facets, hulls_faces, planes_insert, planes_start,
+                             used_vertices, weakest_plane)
 from .._kernels.jit import (B1, BOOL, F1, F2, F3, FLOAT, I1, I2, INT, await_compiled, compile_elsewhere, compiled_here,
                            kernel_array, mark_compiled, precompile)
 from .._kernels.planar import planar_generators
@@ -123,14 +123,17 @@ LINF_ENUMERATION_MAX = 24
 #: most this many sums (the product over contacts of generators + 1), else the L1 surface.
 SUMS_MAX = 4096
 #: Spatial: most vertices of the inscribed polytope (bounds its hull and its evidence).
-MAX_VERTICES = 160
+MAX_VERTICES = 1280
+#: Planar L-infinity: most directions of ``support`` evidence.
+_PLANAR_DIRECTIONS = 640
 #: Work of one local minimisation step (an SOCP) in units of directions examined, for the budget.
 SOCP_COST = 25
 #: Candidate directions kept by the L-infinity sweep for the direct evaluation of ``h``.
 _TOP = 16
 #: Circles swept between two looks at the clock.
 _SWEEP_BATCH = 64
-#: Weakest faces whose normals are added per round of the spatial refinement.
+#: The planar support refinement adds the normals of twice this many weakest faces per round (the
+#: spatial one, that of its weakest face: more per round cost more hull than they save rounds).
 _ADD = 2
 #: The kernels checking planar surfaces, with the argument types the epsilons call them with:
 #: compiled before the time limit's clock runs (:func:`_after_compiling`).
@@ -140,7 +143,7 @@ _CHECK_KERNELS = ((face_bounds, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)))
 _SURFACE_KERNELS = (
     (support_points, (F2, F2, F2, F2, I1, I1, BOOL, B1, I1, I2, I1, F2, F2, F1, F1, F1, F1)),
     (face_bounds_laplace, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)), (planes_start, (F2,)),
-    (planes_insert, (F2, INT, I2, F2, F1, B1, INT, F1)), (live_planes, (F2, F1, B1, INT)), (hull_facets, (F2,)),
+    (planes_insert, (F2, INT, I2, F2, F1, B1, INT, F1)), (weakest_plane, (F2, F1, B1, INT)), (hull_facets, (F2,)),
     (orient_cycle, (I2, INT, INT, BOOL)))
 #: The same for planar grasps, in three sets: these, ...
 _PLANAR_KERNELS = _CHECK_KERNELS + (
@@ -729,8 +732,8 @@ def _support_vertex(R, gens):
 def _support_surface(W, E, owner, m, eps, u, deadline):
     """The vertices of ``support`` evidence: the hull of support points along the coordinate
     directions and ``u``, refined along the normals of its faces nearest the origin (each cut
-    adds a vertex of the GWS beyond the face) until the hull reaches ``eps`` or ``4
-    MAX_VERTICES`` directions are used, or the ``deadline`` passes. Returns ``((directions,
+    adds a vertex of the GWS beyond the face) until the hull reaches ``eps`` or
+    :data:`_PLANAR_DIRECTIONS` directions are used, or the ``deadline`` passes. Returns ``((directions,
     vertices, their error bounds, generator choices) or None when the points span no hull,
     limited)``."""
     dirs = [np.array(v, dtype=float) for v in np.vstack([np.eye(3), -np.eye(3), u[None]])]
@@ -758,7 +761,7 @@ def _support_surface(W, E, owner, m, eps, u, deadline):
             return None, limited
         done = len(dirs)
         normal, dist = face_planes(pts, faces)
-        if dist.min() >= eps * (1 - EPS_TOL / 16) or len(dirs) >= 4 * MAX_VERTICES:
+        if dist.min() >= eps * (1 - EPS_TOL / 16) or len(dirs) >= _PLANAR_DIRECTIONS:
             break
         if _expired(deadline):
             limited = True
@@ -1018,9 +1021,10 @@ class _Guide:
         self.state = None
         self.done = 0
 
-    def planes(self, V: np.ndarray):
-        """Unit outward normals (F, d) and offsets (F,) of the facets of the hull of ``V`` (the
-        points of the last call and new ones after them), or None when ``V`` spans no hull."""
+    def weakest(self, V: np.ndarray):
+        """The unit outward normal (d,) and offset of the facet of the hull of ``V`` (the points
+        of the last call and new ones after them) nearest the origin, or None when ``V`` spans no
+        hull."""
         V = np.ascontiguousarray(V, dtype=float)
         if self.state is not None and len(V) > self.done:
             verts, normal, off, alive, F, centre = self.state
@@ -1028,15 +1032,16 @@ class _Guide:
             self.state = (verts, normal, off, alive, F, centre) if ok else None
         if self.state is None:
             verts, normal, off, alive, F, centre, ok = planes_start(V)
-            self.state = (verts, normal, off, alive, F, centre) if ok else None
+            self.state = (verts, normal, off, alive, F, centre) if ok and F else None
         if self.state is not None:
             self.done = len(V)
-            return live_planes(self.state[1], self.state[2], self.state[3], self.state[4])
+            return weakest_plane(self.state[1], self.state[2], self.state[3], self.state[4])
         try:
             eq = ConvexHull(V).equations
         except (QhullError, ValueError):
             return None
-        return np.ascontiguousarray(eq[:, :-1]), -eq[:, -1]
+        f = int(np.argmin(-eq[:, -1]))
+        return np.ascontiguousarray(eq[f, :-1]), float(-eq[f, -1])
 
 
 def _initial_directions(d: int) -> np.ndarray:
@@ -1080,11 +1085,11 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
     while not limited:
         rounds += 1
         if len(V) > d and (hull is None or len(V) > done):
-            hull = guide.planes(np.array(V))  # None: a flat or degenerate set, more directions first
+            hull = guide.weakest(np.array(V))  # None: a flat or degenerate set, more directions first
             done = len(V)
         if hull is not None:
-            outward, dist = hull  # unit outward normals and offsets: a guide, not a proof
-            if hi - dist.min() <= rel_gap * hi:
+            weakest, dist = hull  # the unit outward normal and offset nearest the origin: a guide, not a proof
+            if hi - dist <= rel_gap * hi:
                 break
         if _expired(deadline):
             limited = True
@@ -1106,21 +1111,18 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
             add(v)
             work += 1
             continue
-        normals = outward[np.argsort(dist, kind="stable")[:_ADD]]
-        hv = pieces.h(normals, norm)
-        work += len(normals)
-        j = int(np.argmin(hv))
-        if hv[j] < hi:
-            u, h_u, steps = pieces.local_minimum(normals[j], norm)
+        hv = float(pieces.h(weakest[None], norm)[0])
+        work += 1
+        if hv < hi:
+            u, h_u, steps = pieces.local_minimum(weakest, norm)
             work += SOCP_COST * steps
             if h_u < hi:
                 u_best, hi = u, h_u
                 add(u_best)
         before = len(V)
-        for v in normals:
-            add(v)
-        if len(V) == before and hv[j] >= hi:
-            break  # nothing new to add: the polytope is as good as these directions make it
+        add(weakest)
+        if len(V) == before and hv >= hi:
+            break  # nothing new to add: the polytope is as good as this direction makes it
     faces = surface_faces(np.array(V)) if len(V) > d else None
     direction = tuple(float(v) for v in u_best)
     lo, ev = 0.0, Evidence("none", direction)
