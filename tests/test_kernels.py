@@ -1,4 +1,5 @@
-"""Compiled helpers against their numpy meaning: the stable argsort the kernels share, and the
+"""Compiled helpers against their numpy meaning: the stable argsorts the kernels share (merge and
+radix), and the
 projection of a Farkas direction off its tight blocks, which must leave it orthogonal to every
 tight column however dependent those columns are."""
 
@@ -7,7 +8,7 @@ from hypothesis import given, settings, strategies as st
 from hypothesis.extra.numpy import arrays
 
 from qualgrasp.certify._kernels.cones import farkas_direction
-from qualgrasp.certify._kernels.order import stable_argsort
+from qualgrasp.certify._kernels.order import radix_argsort, stable_argsort
 
 
 @settings(max_examples=200, deadline=None)
@@ -15,6 +16,13 @@ from qualgrasp.certify._kernels.order import stable_argsort
        | arrays(np.int64, st.integers(0, 70), elements=st.integers(-3, 3)))
 def test_stable_argsort_is_numpys_stable_argsort(keys):
     assert stable_argsort(keys).tolist() == np.argsort(keys, kind="stable").tolist()
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.integers(0, 3000), st.sampled_from([1, 2, 7, 2**11, 2**11 + 1, 2**40, 1280**5, 2**62]), st.integers(0, 2**32))
+def test_radix_argsort_is_numpys_stable_argsort(n, top, seed):
+    keys = np.random.default_rng(seed).integers(0, top, size=n, dtype=np.int64)
+    assert radix_argsort(keys).tolist() == np.argsort(keys, kind="stable").tolist()
 
 
 def test_farkas_direction_leaves_no_component_along_dependent_tight_columns():

@@ -3,7 +3,8 @@
 numba compiles its own ``np.argsort`` (an introsort) anew for every array type, about a second
 each on a first run; this bottom-up merge sort compiles in a fraction of that and is stable (ties
 keep their index order), so the kernels' results do not depend on the sorting algorithm's way with
-ties.
+ties. :func:`radix_argsort` gives the same order for large arrays of non-negative integer keys
+in linear time.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import numpy as np
 
 from .jit import kernel
 
-__all__ = ["stable_argsort"]
+__all__ = ["stable_argsort", "radix_argsort"]
 
 
 @kernel
@@ -45,4 +46,40 @@ def stable_argsort(keys):
                 k += 1
         order, work = work, order
         width *= 2
+    return order
+
+
+#: Bits of the key sorted per pass of :func:`radix_argsort`.
+_DIGIT = 11
+
+
+@kernel
+def radix_argsort(keys):
+    """:func:`stable_argsort` of non-negative int64 ``keys``, by a least-significant-digit radix
+    sort (stable passes of :data:`_DIGIT` bits, as many as the largest key needs): the same
+    indices, in linear time, for the ridge keys of large surfaces."""
+    n = keys.shape[0]
+    order = np.arange(n)
+    if n < 64:
+        return stable_argsort(keys)
+    work = np.empty(n, dtype=np.int64)
+    top = 0
+    for i in range(n):
+        top = max(top, keys[i])
+    buckets = 1 << _DIGIT
+    count = np.empty(buckets + 1, dtype=np.int64)
+    shift = 0
+    while shift < 63 and (top >> shift) > 0:
+        for b in range(buckets + 1):
+            count[b] = 0
+        for i in range(n):
+            count[((keys[order[i]] >> shift) & (buckets - 1)) + 1] += 1
+        for b in range(buckets):
+            count[b + 1] += count[b]
+        for i in range(n):
+            b = (keys[order[i]] >> shift) & (buckets - 1)
+            work[count[b]] = order[i]
+            count[b] += 1
+        order, work = work, order
+        shift += _DIGIT
     return order

@@ -19,7 +19,7 @@ import numpy as np
 
 from .jit import kernel
 from .linalg import U, gamma
-from .order import stable_argsort
+from .order import radix_argsort
 
 __all__ = ["face_bounds", "face_bounds_laplace", "leibniz_tables", "planar_h_bounds", "cycle_code", "orient_cycle"]
 
@@ -256,7 +256,7 @@ def _ridge_keys(faces, nv, keys, sgn):
 @kernel
 def _paired(keys):
     """The ridges sorted by key, or an empty array when a ridge is not in exactly two faces."""
-    order = stable_argsort(keys)
+    order = radix_argsort(keys)
     n = keys.shape[0]
     if n % 2:
         return order[:0]

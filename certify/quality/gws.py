@@ -46,6 +46,9 @@ __all__ = ["SHRINK", "surface_faces", "surfaces_faces", "hull_rows", "orient_fac
 
 # --- surfaces ------------------------------------------------------------------------------------
 
+#: The faces among which :func:`orient_faces` takes the one whose determinant's sign orients the rest.
+_SEEDS = 64
+
 def surface_faces(points: np.ndarray) -> np.ndarray | None:
     """Faces of the hull of ``points`` (n, d), each ordered so that its float determinant
     ``det(v_1, ..., v_d)`` is not negative (outward about an interior origin); None when the
@@ -128,7 +131,8 @@ def _qhull_faces(point_sets) -> list[np.ndarray | None]:
 
 def orient_faces(points: np.ndarray, simplices: np.ndarray) -> np.ndarray:
     """``simplices`` with the first two vertices swapped where needed so that their float
-    determinants are not negative: the face with the largest determinant by its sign, the others
+    determinants are not negative: the face with the largest determinant among the first
+    :data:`_SEEDS` by its sign, the others
     by propagation across shared ridges (:func:`~qualgrasp.certify._kernels.surface.orient_cycle`),
     so that a sliver face, whose determinant's sign rounding can flip, still closes the cycle (its
     own sign is then the exact check's to settle); each face by its own sign where the simplices
@@ -139,12 +143,14 @@ def orient_faces(points: np.ndarray, simplices: np.ndarray) -> np.ndarray:
 def _oriented(points: np.ndarray, simplices: np.ndarray) -> tuple[np.ndarray, bool]:
     """:func:`orient_faces` and whether the simplices form a closed surface."""
     faces = np.array(simplices, dtype=np.int64)
-    det = np.linalg.det(points[faces])
-    flip, closed = det < 0, False
+    closed = False
     if len(faces) and (faces.shape[1] - 1) * math.log2(max(len(points), 2)) < 62:  # ridge keys fit int64
+        det = np.linalg.det(points[faces[:_SEEDS]])  # the seed among the first faces: their largest
         seed = int(np.argmax(np.abs(det)))
-        turn, reached = orient_cycle(kernel_array(faces, np.int64), len(points), seed, bool(flip[seed]))
-        flip, closed = np.where(reached, turn, flip), bool(reached.all())
+        flip, reached = orient_cycle(kernel_array(faces, np.int64), len(points), seed, bool(det[seed] < 0))
+        closed = bool(reached.all())
+    if not closed:
+        flip = np.linalg.det(points[faces]) < 0
     faces[flip, 0], faces[flip, 1] = faces[flip, 1], faces[flip, 0].copy()
     return faces, closed
 
