@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial import ConvexHull
 
-from qualgrasp.certify._kernels.hull import PLANE_TOL, hull_faces, hulls_faces
+from qualgrasp.certify._kernels.hull import PLANE_TOL, hull_faces, hull_facets, hull_grow, hulls_faces, live_facets
 from qualgrasp.certify._kernels.surface import cycle_code, orient_cycle
 from qualgrasp.certify.quality.evidence import Evidence
 from qualgrasp.certify.quality.gws import orient_faces, surfaces_faces
@@ -270,3 +270,29 @@ def test_orientation_propagates_across_ridges_from_the_surest_face(d):
         assert not reached.any()
         assert (np.linalg.det(P[orient_faces(P, open_)]) >= 0).all()
         assert cycle_code(surfaces_faces([P])[0], len(P)) == 0
+
+
+@pytest.mark.parametrize("kind", ["generic", "rounded", "repeated"])
+def test_a_hull_grown_batch_by_batch_has_the_facets_of_one_built_at_once(kind):
+    """The spatial epsilon grows its hull round by round and its checker builds it at once
+    (:func:`hull_facets`): the rule depends on the points alone, so the facets are the same, on
+    points in general position and on rounded or repeated ones (near-coplanar sets, failed
+    insertions and restarts)."""
+    rng = np.random.default_rng(11)
+    for _ in range(6):
+        P = rng.normal(size=(60, 6))
+        if kind == "rounded":
+            P = np.round(P, 1)
+        elif kind == "repeated":
+            P[rng.integers(0, 60, 15)] = P[rng.integers(0, 60, 15)]
+        state = (np.zeros((1, 6), dtype=np.int64), np.zeros((1, 6)), np.zeros(1), np.zeros(1, dtype=bool), 0,
+                 np.zeros(6), 0)
+        n = 0
+        while n < len(P):
+            n = min(len(P), n + int(rng.integers(1, 6)))
+            state = hull_grow(np.ascontiguousarray(P[:n]), *state)
+        verts, normal, off, alive, F, centre, done = state
+        assert done == len(P)
+        assert np.array_equal(live_facets(verts, alive, F), hull_facets(P))
+        if kind == "generic":
+            assert _canonical(np.sort(hull_facets(P), axis=1)) == _canonical(np.sort(ConvexHull(P).simplices, axis=1))

@@ -23,7 +23,7 @@ from .jit import kernel
 from .order import stable_argsort
 
 __all__ = ["PLANE_TOL", "hull_faces", "hulls_faces", "face_planes", "used_vertices", "hull_planes", "planes_start",
-           "planes_insert", "live_planes", "weakest_plane", "hull_facets"]
+           "planes_insert", "live_planes", "weakest_plane", "hull_grow", "live_facets", "hull_facets"]
 
 #: Relative distance below which a point counts as on a face's plane (times the set's largest
 #: absolute coordinate).
@@ -610,16 +610,84 @@ def hull_planes(P):
 @kernel
 def hull_facets(P):
     """The facets of the convex hull of ``P`` (n, d), ``d >= 3``, as rows of ``d`` vertex indices
-    (a triangulation of its boundary into simplices), in the order :func:`live_planes` gives
-    their planes; an empty (0, d) array where :func:`planes_start` fails."""
-    verts, normal, off, alive, F, centre, ok = planes_start(P)
-    if not ok:
-        F = 0
+    (a triangulation of its boundary into simplices), grown by :func:`hull_grow`, in the order
+    :func:`live_planes` gives their planes; an empty (0, d) array where no hull grows."""
+    n, d = P.shape
+    verts, normal = np.zeros((1, d), dtype=np.int64), np.zeros((1, d))
+    off, alive, centre = np.zeros(1), np.zeros(1, dtype=np.bool_), np.zeros(d)
+    verts, normal, off, alive, F, centre, done = hull_grow(P, verts, normal, off, alive, 0, centre, 0)
+    return live_facets(verts, alive, F)
+
+
+@kernel
+def hull_grow(P, verts, normal, off, alive, F, centre, done):
+    """Grow the hull of ``P[:done]`` (the state of :func:`planes_start`; ``F == 0``: no hull yet)
+    to the hull of all of ``P`` (n, d) by a rule that depends on ``P`` alone, so that growing it
+    round by round and building it at once give the same facets: start at the shortest prefix
+    ``P[:k]``, ``k > d``, whose :func:`planes_start` succeeds; insert each later point in order,
+    point ``p`` with the tolerance of ``P[:p + 1]``; where an insertion fails, start again at the
+    shortest prefix past that point that succeeds. Returns ``(verts, normal, off, alive, F,
+    centre, done)``, ``F == 0`` when no prefix gave a hull (or a coordinate is not finite)."""
+    n, d = P.shape
+    work = np.empty((d - 1, d))
+    x = np.empty(d)
+    col = np.empty(d, dtype=np.int64)
+    scale = 0.0
+    for i in range(done):
+        for r in range(d):
+            scale = max(scale, abs(P[i, r]))
+    p = done
+    while p < n:
+        if F == 0:
+            k = max(p + 1, d + 1)
+            while k <= n:
+                verts, normal, off, alive, F, centre, ok = planes_start(P[:k])
+                if ok:
+                    break
+                F = 0
+                k += 1
+            if F == 0:
+                return verts, normal, off, alive, 0, centre, n
+            if alive.shape[0] < 64 * n + 64:  # the room planes_start gives all n points: no growing later
+                verts, normal, off, alive = _room(verts, normal, off, alive, F, 64 * n + 64)
+            for i in range(p, k):
+                for r in range(d):
+                    scale = max(scale, abs(P[i, r]))
+            p = k
+            continue
+        for r in range(d):
+            if not abs(P[p, r]) <= 1e300:
+                return verts, normal, off, alive, 0, centre, n
+            scale = max(scale, abs(P[p, r]))
+        verts, normal, off, alive, F, ok = _insert(P, p, verts, normal, off, alive, F, centre, PLANE_TOL * scale,
+                                                   work, x, col)
+        if not ok:
+            F = 0  # start again past this point
+        p += 1
+    return verts, normal, off, alive, F, centre, n
+
+
+@kernel
+def _room(verts, normal, off, alive, F, cap):
+    """The first ``F`` facets copied into arrays of ``cap`` rows."""
+    d = verts.shape[1]
+    verts2, normal2 = np.zeros((cap, d), dtype=np.int64), np.zeros((cap, d))
+    off2, alive2 = np.zeros(cap), np.zeros(cap, dtype=np.bool_)
+    for f in range(F):
+        for r in range(d):
+            verts2[f, r], normal2[f, r] = verts[f, r], normal[f, r]
+        off2[f], alive2[f] = off[f], alive[f]
+    return verts2, normal2, off2, alive2
+
+
+@kernel
+def live_facets(verts, alive, F):
+    """The live facets among the first ``F`` rows of ``verts``, in order (rows of vertex indices)."""
     count = 0
     for f in range(F):
         if alive[f]:
             count += 1
-    out = np.empty((count, P.shape[1]), dtype=np.int64)
+    out = np.empty((count, verts.shape[1]), dtype=np.int64)
     w = 0
     for f in range(F):
         if alive[f]:

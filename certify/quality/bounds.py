@@ -90,7 +90,7 @@ from .._kernels.conic import support_points
 from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .._kernels.epsilon import planar_epsilon as epsilon_kernel
 from .._kernels.evidence import minkowski_sums, support_choices, surface_rows, vertex_sums
-from .._kernels.hull import (face_planes, hull_faces, hull_facets, hulls_faces, planes_insert, planes_start,
+from .._kernels.hull import (face_planes, hull_faces, hull_facets, hull_grow, hulls_faces, live_facets,
                              used_vertices, weakest_plane)
 from .._kernels.jit import (B1, BOOL, F1, F2, F3, FLOAT, I1, I2, INT, await_compiled, compile_elsewhere, compiled_here,
                            kernel_array, mark_compiled, precompile)
@@ -100,7 +100,7 @@ from ..core.arguments import count_in, number_in, require
 from ..errors import ArgumentError
 from ..core.closure import Verdict, force_closure
 from .evidence import EPS_TOL, Evidence, EvidenceColumns, stated_lo, surface_minimum
-from .gws import (ConicSupport, planar_generator_arrays, planar_support_choices,
+from .gws import (ConicSupport, facet_surface, planar_generator_arrays, planar_support_choices,
                   hull_rows, sum_rows, surface_faces, surfaces_faces)
 from ..core.grasp import Grasp
 from ..core.problem import System, grasp_system
@@ -145,8 +145,9 @@ _CHECK_KERNELS = ((face_bounds, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)))
 #: and the 6-D hulls.
 _SURFACE_KERNELS = (
     (support_points, (F2, F2, F2, F2, I1, I1, BOOL, B1, I1, I2, I1, F2, F2, F1, F1, F1, F1)),
-    (face_bounds_laplace, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)), (planes_start, (F2,)),
-    (planes_insert, (F2, INT, I2, F2, F1, B1, INT, F1)), (weakest_plane, (F2, F1, B1, INT)), (hull_facets, (F2,)),
+    (face_bounds_laplace, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)),
+    (hull_grow, (F2, I2, F2, F1, B1, INT, F1, INT)), (weakest_plane, (F2, F1, B1, INT)), (live_facets, (I2, B1, INT)),
+    (hull_facets, (F2,)),
     (orient_cycle, (I2, INT, INT, BOOL)))
 #: The same for planar grasps, in three sets: these, ...
 _PLANAR_KERNELS = _CHECK_KERNELS + (
@@ -1027,36 +1028,46 @@ class _Pieces:
 
 class _Guide:
     """The hull of the spatial refinement's points, kept from round to round: the compiled
-    incremental hull (:func:`~qualgrasp.certify._kernels.hull.planes_start`,
-    :func:`~qualgrasp.certify._kernels.hull.planes_insert`), each round adding only its new points;
-    qhull built anew where that hull declines (not qhull's own incremental mode, whose precision
-    errors end the process: scipy issue 4974, exit code 7, no exception)."""
+    incremental hull grown by :func:`~qualgrasp.certify._kernels.hull.hull_grow`, each round
+    inserting only its new points, by a rule that depends on the points alone, so that the
+    checker's hull of the final points (:func:`~qualgrasp.certify.quality.gws.surface_faces`)
+    has the same facets; qhull where no hull grows (not qhull's own incremental mode, whose
+    precision errors end the process: scipy issue 4974, exit code 7, no exception)."""
 
     def __init__(self) -> None:
         self.state = None
-        self.done = 0
+
+    def _grow(self, V: np.ndarray) -> np.ndarray:
+        V = np.ascontiguousarray(V, dtype=float)
+        if self.state is None:
+            d = V.shape[1]
+            self.state = (np.zeros((1, d), dtype=np.int64), np.zeros((1, d)), np.zeros(1), np.zeros(1, dtype=bool),
+                          0, np.zeros(d), 0)
+        if len(V) > self.state[6]:
+            self.state = hull_grow(V, *self.state)
+        return V
 
     def weakest(self, V: np.ndarray):
         """The unit outward normal (d,) and offset of the facet of the hull of ``V`` (the points
         of the last call and new ones after them) nearest the origin, or None when ``V`` spans no
         hull."""
-        V = np.ascontiguousarray(V, dtype=float)
-        if self.state is not None and len(V) > self.done:
-            verts, normal, off, alive, F, centre = self.state
-            verts, normal, off, alive, F, ok = planes_insert(V, self.done, verts, normal, off, alive, F, centre)
-            self.state = (verts, normal, off, alive, F, centre) if ok else None
-        if self.state is None:
-            verts, normal, off, alive, F, centre, ok = planes_start(V)
-            self.state = (verts, normal, off, alive, F, centre) if ok and F else None
-        if self.state is not None:
-            self.done = len(V)
-            return weakest_plane(self.state[1], self.state[2], self.state[3], self.state[4])
+        V = self._grow(V)
+        verts, normal, off, alive, F, centre, done = self.state
+        if F:
+            return weakest_plane(normal, off, alive, F)
         try:
             eq = ConvexHull(V).equations
         except (QhullError, ValueError):
             return None
         f = int(np.argmin(-eq[:, -1]))
         return np.ascontiguousarray(eq[f, :-1]), float(-eq[f, -1])
+
+    def faces(self, V: np.ndarray) -> np.ndarray | None:
+        """The faces of the hull of ``V`` (the points of the last call and new ones after them), as
+        :func:`~qualgrasp.certify.quality.gws.surface_faces` gives them, from the hull kept."""
+        V = self._grow(V)
+        verts, normal, off, alive, F, centre, done = self.state
+        return facet_surface(V, live_facets(verts, alive, F))
 
 
 def _initial_directions(d: int) -> np.ndarray:
@@ -1138,7 +1149,7 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
         add(weakest)
         if len(V) == before and hv >= hi:
             break  # nothing new to add: the polytope is as good as this direction makes it
-    faces = surface_faces(np.array(V)) if len(V) > d else None
+    faces = guide.faces(np.array(V)) if len(V) > d else None
     direction = tuple(float(v) for v in u_best)
     lo, ev = 0.0, Evidence("none", direction)
     bounds = _prove(np.array(V), np.array(EV), faces, lambda i: sup.exact_vertex(parts[i]))

@@ -37,7 +37,7 @@ from ..core.grasp import Grasp
 from ..core.problem import grasp_system
 from ..core.wrench import force_column_errors, generator_layout, grasp_arrays, to_exact, variants_of
 
-__all__ = ["SHRINK", "surface_faces", "surfaces_faces", "hull_rows", "orient_faces", "generalised_cross",
+__all__ = ["SHRINK", "surface_faces", "surfaces_faces", "facet_surface", "hull_rows", "orient_faces", "generalised_cross",
            "face_distances",
            "planar_generator_arrays", "sum_errors", "planar_support_choice", "planar_support_choices",
            "planar_support_vertices",
@@ -75,9 +75,16 @@ def surfaces_faces(point_sets) -> list[np.ndarray | None]:
     for pts in point_sets:
         pts = kernel_array(pts)
         facets = hull_facets(pts) if pts.ndim == 2 and pts.shape[1] > 3 else np.zeros((0, 0), dtype=np.int64)
-        faces, closed = _oriented(pts, facets) if len(facets) else (None, False)
-        out.append(faces if closed else _qhull_faces([pts])[0])  # qhull too where rounding broke the surface
+        out.append(facet_surface(pts, facets))
     return out
+
+
+def facet_surface(points: np.ndarray, facets: np.ndarray) -> np.ndarray | None:
+    """The faces :func:`surface_faces` gives for ``points`` from the facets of their compiled hull
+    (simplices): ordered by :func:`orient_faces`, or qhull's where they do not close up (rounding
+    broke the surface) or there are none."""
+    faces, closed = _oriented(points, facets) if len(facets) else (None, False)
+    return faces if closed else _qhull_faces([points])[0]
 
 
 def hull_rows(V: np.ndarray, vstart: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
