@@ -10,7 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial import ConvexHull
 
-from qualgrasp.certify._kernels.hull import PLANE_TOL, hull_faces, hull_facets, hull_grow, hulls_faces, live_facets
+from qualgrasp.certify._kernels.hull import (PLANE_TOL, grow_start, hull_faces, hull_facets, hull_grow, hulls_faces,
+                                             live_facets)
 from qualgrasp.certify._kernels.surface import cycle_code, orient_cycle
 from qualgrasp.certify.quality.evidence import Evidence
 from qualgrasp.certify.quality.gws import orient_faces, surfaces_faces
@@ -285,8 +286,7 @@ def test_a_hull_grown_batch_by_batch_has_the_facets_of_one_built_at_once(kind):
             P = np.round(P, 1)
         elif kind == "repeated":
             P[rng.integers(0, 60, 15)] = P[rng.integers(0, 60, 15)]
-        state = (np.zeros((1, 6), dtype=np.int64), np.zeros((1, 6)), np.zeros(1), np.zeros(1, dtype=bool), 0,
-                 np.zeros(6), 0)
+        state = grow_start(6)
         n = 0
         while n < len(P):
             n = min(len(P), n + int(rng.integers(1, 6)))

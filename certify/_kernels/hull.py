@@ -23,7 +23,7 @@ from .jit import kernel
 from .order import stable_argsort
 
 __all__ = ["PLANE_TOL", "hull_faces", "hulls_faces", "face_planes", "used_vertices", "hull_planes", "planes_start",
-           "planes_insert", "live_planes", "weakest_plane", "hull_grow", "live_facets", "hull_facets"]
+           "planes_insert", "live_planes", "weakest_plane", "hull_grow", "grow_start", "live_facets", "hull_facets"]
 
 #: Relative distance below which a point counts as on a face's plane (times the set's largest
 #: absolute coordinate).
@@ -607,15 +607,19 @@ def hull_planes(P):
     return live_planes(normal, off, alive, F if ok else 0)
 
 
-@kernel
-def hull_facets(P):
+def grow_start(d: int) -> tuple:
+    """The state of :func:`hull_grow` before any point: no hull, no point done."""
+    return (np.zeros((1, d), dtype=np.int64), np.zeros((1, d)), np.zeros(1), np.zeros(1, dtype=np.bool_), 0,
+            np.zeros(d), 0)
+
+
+def hull_facets(P) -> np.ndarray:
     """The facets of the convex hull of ``P`` (n, d), ``d >= 3``, as rows of ``d`` vertex indices
     (a triangulation of its boundary into simplices), grown by :func:`hull_grow`, in the order
-    :func:`live_planes` gives their planes; an empty (0, d) array where no hull grows."""
-    n, d = P.shape
-    verts, normal = np.zeros((1, d), dtype=np.int64), np.zeros((1, d))
-    off, alive, centre = np.zeros(1), np.zeros(1, dtype=np.bool_), np.zeros(d)
-    verts, normal, off, alive, F, centre, done = hull_grow(P, verts, normal, off, alive, 0, centre, 0)
+    :func:`live_planes` gives their planes; an empty (0, d) array where no hull grows. (Python
+    around the two kernels, which the spatial epsilon calls with the same types: compiled once.)"""
+    P = np.ascontiguousarray(P, dtype=np.float64)
+    verts, normal, off, alive, F, centre, done = hull_grow(P, *grow_start(P.shape[1]))
     return live_facets(verts, alive, F)
 
 

@@ -90,7 +90,7 @@ from .._kernels.conic import support_points
 from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .._kernels.epsilon import planar_epsilon as epsilon_kernel
 from .._kernels.evidence import minkowski_sums, support_choices, surface_rows, vertex_sums
-from .._kernels.hull import (face_planes, hull_faces, hull_facets, hull_grow, hulls_faces, live_facets,
+from .._kernels.hull import (face_planes, grow_start, hull_faces, hull_grow, hulls_faces, live_facets,
                              used_vertices, weakest_plane)
 from .._kernels.jit import (B1, BOOL, F1, F2, F3, FLOAT, I1, I2, INT, await_compiled, compile_elsewhere, compiled_here,
                            kernel_array, mark_compiled, precompile)
@@ -147,7 +147,6 @@ _SURFACE_KERNELS = (
     (support_points, (F2, F2, F2, F2, I1, I1, BOOL, B1, I1, I2, I1, F2, F2, F1, F1, F1, F1)),
     (face_bounds_laplace, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)),
     (hull_grow, (F2, I2, F2, F1, B1, INT, F1, INT)), (weakest_plane, (F2, F1, B1, INT)), (live_facets, (I2, B1, INT)),
-    (hull_facets, (F2,)),
     (orient_cycle, (I2, INT, INT, BOOL)))
 #: The same for planar grasps, in three sets: these, ...
 _PLANAR_KERNELS = _CHECK_KERNELS + (
@@ -1040,9 +1039,7 @@ class _Guide:
     def _grow(self, V: np.ndarray) -> np.ndarray:
         V = np.ascontiguousarray(V, dtype=float)
         if self.state is None:
-            d = V.shape[1]
-            self.state = (np.zeros((1, d), dtype=np.int64), np.zeros((1, d)), np.zeros(1), np.zeros(1, dtype=bool),
-                          0, np.zeros(d), 0)
+            self.state = grow_start(V.shape[1])
         if len(V) > self.state[6]:
             self.state = hull_grow(V, *self.state)
         return V
