@@ -269,6 +269,8 @@ def test_orientation_propagates_across_ridges_from_the_surest_face(d):
         open_ = faces[1:]
         flip, reached = orient_cycle(open_, len(P), 0, False)
         assert not reached.any()
+        two = np.vstack([faces, faces + len(P)])  # two closed pieces: only the seed's is reached
+        assert orient_cycle(two, 2 * len(P), 0, False)[1].sum() == len(faces)
         assert (np.linalg.det(P[orient_faces(P, open_)]) >= 0).all()
         assert cycle_code(surfaces_faces([P])[0], len(P)) == 0
 
@@ -296,3 +298,14 @@ def test_a_hull_grown_batch_by_batch_has_the_facets_of_one_built_at_once(kind):
         assert np.array_equal(live_facets(verts, alive, F), hull_facets(P))
         if kind == "generic":
             assert _canonical(np.sort(hull_facets(P), axis=1)) == _canonical(np.sort(ConvexHull(P).simplices, axis=1))
+
+
+def test_a_surface_that_cannot_be_oriented_is_not_reported_closed():
+    """The real projective plane's six-vertex triangulation: every edge in exactly two triangles,
+    yet no orientation agrees across all of them."""
+    rp2 = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5], [0, 5, 1], [1, 2, 4], [2, 3, 5], [3, 4, 1],
+                    [4, 5, 2], [5, 1, 3]])
+    edges = np.sort(np.vstack([rp2[:, [0, 1]], rp2[:, [1, 2]], rp2[:, [0, 2]]]), axis=1)
+    assert (np.unique(edges, axis=0, return_counts=True)[1] == 2).all()
+    assert not orient_cycle(rp2, 6, 0, False)[1].any()
+    assert cycle_code(rp2, 6) == 4

@@ -629,9 +629,10 @@ def hull_grow(P, verts, normal, off, alive, F, centre, done):
     to the hull of all of ``P`` (n, d) by a rule that depends on ``P`` alone, so that growing it
     round by round and building it at once give the same facets: start at the shortest prefix
     ``P[:k]``, ``k > d``, whose :func:`planes_start` succeeds; insert each later point in order,
-    point ``p`` with the tolerance of ``P[:p + 1]``; where an insertion fails, start again at the
-    shortest prefix past that point that succeeds. Returns ``(verts, normal, off, alive, F,
-    centre, done)``, ``F == 0`` when no prefix gave a hull (or a coordinate is not finite)."""
+    point ``p`` with the tolerance of ``P[:p + 1]``; where inserting point ``p`` fails, start again
+    at the shortest prefix holding it, ``P[:k]``, ``k > p``, that succeeds. Returns ``(verts,
+    normal, off, alive, F, centre, done)``, ``F == 0`` when no hull grows that way (no prefix
+    builds, no restart after a failed insertion builds, or a coordinate is not finite)."""
     n, d = P.shape
     work = np.empty((d - 1, d))
     x = np.empty(d)
@@ -652,7 +653,7 @@ def hull_grow(P, verts, normal, off, alive, F, centre, done):
                 k += 1
             if F == 0:
                 return verts, normal, off, alive, 0, centre, n
-            if alive.shape[0] < 64 * n + 64:  # the room planes_start gives all n points: no growing later
+            if alive.shape[0] < 64 * n + 64:  # the room planes_start gives n points: less growing later
                 verts, normal, off, alive = _room(verts, normal, off, alive, F, 64 * n + 64)
             for i in range(p, k):
                 for r in range(d):
@@ -665,9 +666,10 @@ def hull_grow(P, verts, normal, off, alive, F, centre, done):
             scale = max(scale, abs(P[p, r]))
         verts, normal, off, alive, F, ok = _insert(P, p, verts, normal, off, alive, F, centre, PLANE_TOL * scale,
                                                    work, x, col)
-        if not ok:
-            F = 0  # start again past this point
-        p += 1
+        if ok:
+            p += 1
+        else:
+            F = 0  # start again at the shortest prefix holding this point that builds
     return verts, normal, off, alive, F, centre, n
 
 

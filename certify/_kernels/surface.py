@@ -19,7 +19,7 @@ import numpy as np
 
 from .jit import kernel
 from .linalg import U, gamma
-from .order import radix_argsort
+from .order import radix_argsort, stable_argsort
 
 __all__ = ["face_bounds", "face_bounds_laplace", "leibniz_tables", "planar_h_bounds", "cycle_code", "orient_cycle"]
 
@@ -280,11 +280,15 @@ def cycle_code(faces, nv):
     code = _ridge_keys(faces, nv, keys, sgn)
     if code:
         return code
-    order = _paired(keys)
-    if order.shape[0] < F * d:
+    order = stable_argsort(keys)  # the merge sort the planar kernels compile anyway
+    n = F * d
+    if n % 2:
         return 3
-    for i in range(0, F * d, 2):
-        if sgn[order[i]] + sgn[order[i + 1]] != 0:
+    for i in range(0, n, 2):
+        a, b = order[i], order[i + 1]
+        if keys[a] != keys[b] or (i + 2 < n and keys[order[i + 2]] == keys[a]):
+            return 3
+        if sgn[a] + sgn[b] != 0:
             return 4
     return 0
 
@@ -294,8 +298,10 @@ def orient_cycle(faces, nv, seed, flip_seed):
     """Which faces of a closed surface to turn over (swap two vertices of) so that every two
     faces sharing a ridge are oppositely oriented (:func:`cycle_code`), the face ``seed`` turned
     over when ``flip_seed``: propagated from it across the ridges, so the orientation is decided
-    once, not by a sign of each face. Returns ``(flip, reached)``; nothing is reached when the
-    faces are not a closed surface on ``nv`` vertices."""
+    once, not by a sign of each face. Returns ``(flip, reached)``: nothing is reached when a ridge
+    is not in exactly two faces, an index is out of range or repeated in a face, or the surface
+    cannot be oriented; only the seed's piece when the surface has more than one (so the faces
+    form one closed oriented surface exactly when all are reached)."""
     F, d = faces.shape
     flip = np.zeros(F, dtype=np.bool_)
     reached = np.zeros(F, dtype=np.bool_)
@@ -319,10 +325,13 @@ def orient_cycle(faces, nv, seed, flip_seed):
             a = f * d + k
             b = partner[a]
             g = b // d
+            # opposite induced signs after turning: turned faces negate every ridge's sign
+            turn = flip[f] != (sgn[a] == sgn[b])
             if not reached[g]:
-                # opposite induced signs after turning: turned faces negate every ridge's sign
-                flip[g] = flip[f] != (sgn[a] == sgn[b])
+                flip[g] = turn
                 reached[g] = True
                 stack[top] = g
                 top += 1
+            elif flip[g] != turn:  # a loop of faces that cannot be oriented
+                return flip, np.zeros(F, dtype=np.bool_)
     return flip, reached

@@ -419,6 +419,8 @@ def spatial_vertex_arrays(sup: ConicSupport, ev: Evidence, norm: str):
         return "L-infinity support evidence has no ref"
     if N <= d:
         return "too few vertices"
+    if (d - 1) * math.log2(N) >= 62:  # the hull's ridge keys would overflow: refused before building it
+        return "too many vertices"
     P = np.array(ev.points, dtype=float).reshape(N, d)
     ref = None
     if norm == "L1":

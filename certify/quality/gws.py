@@ -50,9 +50,10 @@ __all__ = ["SHRINK", "surface_faces", "surfaces_faces", "facet_surface", "hull_r
 _SEEDS = 64
 
 def surface_faces(points: np.ndarray) -> np.ndarray | None:
-    """Faces of the hull of ``points`` (n, d), each ordered so that its float determinant
-    ``det(v_1, ..., v_d)`` is not negative (outward about an interior origin); None when the
-    points span no full-dimensional hull. Compiled hulls give them, qhull where those decline: in
+    """Faces of the hull of ``points`` (n, d), ordered outward about an interior origin: each
+    float determinant ``det(v_1, ..., v_d)`` not negative in 3-D, and in 6-D oriented as one
+    closed surface (:func:`orient_faces`: a sliver face's determinant may round negative; the
+    exact check settles it); None when the points span no full-dimensional hull. Compiled hulls give them, qhull where those decline: in
     3-D (planar grasps) :func:`~qualgrasp.certify._kernels.hull.hull_faces`, in other dimensions
     (6-D, spatial grasps) the facets of :func:`~qualgrasp.certify._kernels.hull.hull_facets`,
     simplices, ordered by :func:`orient_faces` (qhull's where they do not close up)."""
