@@ -100,7 +100,7 @@ from ..core.arguments import count_in, number_in, require
 from ..errors import ArgumentError
 from ..core.closure import Verdict, force_closure
 from .evidence import EPS_TOL, Evidence, EvidenceColumns, stated_lo, surface_minimum
-from .gws import (ConicSupport, facet_surface, planar_generator_arrays, planar_support_choices,
+from .gws import (ConicSupport, oriented_surface, planar_generator_arrays, planar_support_choices,
                   hull_rows, sum_rows, surface_faces, surfaces_faces)
 from ..core.grasp import Grasp
 from ..core.problem import System, grasp_system
@@ -292,14 +292,14 @@ class _NoExact(Exception):
     """The exact data needed to settle a face is not available."""
 
 
-def _prove(V: np.ndarray, EV: np.ndarray, faces, exact_vertex):
+def _prove(V: np.ndarray, EV: np.ndarray, faces, exact_vertex, closed: bool = False):
     """Bounds ``(lo, hi)`` of the smallest squared face distance of a surface proving a ball
-    (:func:`qualgrasp.certify.quality.evidence.surface_minimum`, the checker's own rule), or None when
-    it proves nothing."""
+    (:func:`qualgrasp.certify.quality.evidence.surface_minimum`, the checker's own rule; ``closed``:
+    the faces are known to close up), or None when it proves nothing."""
     if faces is None or len(faces) == 0:
         return None
     try:
-        reason, lo, hi = surface_minimum(V, EV, faces, exact_vertex)
+        reason, lo, hi = surface_minimum(V, EV, faces, exact_vertex, closed=closed)
     except _NoExact:
         return None
     return None if reason or lo <= 0 else (lo, hi)
@@ -1059,12 +1059,13 @@ class _Guide:
         f = int(np.argmin(-eq[:, -1]))
         return np.ascontiguousarray(eq[f, :-1]), float(-eq[f, -1])
 
-    def faces(self, V: np.ndarray) -> np.ndarray | None:
+    def faces(self, V: np.ndarray) -> tuple[np.ndarray | None, bool]:
         """The faces of the hull of ``V`` (the points of the last call and new ones after them), as
-        :func:`~qualgrasp.certify.quality.gws.surface_faces` gives them, from the hull kept."""
+        :func:`~qualgrasp.certify.quality.gws.surface_faces` gives them, from the hull kept, and
+        whether they were found to close up (:func:`~qualgrasp.certify.quality.gws.oriented_surface`)."""
         V = self._grow(V)
         verts, normal, off, alive, F, centre, done = self.state
-        return facet_surface(V, live_facets(verts, alive, F))
+        return oriented_surface(V, live_facets(verts, alive, F))
 
 
 def _initial_directions(d: int) -> np.ndarray:
@@ -1146,10 +1147,10 @@ def _spatial(grasp, sup: ConicSupport, pieces: _Pieces, norm, rel_gap, budget, d
         add(weakest)
         if len(V) == before and hv >= hi:
             break  # nothing new to add: the polytope is as good as this direction makes it
-    faces = guide.faces(np.array(V)) if len(V) > d else None
+    faces, closed = guide.faces(np.array(V)) if len(V) > d else (None, False)
     direction = tuple(float(v) for v in u_best)
     lo, ev = 0.0, Evidence("none", direction)
-    bounds = _prove(np.array(V), np.array(EV), faces, lambda i: sup.exact_vertex(parts[i]))
+    bounds = _prove(np.array(V), np.array(EV), faces, lambda i: sup.exact_vertex(parts[i]), closed)
     if bounds is not None:
         lo = min(stated_lo(*bounds), hi)
         ev = Evidence("support", direction, ref=tuple(refs) if norm == "L1" else (),

@@ -311,15 +311,18 @@ def exact_face(vertices: Sequence[Sequence[Fraction]]) -> Fraction | None:
 
 
 def surface_minimum(V: np.ndarray, EV: np.ndarray, faces: np.ndarray, exact_vertex, *,
-                    tight: float = EPS_TOL / 8) -> tuple[str | None, Fraction, Fraction]:
+                    tight: float = EPS_TOL / 8, closed: bool = False) -> tuple[str | None, Fraction, Fraction]:
     """Check conditions (i) to (iii) of the module docstring for ``faces`` on the vertices whose
     float values ``V`` (nv, d) are within ``EV`` of the exact ones, and bound the smallest face
     distance ``D``: ``(reason or None, lo, hi)`` with ``lo <= D^2 <= hi``, ``hi <= (1 + tight)
     lo``. Rigorous float bounds (:func:`qualgrasp.certify._kernels.surface.face_bounds`, or
     :func:`~qualgrasp.certify._kernels.surface.face_bounds_laplace` beyond 3-D) decide
     every face they can; ``exact_vertex(i)`` (exact coordinates of vertex ``i``) is asked only
-    for the faces they leave undecided, or too loosely bounded to tell the minimum."""
-    reason = cycle_check(faces, len(V))
+    for the faces they leave undecided, or too loosely bounded to tell the minimum. ``closed``:
+    the faces are known to form a closed oriented cycle (the producer's faces oriented by
+    :func:`~qualgrasp.certify.quality.gws.oriented_surface`, which checks the same conditions), so
+    condition (i) is not checked again; the checker always checks it."""
+    reason = None if closed else cycle_check(faces, len(V))
     if reason:
         return reason, Fraction(0), Fraction(0)
     d = V.shape[1]

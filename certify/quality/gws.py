@@ -37,7 +37,7 @@ from ..core.grasp import Grasp
 from ..core.problem import grasp_system
 from ..core.wrench import force_column_errors, generator_layout, grasp_arrays, to_exact, variants_of
 
-__all__ = ["SHRINK", "surface_faces", "surfaces_faces", "facet_surface", "hull_rows", "orient_faces", "generalised_cross",
+__all__ = ["SHRINK", "surface_faces", "surfaces_faces", "facet_surface", "oriented_surface", "hull_rows", "orient_faces", "generalised_cross",
            "face_distances",
            "planar_generator_arrays", "sum_errors", "planar_support_choice", "planar_support_choices",
            "planar_support_vertices",
@@ -84,8 +84,15 @@ def facet_surface(points: np.ndarray, facets: np.ndarray) -> np.ndarray | None:
     """The faces :func:`surface_faces` gives for ``points`` from the facets of their compiled hull
     (simplices): ordered by :func:`orient_faces`, or qhull's where they do not close up (rounding
     broke the surface) or there are none."""
+    return oriented_surface(points, facets)[0]
+
+
+def oriented_surface(points: np.ndarray, facets: np.ndarray) -> tuple[np.ndarray | None, bool]:
+    """:func:`facet_surface` and whether its faces were found to be one closed oriented cycle (the
+    conditions of :func:`qualgrasp.certify.quality.evidence.cycle_check`; False for qhull's, whose
+    orientation is each face's own sign, unchecked)."""
     faces, closed = _oriented(points, facets) if len(facets) else (None, False)
-    return faces if closed else _qhull_faces([points])[0]
+    return (faces, True) if closed else (_qhull_faces([points])[0], False)
 
 
 def hull_rows(V: np.ndarray, vstart: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
