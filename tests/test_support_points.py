@@ -60,3 +60,21 @@ def test_an_l1_point_uses_the_contact_it_is_given():
     for q, b in enumerate([2, 0, 1]):
         cols = list(sup.blocks[b].cols)
         assert X[q, cols].any() and not np.delete(X[q], cols).any()
+
+
+@pytest.mark.parametrize("norm", ["L1", "Linf"])
+def test_the_numpy_route_of_earlier_builds_gives_proved_points_near_the_kernels(norm):
+    """The checker re-checks evidence of builds before the kernel by their numpy formula: its
+    points are proved points of the GWS (exact wrenches within their error bounds), within
+    rounding of the kernel's wherever no contact's support value is near 0."""
+    rng = np.random.default_rng(3)
+    for grasp in random_grasps(4, 8, dim=3, model="point", n_contacts=3, spread=0.3):
+        sup = ConicSupport(grasp)
+        P = rng.normal(size=(12, 6))
+        W, EW, X, ok = sup.vertices(P, norm, np.arange(12))
+        W2, EW2, X2, ok2 = sup.vertices_numpy(P, norm, np.arange(12))
+        assert ok2.all()
+        for q in range(len(P)):
+            exact = sup.exact_vertex(X2[q])
+            assert all(abs(Fraction(float(W2[q, r])) - exact[r]) <= Fraction(float(EW2[q, r])) for r in range(6))
+        assert np.allclose(W2, W, rtol=0, atol=1e-12) and np.allclose(X2, X, rtol=0, atol=1e-12)

@@ -368,6 +368,43 @@ class ConicSupport:
         W, EW, X, ok = self.vertices(v, norm, np.array([index]), None if ref is None else np.array([ref]))
         return (W[0], EW[0], X[0]) if ok[0] else None
 
+    def vertices_numpy(self, P: np.ndarray, norm: str, index: np.ndarray, ref: np.ndarray | None = None):
+        """:meth:`vertices` by the numpy formula of the builds before 2026-11-27 (``C' v`` and
+        ``C x`` through BLAS, the normal parts by ``einsum``), for re-checking the evidence they
+        wrote: its points are proved points of the GWS like the kernel's, in another rounding,
+        which near a tie or a cancellation can move a vertex further than the tolerance."""
+        lor, ray = np.flatnonzero(~self.ray), np.flatnonzero(self.ray)
+        f_col, m_col, nh, gr, mu = self.f_col[lor], self.m_col[lor], self.nh[lor], self.gr[lor], self.mu[lor]
+        N = len(P)
+        W, EW, X = np.zeros((N, self.C.shape[0])), np.zeros((N, self.C.shape[0])), np.zeros((N, self.C.shape[1]))
+        ok = np.ones(N, dtype=bool)
+        for q in range(N):
+            a = self.C.T @ P[q]
+            c, F = np.empty(len(self.blocks)), np.zeros(self.C.shape[1])
+            c[ray], F[self.col0[ray]] = a[self.col0[ray]], 1.0
+            if len(lor):
+                af = a[f_col]
+                an = np.einsum("bi,bi->b", af, nh)
+                at = af - an[:, None] * nh
+                am = np.where(m_col >= 0, a[m_col] * gr, 0.0)
+                nz = np.sqrt(np.einsum("bi,bi->b", at, at) + am * am)
+                c[lor] = an + mu * nz
+                k = np.divide(SHRINK * mu, nz, out=np.zeros_like(nz), where=nz > 0)
+                F[f_col] = nh + k[:, None] * at
+                F[m_col[m_col >= 0]] = (k * am * gr)[m_col >= 0]
+            if norm == "L1":
+                use = np.array([int(np.argmax(c)) if ref is None else int(ref[q])])
+            else:
+                use = np.flatnonzero(c > 0)
+            keep = np.zeros(self.C.shape[1], dtype=bool)
+            for b in use:
+                keep[self.data[b][0]] = True
+            X[q] = np.where(keep, F * vertex_scale(int(index[q])), 0.0)
+            ok[q] = all(self.inside(int(b), X[q, self.data[b][0]]) for b in use)
+            ax = np.abs(X[q])
+            W[q], EW[q] = self.C @ X[q], sum_errors(self.errors @ ax, self.absC @ ax, int(keep.sum()))
+        return W, EW, X, ok
+
     def exact_vertex(self, x: np.ndarray) -> list[Fraction]:
         """The exact wrench of the column values ``x``."""
         Cx = self.Cx
