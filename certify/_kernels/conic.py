@@ -156,8 +156,6 @@ def support_points(C, errors, absC, P, index, ref, l1, ray, col0, f_col, m_col, 
         The points and bounds on their distance to the exact wrenches of the column values.
     X : array, shape (n, k)
         The column values (0 off the contacts used).
-    used : bool array, shape (n, m)
-        The contacts each point uses.
     open_ : bool array, shape (n, m)
         Forces the float test leaves undecided (an exact test decides them).
     ok : bool array, shape (n,)
@@ -167,7 +165,7 @@ def support_points(C, errors, absC, P, index, ref, l1, ray, col0, f_col, m_col, 
     nb = ray.shape[0]
     N = P.shape[0]
     W, EW, X = np.zeros((N, d)), np.zeros((N, d)), np.zeros((N, k))
-    used = np.zeros((N, nb), dtype=np.bool_)
+    used = np.zeros(nb, dtype=np.bool_)
     open_ = np.zeros((N, nb), dtype=np.bool_)
     ok = np.ones(N, dtype=np.bool_)
     a = np.empty(k)
@@ -180,11 +178,13 @@ def support_points(C, errors, absC, P, index, ref, l1, ray, col0, f_col, m_col, 
                 s += C[r, j] * P[q, r]
             a[j] = s
         _support_forces(a, ray, col0, f_col, m_col, nh, mu, gr, c, Xf)
-        _use(c, ref[q], l1, used[q])
+        for b in range(nb):
+            used[b] = False
+        _use(c, ref[q], l1, used)
         scale = 1.0 - ((index[q] * 40503) % 65536) * 2.0**-30
         terms = 0
         for b in range(nb):
-            if not used[q, b]:
+            if not used[b]:
                 continue
             if ray[b]:
                 X[q, col0[b]] = Xf[col0[b]] * scale
@@ -207,7 +207,7 @@ def support_points(C, errors, absC, P, index, ref, l1, ray, col0, f_col, m_col, 
                 mag += absC[r, j] * abs(x)
             W[q, r] = s
             EW[q, r] = e + 2 * (terms + 1) * _U * mag
-    return W, EW, X, used, open_, ok
+    return W, EW, X, open_, ok
 
 
 @kernel

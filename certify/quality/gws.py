@@ -37,7 +37,7 @@ from ..core.grasp import Grasp
 from ..core.problem import grasp_system
 from ..core.wrench import force_column_errors, generator_layout, grasp_arrays, to_exact, variants_of
 
-__all__ = ["SHRINK", "surface_faces", "surfaces_faces", "facet_surface", "oriented_surface", "hull_rows", "orient_faces", "generalised_cross",
+__all__ = ["SHRINK", "surface_faces", "surfaces_faces", "oriented_surface", "hull_rows", "orient_faces", "generalised_cross",
            "face_distances",
            "planar_generator_arrays", "sum_errors", "planar_support_choice", "planar_support_choices",
            "planar_support_vertices",
@@ -76,19 +76,14 @@ def surfaces_faces(point_sets) -> list[np.ndarray | None]:
     for pts in point_sets:
         pts = kernel_array(pts)
         facets = hull_facets(pts) if pts.ndim == 2 and pts.shape[1] > 3 else np.zeros((0, 0), dtype=np.int64)
-        out.append(facet_surface(pts, facets))
+        out.append(oriented_surface(pts, facets)[0])
     return out
 
 
-def facet_surface(points: np.ndarray, facets: np.ndarray) -> np.ndarray | None:
-    """The faces :func:`surface_faces` gives for ``points`` from the facets of their compiled hull
-    (simplices): ordered by :func:`orient_faces`, or qhull's where they do not close up (rounding
-    broke the surface) or there are none."""
-    return oriented_surface(points, facets)[0]
-
-
 def oriented_surface(points: np.ndarray, facets: np.ndarray) -> tuple[np.ndarray | None, bool]:
-    """:func:`facet_surface` and whether its faces were found to be one closed oriented cycle (the
+    """The faces :func:`surface_faces` gives for ``points`` from the facets of their compiled hull
+    (simplices), ordered by :func:`orient_faces`, or qhull's where they do not close up (rounding
+    broke the surface) or there are none; and whether they were found to be one closed oriented cycle (the
     conditions of :func:`qualgrasp.certify.quality.evidence.cycle_check`; False for qhull's, whose
     orientation is each face's own sign, unchecked)."""
     faces, closed = _oriented(points, facets) if len(facets) else (None, False)
@@ -354,7 +349,7 @@ class ConicSupport:
         P = kernel_array(np.atleast_2d(P))
         index = kernel_array(index, np.int64)
         ref = np.full(len(P), -1, np.int64) if ref is None else kernel_array(ref, np.int64)
-        W, EW, X, used, open_, ok = support_points(
+        W, EW, X, open_, ok = support_points(
             self.C, self.errors, self.absC, P, index, ref, norm == "L1", self.ray, self.col0, self.f_col,
             self.m_col, self.n, self.nh, self.nn, self.mu, self.g, self.gr)
         for q, b in zip(*np.nonzero(open_ & ok[:, None])):
