@@ -14,10 +14,13 @@ import polars as pl
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
+from hypothesis import given, settings, strategies as st
+from hypothesis.extra.numpy import arrays
 
 from qualgrasp.certify import Options, certify_arrow
 from qualgrasp.certify.batch import certify_file
 from qualgrasp.certify.files import table_to_rows
+from qualgrasp.certify.files.columns import row_labels, value_columns
 
 N = 10_000
 
@@ -153,3 +156,32 @@ def test_a_corrupt_parquet_page_gives_error_rows_and_the_run_goes_on(tmp_path):
     assert errors and all("unreadable Parquet data (row group 1)" in r["error"] for r in errors)
     assert all(200 <= r["line"] - 1 < 400 for r in errors)
     assert rows[:200] == good[:200] and rows[400:] == good[400:]
+
+
+@given(st.integers(1, 6).flatmap(lambda m: arrays(np.int64, st.tuples(st.integers(0, 40), st.just(m)),
+                                                  elements=st.sampled_from([0, 1, 2, 9, 17, 2**40, -3]))))
+@settings(max_examples=200, deadline=None)
+def test_row_labels_are_numpys_unique_rows(key):
+    """The group labels of the columnar path number rows as numpy's unique rows do, whichever of
+    its three routes (all rows equal, packed into one integer, numpy's rows) a key takes."""
+    want = np.unique(key, axis=0, return_inverse=True)[1].ravel() if len(key) else np.zeros(0, dtype=np.int64)
+    assert np.array_equal(row_labels(key), want)
+
+
+def test_group_labels_of_mixed_patterns():
+    """Rows of two dimensions, three contact counts and mixed models get one label per pattern."""
+    rng = np.random.default_rng(5)
+    rows = []
+    for i in range(300):
+        dim, m = int(rng.integers(2, 4)), int(rng.integers(2, 5))
+        models = [str(rng.choice(["point", "frictionless"])) for _ in range(m)]
+        contacts = [{"p": rng.normal(size=dim).tolist(), "n": rng.normal(size=dim).tolist(), "model": mod}
+                    | ({"mu": 0.5} if mod == "point" else {}) for mod in models]
+        rows.append({"id": i, "contacts": contacts})
+    cols = value_columns(rows)
+    label = cols.pattern()
+    assert cols.ok.all()
+    keys = [(r["contacts"][0]["p"].__len__(), tuple(c["model"] for c in r["contacts"])) for r in rows]
+    for a in range(len(rows)):
+        same = [b for b in range(len(rows)) if keys[b] == keys[a]]
+        assert set(np.flatnonzero(label == label[a])) == set(same)

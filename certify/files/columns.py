@@ -19,6 +19,7 @@ it an error naming the field.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, Sequence
 
@@ -32,7 +33,7 @@ from .reader import READ_ERROR
 from ..core.validation import (ABSENT, MAX_CONTACTS, TOP_LEVEL, UNKNOWN, CheckedGrasps, ContactData, GraspData, check_grasps,
                                grasp_data, show)
 
-__all__ = ["GraspColumns", "grasp_columns", "value_columns", "extra_columns"]
+__all__ = ["GraspColumns", "grasp_columns", "value_columns", "extra_columns", "row_labels"]
 
 
 @dataclass
@@ -104,20 +105,24 @@ class GraspColumns:
     def pattern(self) -> np.ndarray:
         """Group label of every valid row: rows with equal labels share dimension, contact count
         and each contact's model and variant (the key of the columnar kernels); -1 for invalid
-        rows."""
+        rows. Labels count up in the lexicographic order of (dimension, count, key)."""
         n = len(self.ok)
         out = np.full(n, -1)
         c, offsets = self.checked.contacts, self.checked.offsets
         ok = np.flatnonzero(self.ok)
+        if not len(ok):
+            return out
+        count = self.count[ok].astype(np.int64)
+        shapes, shape_of = np.unique(self.dim[ok].astype(np.int64) * (int(count.max()) + 1) + count,
+                                     return_inverse=True)
         next_label = 0
-        shapes = np.stack([self.dim[ok], self.count[ok]], axis=1)
-        for shape in np.unique(shapes, axis=0):
-            rows = ok[(shapes == shape).all(axis=1)]
-            index = (offsets[rows][:, None] + np.arange(int(shape[1]))).ravel()
-            key = (c.model[index] * 8 + c.variant[index]).reshape(len(rows), int(shape[1]))
-            _, label = np.unique(key, axis=0, return_inverse=True)
-            out[rows] = next_label + label.ravel()
-            next_label += int(label.max()) + 1 if len(label) else 0
+        for s in range(len(shapes)):
+            rows = ok[shape_of.ravel() == s]
+            m = int(self.count[rows[0]])
+            index = (offsets[rows][:, None] + np.arange(m)).ravel()
+            label = row_labels((c.model[index].astype(np.int64) * 8 + c.variant[index]).reshape(len(rows), m))
+            out[rows] = next_label + label
+            next_label += int(label.max()) + 1
         return out
 
     def models_of(self, row: int) -> tuple[str, ...]:
@@ -129,6 +134,22 @@ class GraspColumns:
         """Model variants of the contacts of ``row``."""
         a = self.checked.offsets[row]
         return tuple(int(v) for v in self.checked.contacts.variant[a:a + self.count[row]])
+
+
+def row_labels(key: np.ndarray) -> np.ndarray:
+    """Labels of the rows of ``key`` ((B, m) integers), numbered in the rows'
+    lexicographic order: ``np.unique(key, axis=0, return_inverse=True)[1]``, without its sort of
+    rows where every row is the same (the usual grasp set) or the rows pack into one integer."""
+    B, m = key.shape
+    if not B or not m or (key == key[0]).all():
+        return np.zeros(B, dtype=np.int64)
+    base = int(key.max()) + 1
+    if key.min() >= 0 and m * math.log2(base) < 62:
+        packed = np.zeros(B, dtype=np.int64)
+        for j in range(m):  # the first column weighs most: the packed order is the lexicographic one
+            packed = packed * base + key[:, j]
+        return np.unique(packed, return_inverse=True)[1].ravel()
+    return np.unique(key, axis=0, return_inverse=True)[1].ravel()
 
 
 def _columns(checked: CheckedGrasps, count: np.ndarray, ids: list, meta) -> GraspColumns:
