@@ -121,7 +121,6 @@ class Geometry:
         self.regions = regions
         self._rows: list[tuple] = []
         self._ids: dict[tuple[int, int, int], int | None] = {}
-        self._arrays: dict[str, np.ndarray] | None = None
 
     def arcs(self, i: int) -> int:
         """Number of arcs of region ``i`` (1 for a straight region or a single point)."""
@@ -139,7 +138,8 @@ class Geometry:
             else:
                 self._ids[key] = len(self._rows)
                 self._rows.append((i, j0, j1) + row)
-                self._arrays = None
+                for f in Geometry._FIELDS:  # stale: the next read builds them again
+                    self.__dict__.pop(f, None)
         return self._ids[key]
 
     def ranges(self, i: int) -> list[int]:
@@ -157,15 +157,15 @@ class Geometry:
         return out
 
     def __getattr__(self, name: str) -> np.ndarray:
+        # called only when the arrays are not instance attributes: built once per growth of the rows
         if name not in Geometry._FIELDS:
             raise AttributeError(name)
-        if self._arrays is None:
-            cols = list(zip(*self._rows))
-            shapes = {"p0": 2, "p1": 2, "e": 2, "normal": 2, "psi": 2}
-            dtypes = {"region": np.int64, "j0": np.int64, "j1": np.int64, "exact": bool, "splittable_s": bool}
-            self._arrays = {f: np.array(c, dtype=dtypes.get(f, float)).reshape((-1, shapes[f]) if f in shapes else (-1,))
-                            for f, c in zip(Geometry._FIELDS, cols)}
-        return self._arrays[name]
+        cols = list(zip(*self._rows))
+        shapes = {"p0": 2, "p1": 2, "e": 2, "normal": 2, "psi": 2}
+        dtypes = {"region": np.int64, "j0": np.int64, "j1": np.int64, "exact": bool, "splittable_s": bool}
+        for f, c in zip(Geometry._FIELDS, cols):
+            self.__dict__[f] = np.array(c, dtype=dtypes.get(f, float)).reshape((-1, shapes[f]) if f in shapes else (-1,))
+        return self.__dict__[name]
 
 
 def _stretch(r, j0: int, j1: int, tol: float):
@@ -302,6 +302,12 @@ def _piece_vertices(arcs: Geometry, arc: np.ndarray, s0, s1, t0, t1):
     return Q, Qabs, Nv
 
 
+def _corner_max(A: np.ndarray) -> np.ndarray:
+    """``A.max(axis=1)`` of (B, 4, d) corner values (elementwise maxima: faster than a reduction
+    over a short middle axis, and the same numbers)."""
+    return np.maximum(np.maximum(A[:, 0], A[:, 1]), np.maximum(A[:, 2], A[:, 3]))
+
+
 def bounds(regions: RegionTuple, arcs: Geometry, model: _Model, contact, arc, face, box, s0, s1, t0, t1,
            Y: np.ndarray | None = None, cand: np.ndarray | None = None):
     """Rigorous lower bounds, per item, of ``L max_g y @ w_g`` over a cell and a piece.
@@ -321,11 +327,11 @@ def bounds(regions: RegionTuple, arcs: Geometry, model: _Model, contact, arc, fa
     # rounding: every term of the exact expression is bounded in absolute value by ``scale``
     # (the same expression over absolute values, bounded above), so each value is within
     # gamma_40 scale of its float (Higham's gamma_n; the depth of the expression is below 25)
-    ya = np.abs(Y).max(axis=1)                                                        # (B, 3)
+    ya = _corner_max(np.abs(Y))                                                       # (B, 3)
     qa = (np.abs(arcs.p0[arc]) + np.maximum(np.abs(s0), np.abs(s1))[:, None] * 1.0000001 * (np.abs(arcs.p1[arc])
           + np.abs(arcs.p0[arc])) + (arcs.h[arc] * (1 + 2 * _REL))[:, None] * np.abs(arcs.e[arc]))
     va = L * ya[:, :2] + ya[:, 2:3] * (qa[:, ::-1] + np.abs([cx, cy])[::-1])
-    na = np.abs(Nv).max(axis=1)                                                       # (B, 2)
+    na = _corner_max(np.abs(Nv))                                                      # (B, 2)
     ra = (na.sum(axis=1)[:, None] * (1 + np.abs(fm)))                                 # (B, G)
     scale = (ra * va.sum(axis=1)[:, None] + ya[:, 2:3] * np.abs(ow)).max(axis=1)     # (B,)
     which = np.full(B, -1, dtype=np.int64) if cand is None else np.asarray(cand, dtype=np.int64)
@@ -479,8 +485,9 @@ def decide_branch(regions: RegionTuple, budget: int = DEFAULT_BUDGET, batch_item
             covering.setdefault(int(it["group_cell"][g]), int(it["group_contact"][g]))
         for c, i in covering.items():
             f, box, pieces = batch[c]
-            sel = (it["cell"] == c) & (it["contact"] == i)
-            covered.append((f, box, i, np.column_stack([pieces[pieces[:, 0] == i][:, 1:], best[sel]])))
+            a, b = it["cell_start"][c], it["cell_start"][c + 1]  # the cell's items, one per piece
+            sel = pieces[:, 0] == i
+            covered.append((f, box, i, np.column_stack([pieces[sel][:, 1:], best[a:b][sel]])))
         open_cells = np.array([c for c in range(len(batch)) if c not in covering], dtype=np.int64)
         if not len(open_cells):
             continue
@@ -528,13 +535,11 @@ def decide_branch(regions: RegionTuple, budget: int = DEFAULT_BUDGET, batch_item
                 _, sp_s, sp_t = _centre_values(regions, arcs, model, it["contact"][sel], it["arc"][sel],
                                                Yc[item_slot[sel]], it["s0"][sel], it["s1"][sel], it["t0"][sel], it["t1"][sel])
                 proposals = []
-                for q, j in enumerate(sel):
-                    c = int(it["cell"][j])
-                    row = batch[c][2][it["row"][j]]
-                    halves = _split_piece(row[1:], arcs, sp_s[q], sp_t[q])
+                lb_far, tg_sel = lbc[far].tolist(), target[item_slot[sel]].tolist()
+                for q, (c, r) in enumerate(zip(it["cell"][sel].tolist(), it["row"][sel].tolist())):
+                    halves = _split_piece(batch[c][2][r], arcs, sp_s[q], sp_t[q])
                     if halves is not None:
-                        proposals.append((c, int(it["row"][j]), np.column_stack([np.full(2, row[0]), halves]),
-                                          float(lbc[far][q]), float(target[item_slot[j]])))
+                        proposals.append((c, r, halves, lb_far[q], tg_sel[q]))
                 if proposals:
                     H = np.vstack([p[2] for p in proposals])
                     work += len(H)
@@ -545,20 +550,16 @@ def decide_branch(regions: RegionTuple, budget: int = DEFAULT_BUDGET, batch_item
                     for n_, (c, r, halves, lbc_j, tg) in enumerate(proposals):
                         if min(lbh[2 * n_], lbh[2 * n_ + 1]) > lbc_j + 0.05 * (tg - lbc_j):
                             accepted.setdefault(c, {})[r] = halves
-        for c in open_cells:
+        kids, small = _quarters(np.array([batch[c][1] for c in open_cells]))
+        for q, c in enumerate(open_cells.tolist()):
             f, box, pieces = batch[c]
             if c in accepted:
                 parts = accepted[c]
                 queue.append((f, box, np.vstack([parts.get(r, pieces[r:r + 1]) for r in range(len(pieces))])))
-                continue
-            w = box[1] - box[0]
-            if w / 2 < MIN_CELL:
+            elif small[q]:
                 stuck += 1
-                continue
-            h = w / 2
-            for a0 in (box[0], box[0] + h):
-                for a1 in (box[2], box[2] + h):
-                    queue.append((f, np.array([a0, a0 + h, a1, a1 + h]), pieces))
+            else:
+                queue.extend((f, kid, pieces) for kid in kids[q])
     if stuck:
         why = "; ".join(sorted(set(failures))) if failures else "no exact candidate choice separates there"
         return BranchResult("undecided", reason=f"{stuck} direction cells reached the finest size uncovered "
@@ -567,28 +568,38 @@ def decide_branch(regions: RegionTuple, budget: int = DEFAULT_BUDGET, batch_item
     return BranchResult("robust", cells=covered, work=work, geometry=arcs)
 
 
+def _quarters(boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The four quarters (n, 4, 4) of each cell box (n, 4) (``lo0, hi0, lo1, hi1``; first coordinate
+    slowest), and whether a quarter's width is below :data:`MIN_CELL` (n,)."""
+    h = (boxes[:, 1] - boxes[:, 0]) / 2
+    lo0, lo1 = boxes[:, 0], boxes[:, 2]
+    kids = np.stack([np.stack([a0, a0 + h, a1, a1 + h], axis=1) for a0 in (lo0, lo0 + h) for a1 in (lo1, lo1 + h)],
+                    axis=1)
+    return kids, h < MIN_CELL
+
+
 def _split_piece(p, arcs: Geometry, spread_s: float, spread_t: float):
-    """Two pieces covering the piece ``[stretch, s0, s1, t0, t1]``: a stretch of several arcs is
-    cut at its middle point; a single arc along ``s`` or ``t`` (the larger spread). None when it
-    may not be split."""
-    g = int(p[0])
+    """Two pieces (2, 6) covering the piece ``p = [contact, stretch, s0, s1, t0, t1]``: a stretch
+    of several arcs is cut at its middle point; a single arc along ``s`` or ``t`` (the larger
+    spread). None when it may not be split."""
+    g = int(p[1])
     i, j0, j1 = int(arcs.region[g]), int(arcs.j0[g]), int(arcs.j1[g])
     if j1 - j0 > 1:
         mid = (j0 + j1) // 2
         ids = [arcs.id(i, j0, mid), arcs.id(i, mid, j1)]
         if None in ids:  # pragma: no cover  (a part of a boundable stretch is boundable)
             return None
-        return np.array([[ids[0], 0.0, 1.0, 0.0, 1.0], [ids[1], 0.0, 1.0, 0.0, 1.0]])
-    can_s = arcs.splittable_s[g] and p[2] - p[1] > MIN_PIECE
-    can_t = (not arcs.exact[g]) and p[4] - p[3] > MIN_PIECE
+        return np.array([[p[0], ids[0], 0.0, 1.0, 0.0, 1.0], [p[0], ids[1], 0.0, 1.0, 0.0, 1.0]])
+    can_s = arcs.splittable_s[g] and p[3] - p[2] > MIN_PIECE
+    can_t = (not arcs.exact[g]) and p[5] - p[4] > MIN_PIECE
     if not (can_s or can_t):
         return None
     along_s = can_s and (not can_t or spread_s >= spread_t)
-    a, b = (1, 2) if along_s else (3, 4)
+    a, b = (2, 3) if along_s else (4, 5)
     mid = (p[a] + p[b]) / 2
-    lo, hi = p.copy(), p.copy()
-    lo[b], hi[a] = mid, mid
-    return np.vstack([lo, hi])
+    out = np.vstack([p, p])
+    out[0, b], out[1, a] = mid, mid
+    return out
 
 
 def _items(batch, k):
@@ -600,7 +611,8 @@ def _items(batch, k):
     key = cell * k + contact
     start = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
     offsets = np.r_[0, np.cumsum(counts)[:-1]]
-    return {"cell": cell, "contact": contact, "arc": P[:, 1].astype(np.int64), "s0": P[:, 2], "s1": P[:, 3],
+    return {"cell": cell, "cell_start": np.r_[0, np.cumsum(counts)], "contact": contact,
+            "arc": P[:, 1].astype(np.int64), "s0": P[:, 2], "s1": P[:, 3],
             "t0": P[:, 4], "t1": P[:, 5], "face": np.repeat([b[0] for b in batch], counts).astype(np.int64),
             "box": np.repeat(np.array([b[1] for b in batch]), counts, axis=0), "row": np.arange(len(P)) - offsets[cell],
             "group_start": start, "group_cell": cell[start], "group_contact": contact[start]}
