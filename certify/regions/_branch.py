@@ -597,7 +597,8 @@ def _split_piece(p, arcs: Geometry, spread_s: float, spread_t: float):
     along_s = can_s and (not can_t or spread_s >= spread_t)
     a, b = (2, 3) if along_s else (4, 5)
     mid = (p[a] + p[b]) / 2
-    out = np.vstack([p, p])
+    out = np.empty((2, 6))
+    out[0] = out[1] = p
     out[0, b], out[1, a] = mid, mid
     return out
 
