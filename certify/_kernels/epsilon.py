@@ -81,7 +81,7 @@ def planar_epsilon_one(Wb, owner, m, linf):
     for a in range(n):
         scale = max(scale, abs(E[a, 0]) + abs(E[a, 1]) + abs(E[a, 2]))
     tiny = 1e-12 * max(1.0, scale * scale)
-    work = np.empty(m)
+    work = np.empty((2, m))
     arg = np.zeros(3)
     best = np.inf
     for a in range(n):
@@ -100,8 +100,8 @@ def planar_epsilon_one(Wb, owner, m, linf):
 
 @kernel
 def _candidate(Wb, owner, work, linf, x0, x1, x2, y0, y1, y2, tiny, best, arg):
-    """Evaluate the support function at both unit normals ``+-(x cross y)``; return the least
-    value so far (``arg`` holds its direction)."""
+    """Evaluate the support function at both unit normals ``+-(x cross y)``, ``+`` first; return
+    the least value so far (``arg`` holds its direction). ``work`` is (2, contacts)."""
     u0 = x1 * y2 - x2 * y1
     u1 = x2 * y0 - x0 * y2
     u2 = x0 * y1 - x1 * y0
@@ -109,12 +109,37 @@ def _candidate(Wb, owner, work, linf, x0, x1, x2, y0, y1, y2, tiny, best, arg):
     if nu <= tiny:
         return best
     u0, u1, u2 = u0 / nu, u1 / nu, u2 / nu
-    for sgn in (1.0, -1.0):
-        h = _support_planar(Wb, owner, work, sgn * u0, sgn * u1, sgn * u2, linf)
-        if h < best:
-            best = h
-            arg[0], arg[1], arg[2] = sgn * u0, sgn * u1, sgn * u2
+    plus, minus = _support_both(Wb, owner, work[0], work[1], u0, u1, u2, linf)
+    if plus < best:
+        best = plus
+        arg[0], arg[1], arg[2] = u0, u1, u2
+    if minus < best:
+        best = minus
+        arg[0], arg[1], arg[2] = -u0, -u1, -u2
     return best
+
+
+@kernel
+def _support_both(Wb, owner, best, worst, u0, u1, u2, linf):
+    """:func:`_support_planar` at ``u`` and at ``-u`` in one pass over the generators. The
+    products at ``-u`` are those at ``u`` negated, exactly (rounding to nearest is symmetric), so
+    both values are what :func:`_support_planar` gives. ``best`` and ``worst`` are work arrays
+    with one entry per contact."""
+    m = best.shape[0]
+    for i in range(m):
+        best[i] = 0.0
+        worst[i] = 0.0
+    for j in range(Wb.shape[1]):
+        v = Wb[0, j] * u0 + Wb[1, j] * u1 + Wb[2, j] * u2
+        if v > best[owner[j]]:
+            best[owner[j]] = v
+        if -v > worst[owner[j]]:
+            worst[owner[j]] = -v
+    plus, minus = 0.0, 0.0
+    for i in range(m):
+        plus = plus + best[i] if linf else max(plus, best[i])
+        minus = minus + worst[i] if linf else max(minus, worst[i])
+    return plus, minus
 
 
 @kernel
