@@ -121,6 +121,7 @@ class Geometry:
         self.regions = regions
         self._rows: list[tuple] = []
         self._ids: dict[tuple[int, int, int], int | None] = {}
+        self._halves: dict[int, tuple[int, int] | None] = {}
 
     def arcs(self, i: int) -> int:
         """Number of arcs of region ``i`` (1 for a straight region or a single point)."""
@@ -141,6 +142,16 @@ class Geometry:
                 for f in Geometry._FIELDS:  # stale: the next read builds them again
                     self.__dict__.pop(f, None)
         return self._ids[key]
+
+    def halves(self, g: int) -> tuple[int, int] | None:
+        """Ids of the two halves of stretch ``g`` (several arcs, cut at its middle arc), None
+        when one cannot be bounded."""
+        if g not in self._halves:
+            i, j0, j1 = self._rows[g][:3]
+            mid = (j0 + j1) // 2
+            ids = (self.id(i, j0, mid), self.id(i, mid, j1))
+            self._halves[g] = None if None in ids else ids
+        return self._halves[g]
 
     def ranges(self, i: int) -> list[int]:
         """Ids of a partition of region ``i`` into the fewest halvings that can be bounded."""
@@ -534,22 +545,21 @@ def decide_branch(regions: RegionTuple, budget: int = DEFAULT_BUDGET, batch_item
             if len(sel):
                 _, sp_s, sp_t = _centre_values(regions, arcs, model, it["contact"][sel], it["arc"][sel],
                                                Yc[item_slot[sel]], it["s0"][sel], it["s1"][sel], it["t0"][sel], it["t1"][sel])
-                proposals = []
-                lb_far, tg_sel = lbc[far].tolist(), target[item_slot[sel]].tolist()
-                for q, (c, r) in enumerate(zip(it["cell"][sel].tolist(), it["row"][sel].tolist())):
-                    halves = _split_piece(batch[c][2][r], arcs, sp_s[q], sp_t[q])
-                    if halves is not None:
-                        proposals.append((c, r, halves, lb_far[q], tg_sel[q]))
-                if proposals:
-                    H = np.vstack([p[2] for p in proposals])
+                halves, ok = _split_pieces(it["piece"][sel], arcs, sp_s, sp_t)
+                if ok.any():
+                    H = halves[ok].reshape(-1, 6)
                     work += len(H)
-                    cells_of = np.repeat([p[0] for p in proposals], 2)
+                    cells_of = np.repeat(it["cell"][sel][ok], 2)
                     lbh, _ = bounds(regions, arcs, model, H[:, 0].astype(np.int64), H[:, 1].astype(np.int64), None, None,
                                     H[:, 2], H[:, 3], H[:, 4], H[:, 5],
                                     Y=np.repeat(yc_all[cells_of][:, None, :], 4, axis=1))
-                    for n_, (c, r, halves, lbc_j, tg) in enumerate(proposals):
-                        if min(lbh[2 * n_], lbh[2 * n_ + 1]) > lbc_j + 0.05 * (tg - lbc_j):
-                            accepted.setdefault(c, {})[r] = halves
+                    lo, hi = lbh[0::2], lbh[1::2]
+                    worse = np.where(hi < lo, hi, lo)  # Python's min(lo, hi)
+                    lbc_j, tg = lbc[far][ok], target[item_slot[sel]][ok]
+                    gain = worse > lbc_j + 0.05 * (tg - lbc_j)
+                    for c, r, q in zip(it["cell"][sel][ok][gain].tolist(), it["row"][sel][ok][gain].tolist(),
+                                       np.flatnonzero(ok)[gain].tolist()):
+                        accepted.setdefault(c, {})[r] = halves[q]
         kids, small = _quarters(np.array([batch[c][1] for c in open_cells]))
         for q, c in enumerate(open_cells.tolist()):
             f, box, pieces = batch[c]
@@ -578,29 +588,32 @@ def _quarters(boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return kids, h < MIN_CELL
 
 
-def _split_piece(p, arcs: Geometry, spread_s: float, spread_t: float):
-    """Two pieces (2, 6) covering the piece ``p = [contact, stretch, s0, s1, t0, t1]``: a stretch
-    of several arcs is cut at its middle point; a single arc along ``s`` or ``t`` (the larger
-    spread). None when it may not be split."""
-    g = int(p[1])
-    i, j0, j1 = int(arcs.region[g]), int(arcs.j0[g]), int(arcs.j1[g])
-    if j1 - j0 > 1:
-        mid = (j0 + j1) // 2
-        ids = [arcs.id(i, j0, mid), arcs.id(i, mid, j1)]
-        if None in ids:  # pragma: no cover  (a part of a boundable stretch is boundable)
-            return None
-        return np.array([[p[0], ids[0], 0.0, 1.0, 0.0, 1.0], [p[0], ids[1], 0.0, 1.0, 0.0, 1.0]])
-    can_s = arcs.splittable_s[g] and p[3] - p[2] > MIN_PIECE
-    can_t = (not arcs.exact[g]) and p[5] - p[4] > MIN_PIECE
-    if not (can_s or can_t):
-        return None
-    along_s = can_s and (not can_t or spread_s >= spread_t)
-    a, b = (2, 3) if along_s else (4, 5)
-    mid = (p[a] + p[b]) / 2
-    out = np.empty((2, 6))
-    out[0] = out[1] = p
-    out[0, b], out[1, a] = mid, mid
-    return out
+def _split_pieces(rows: np.ndarray, arcs: Geometry, spread_s: np.ndarray, spread_t: np.ndarray):
+    """Two pieces covering each piece ``[contact, stretch, s0, s1, t0, t1]`` of ``rows`` (n, 6): a
+    stretch of several arcs is cut at its middle point; a single arc along ``s`` or ``t`` (the
+    larger spread). Returns the halves (n, 2, 6) and whether each piece may be split."""
+    g = rows[:, 1].astype(np.int64)
+    multi = arcs.j1[g] - arcs.j0[g] > 1
+    splittable_s, exact = arcs.splittable_s[g], arcs.exact[g]
+    halves = np.repeat(rows[:, None, :], 2, axis=1)
+    ok = np.zeros(len(rows), dtype=bool)
+    for q in np.flatnonzero(multi).tolist():  # in order: new stretches get their ids as before
+        ids = arcs.halves(int(g[q]))
+        if ids is not None:
+            halves[q, :, 1] = ids
+            halves[q, :, 2:] = (0.0, 1.0, 0.0, 1.0)
+            ok[q] = True
+    can_s = splittable_s & (rows[:, 3] - rows[:, 2] > MIN_PIECE)
+    can_t = ~exact & (rows[:, 5] - rows[:, 4] > MIN_PIECE)
+    single = ~multi & (can_s | can_t)
+    along_s = can_s & (~can_t | (spread_s >= spread_t))
+    q = np.flatnonzero(single)
+    a = np.where(along_s[q], 2, 4)
+    mid = (rows[q, a] + rows[q, a + 1]) / 2
+    halves[q, 0, a + 1] = mid
+    halves[q, 1, a] = mid
+    ok[q] = True
+    return halves, ok
 
 
 def _items(batch, k):
@@ -612,7 +625,7 @@ def _items(batch, k):
     key = cell * k + contact
     start = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
     offsets = np.r_[0, np.cumsum(counts)[:-1]]
-    return {"cell": cell, "cell_start": np.r_[0, np.cumsum(counts)], "contact": contact,
+    return {"cell": cell, "cell_start": np.r_[0, np.cumsum(counts)], "piece": P, "contact": contact,
             "arc": P[:, 1].astype(np.int64), "s0": P[:, 2], "s1": P[:, 3],
             "t0": P[:, 4], "t1": P[:, 5], "face": np.repeat([b[0] for b in batch], counts).astype(np.int64),
             "box": np.repeat(np.array([b[1] for b in batch]), counts, axis=0), "row": np.arange(len(P)) - offsets[cell],
