@@ -144,10 +144,11 @@ def row_labels(key: np.ndarray) -> np.ndarray:
     if not B or not m or (key == key[0]).all():
         return np.zeros(B, dtype=np.int64)
     base = int(key.max()) + 1
-    if key.min() >= 0 and m * math.log2(base) < 62:
+    if key.dtype.kind in "iu" and int(key.min()) >= 0 and m * math.log2(base) < 62:
         packed = np.zeros(B, dtype=np.int64)
+        small = key.astype(np.int64)  # exact: every value is below 2**62 (uint64 would go to float)
         for j in range(m):  # the first column weighs most: the packed order is the lexicographic one
-            packed = packed * base + key[:, j]
+            packed = packed * base + small[:, j]
         return np.unique(packed, return_inverse=True)[1].ravel()
     return np.unique(key, axis=0, return_inverse=True)[1].ravel()
 

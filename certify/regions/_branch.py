@@ -175,7 +175,8 @@ class Geometry:
         shapes = {"p0": 2, "p1": 2, "e": 2, "normal": 2, "psi": 2}
         dtypes = {"region": np.int64, "j0": np.int64, "j1": np.int64, "exact": bool, "splittable_s": bool}
         for f, c in zip(Geometry._FIELDS, cols):
-            self.__dict__[f] = np.array(c, dtype=dtypes.get(f, float)).reshape((-1, shapes[f]) if f in shapes else (-1,))
+            shape = (-1, shapes[f]) if f in shapes else (-1,)
+            self.__dict__[f] = np.array(c, dtype=dtypes.get(f, float)).reshape(shape)
         return self.__dict__[name]
 
 
