@@ -290,7 +290,8 @@ def cell_vertices(face: np.ndarray, box: np.ndarray) -> np.ndarray:
 
 
 def _piece_vertices(arcs: Geometry, arc: np.ndarray, s0, s1, t0, t1):
-    """Point vertices (B, 4, 2) with their absolute bounds, and normal vertices (B, 4, 2)."""
+    """Point vertices (B, 4, 2) and normal vertices (B, 4, 2) of pieces (``bounds`` bounds their
+    magnitudes itself)."""
     h = arcs.h[arc]
     ext = np.where(h > 0, _REL, 0.0)
     s0e = np.where(s0 <= 0, s0 - ext, s0)
@@ -299,7 +300,6 @@ def _piece_vertices(arcs: Geometry, arc: np.ndarray, s0, s1, t0, t1):
     S = np.stack([s0e, s0e, s1e, s1e], axis=1)[..., None]
     Hh = np.stack([-h, h, -h, h], axis=1)[..., None]
     Q = P0[:, None, :] + S * (P1 - P0)[:, None, :] + Hh * E[:, None, :]
-    Qabs = np.abs(P0)[:, None, :] + np.abs(S) * (np.abs(P1) + np.abs(P0))[:, None, :] + np.abs(Hh) * np.abs(E)[:, None, :]
     lo, hi = arcs.psi[arc, 0], arcs.psi[arc, 1]
     a = lo + t0 * (hi - lo) - _ANG
     b = lo + t1 * (hi - lo) + _ANG
@@ -311,7 +311,7 @@ def _piece_vertices(arcs: Geometry, arc: np.ndarray, s0, s1, t0, t1):
     Nv = np.stack([inner * ua, inner * ub, scale[:, None] * ua, scale[:, None] * ub], axis=1)
     exact = arcs.exact[arc]
     Nv[exact] = arcs.normal[arc][exact][:, None, :]
-    return Q, Qabs, Nv
+    return Q, Nv
 
 
 def _corner_max(A: np.ndarray) -> np.ndarray:
@@ -331,7 +331,7 @@ def bounds(regions: RegionTuple, arcs: Geometry, model: _Model, contact, arc, fa
     """
     if Y is None:
         Y = cell_vertices(face, box)
-    Q, Qabs, Nv = _piece_vertices(arcs, arc, s0, s1, t0, t1)
+    Q, Nv = _piece_vertices(arcs, arc, s0, s1, t0, t1)
     cx, cy = regions.center
     L = regions.length
     B = len(contact)
