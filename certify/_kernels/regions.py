@@ -14,7 +14,7 @@ import numpy as np
 
 from .jit import kernel
 
-__all__ = ["piece_bounds"]
+__all__ = ["piece_bounds", "piece_vertices", "bound_scales"]
 
 
 @kernel
@@ -68,3 +68,70 @@ def piece_bounds(Y, Q, N, contact, fm, ow, weights, cmask, cand, scale, cx, cy, 
         lb[b] = top
         best[b] = arg
     return lb, best
+
+
+@kernel
+def piece_vertices(P0, P1, E, h, s0, s1, ua, ub, scale, exact, normal, rel):
+    """Point and normal vertices (B, 4, 2) of pieces: piece ``b`` covers the chord ``P0 + s (P1 -
+    P0)`` for ``s`` in ``[s0, s1]`` (pushed out by ``rel`` at an end of an arc with ``h > 0``),
+    widened by ``+-h`` along ``E``; its normals lie between the unit vectors ``ua`` and ``ub``
+    (B, 2), inside ``(1 - rel)`` of them and the chord ``scale`` (B,) times them (``exact`` rows:
+    ``normal`` itself at every vertex). Corner ``(s0, -h), (s0, h), (s1, -h), (s1, h)`` for the
+    points, ``(1 - rel) ua, (1 - rel) ub, scale ua, scale ub`` for the normals; the numbers are
+    those of the same expressions over numpy arrays, term for term."""
+    B = P0.shape[0]
+    Q = np.empty((B, 4, 2))
+    N = np.empty((B, 4, 2))
+    inner = 1 - rel
+    for b in range(B):
+        ext = rel if h[b] > 0 else 0.0
+        lo = s0[b] - ext if s0[b] <= 0 else s0[b]
+        hi = s1[b] + ext if s1[b] >= 1 else s1[b]
+        for c in range(4):
+            s = lo if c < 2 else hi
+            w = h[b] if c % 2 else -h[b]
+            for r in range(2):
+                Q[b, c, r] = (P0[b, r] + s * (P1[b, r] - P0[b, r])) + w * E[b, r]
+        for r in range(2):
+            if exact[b]:
+                for c in range(4):
+                    N[b, c, r] = normal[b, r]
+            else:
+                N[b, 0, r] = inner * ua[b, r]
+                N[b, 1, r] = inner * ub[b, r]
+                N[b, 2, r] = scale[b] * ua[b, r]
+                N[b, 3, r] = scale[b] * ub[b, r]
+    return Q, N
+
+
+@kernel
+def _corner_max(A, b, k):
+    """The largest ``abs(A[b, c, k])`` over the four corners ``c``."""
+    return max(max(abs(A[b, 0, k]), abs(A[b, 1, k])), max(abs(A[b, 2, k]), abs(A[b, 3, k])))
+
+
+@kernel
+def bound_scales(Y, N, P0, P1, E, h, s0, s1, contact, fm, ow, cx, cy, L, rel):
+    """The ``scale`` of :func:`piece_bounds` (B,): the expression of the bound over absolute
+    values, bounded above, from the corners ``Y`` (B, 4, 3) and ``N`` (B, 4, 2) and the pieces'
+    chords as :func:`piece_vertices` takes them (``|s|`` widened by ``1e-7`` and ``h`` by ``2 rel``
+    for the points' ends), the largest over the contact's generators (padded ones included)."""
+    B, G = Y.shape[0], fm.shape[1]
+    out = np.empty(B)
+    widen = 1 + 2 * rel
+    for b in range(B):
+        i = contact[b]
+        y0, y1, y2 = _corner_max(Y, b, 0), _corner_max(Y, b, 1), _corner_max(Y, b, 2)
+        sm = max(abs(s0[b]), abs(s1[b])) * 1.0000001
+        hh = h[b] * widen
+        qa0 = (abs(P0[b, 0]) + sm * (abs(P1[b, 0]) + abs(P0[b, 0]))) + hh * abs(E[b, 0])
+        qa1 = (abs(P0[b, 1]) + sm * (abs(P1[b, 1]) + abs(P0[b, 1]))) + hh * abs(E[b, 1])
+        vs = (L * y0 + y2 * (qa1 + abs(cy))) + (L * y1 + y2 * (qa0 + abs(cx)))
+        ns = _corner_max(N, b, 0) + _corner_max(N, b, 1)
+        top = -np.inf
+        for g in range(G):
+            v = (ns * (1 + abs(fm[i, g]))) * vs + y2 * abs(ow[i, g])
+            if v > top:
+                top = v
+        out[b] = top
+    return out

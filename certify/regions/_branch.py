@@ -65,7 +65,8 @@ from typing import Any
 import numpy as np
 
 from .. import models as registry
-from .._kernels.regions import piece_bounds
+from .._kernels.jit import kernel_array
+from .._kernels.regions import bound_scales, piece_bounds, piece_vertices
 from ..core.certificates import Check, verify
 from ..core.closure import force_closure
 from ..core.grasp import Contact, Grasp
@@ -289,35 +290,16 @@ def cell_vertices(face: np.ndarray, box: np.ndarray) -> np.ndarray:
     return V
 
 
-def _piece_vertices(arcs: Geometry, arc: np.ndarray, s0, s1, t0, t1):
-    """Point vertices (B, 4, 2) and normal vertices (B, 4, 2) of pieces (``bounds`` bounds their
-    magnitudes itself)."""
-    h = arcs.h[arc]
-    ext = np.where(h > 0, _REL, 0.0)
-    s0e = np.where(s0 <= 0, s0 - ext, s0)
-    s1e = np.where(s1 >= 1, s1 + ext, s1)
-    P0, P1, E = arcs.p0[arc], arcs.p1[arc], arcs.e[arc]
-    S = np.stack([s0e, s0e, s1e, s1e], axis=1)[..., None]
-    Hh = np.stack([-h, h, -h, h], axis=1)[..., None]
-    Q = P0[:, None, :] + S * (P1 - P0)[:, None, :] + Hh * E[:, None, :]
+def _normal_corners(arcs: Geometry, arc: np.ndarray, t0, t1):
+    """The normals' bounding unit vectors ``ua``, ``ub`` (B, 2) of pieces and their chord scale
+    (B,) (:func:`~qualgrasp.certify._kernels.regions.piece_vertices` takes them; the cosines and
+    sines are numpy's)."""
     lo, hi = arcs.psi[arc, 0], arcs.psi[arc, 1]
     a = lo + t0 * (hi - lo) - _ANG
     b = lo + t1 * (hi - lo) + _ANG
     half = (b - a) / 2
     scale = (1.0 / np.cos(half)) * (1 + _REL)
-    ua = np.stack([np.cos(a), np.sin(a)], axis=1)
-    ub = np.stack([np.cos(b), np.sin(b)], axis=1)
-    inner = 1 - _REL
-    Nv = np.stack([inner * ua, inner * ub, scale[:, None] * ua, scale[:, None] * ub], axis=1)
-    exact = arcs.exact[arc]
-    Nv[exact] = arcs.normal[arc][exact][:, None, :]
-    return Q, Nv
-
-
-def _corner_max(A: np.ndarray) -> np.ndarray:
-    """``A.max(axis=1)`` of (B, 4, d) corner values (elementwise maxima: faster than a reduction
-    over a short middle axis, and the same numbers)."""
-    return np.maximum(np.maximum(A[:, 0], A[:, 1]), np.maximum(A[:, 2], A[:, 3]))
+    return np.stack([np.cos(a), np.sin(a)], axis=1), np.stack([np.cos(b), np.sin(b)], axis=1), scale
 
 
 def bounds(regions: RegionTuple, arcs: Geometry, model: _Model, contact, arc, face, box, s0, s1, t0, t1,
@@ -329,28 +311,21 @@ def bounds(regions: RegionTuple, arcs: Geometry, model: _Model, contact, arc, fa
     ``cand`` (B,) evaluates only that candidate combination. Returns ``(bound, candidate)``:
     the best bound over the candidates and which one gave it.
     """
-    if Y is None:
-        Y = cell_vertices(face, box)
-    Q, Nv = _piece_vertices(arcs, arc, s0, s1, t0, t1)
-    cx, cy = regions.center
-    L = regions.length
-    B = len(contact)
-    fm, ow = model.fm[contact], model.ow[contact]                                   # (B, G)
+    Y = kernel_array(cell_vertices(face, box) if Y is None else Y)
+    P0, P1, E, h = arcs.p0[arc], arcs.p1[arc], arcs.e[arc], arcs.h[arc]
+    s0, s1 = kernel_array(s0), kernel_array(s1)
+    contact = kernel_array(contact, np.int64)
+    Q, Nv = piece_vertices(P0, P1, E, h, s0, s1, *_normal_corners(arcs, arc, t0, t1), arcs.exact[arc],
+                           arcs.normal[arc], _REL)
+    cx, cy = (float(v) for v in regions.center)
+    L = float(regions.length)
     # rounding: every term of the exact expression is bounded in absolute value by ``scale``
     # (the same expression over absolute values, bounded above), so each value is within
     # gamma_40 scale of its float (Higham's gamma_n; the depth of the expression is below 25)
-    ya = _corner_max(np.abs(Y))                                                       # (B, 3)
-    qa = (np.abs(arcs.p0[arc]) + np.maximum(np.abs(s0), np.abs(s1))[:, None] * 1.0000001 * (np.abs(arcs.p1[arc])
-          + np.abs(arcs.p0[arc])) + (arcs.h[arc] * (1 + 2 * _REL))[:, None] * np.abs(arcs.e[arc]))
-    va = L * ya[:, :2] + ya[:, 2:3] * (qa[:, ::-1] + np.abs([cx, cy])[::-1])
-    na = _corner_max(np.abs(Nv))                                                      # (B, 2)
-    ra = (na.sum(axis=1)[:, None] * (1 + np.abs(fm)))                                 # (B, G)
-    scale = (ra * va.sum(axis=1)[:, None] + ya[:, 2:3] * np.abs(ow)).max(axis=1)     # (B,)
-    which = np.full(B, -1, dtype=np.int64) if cand is None else np.asarray(cand, dtype=np.int64)
-    lb, best = piece_bounds(np.ascontiguousarray(Y, dtype=float), np.ascontiguousarray(Q), np.ascontiguousarray(Nv),
-                            np.ascontiguousarray(contact, dtype=np.int64), model.fm, model.ow, model.weights,
-                            model.cmask, which, scale, float(cx), float(cy), float(L), _GAMMA)
-    return lb, best
+    scale = bound_scales(Y, Nv, P0, P1, E, h, s0, s1, contact, model.fm, model.ow, cx, cy, L, _REL)
+    which = np.full(len(contact), -1, dtype=np.int64) if cand is None else kernel_array(cand, np.int64)
+    return piece_bounds(Y, Q, Nv, contact, model.fm, model.ow, model.weights, model.cmask, which, scale,
+                        cx, cy, L, _GAMMA)
 
 
 def _centre_values(regions, arcs, model, contact, arc, yc, s0, s1, t0, t1):
