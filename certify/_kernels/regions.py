@@ -6,6 +6,11 @@ minimum over the vertex combinations ``(y, q, n)`` (4 each) of ``sum_g W[c, g] F
 ``perp(x) = (-x_1, x_0)``, for each candidate combination ``c``, minus ``gamma * scale[b]`` (the
 rigorous rounding bound). Plain IEEE arithmetic (no fast-math), so the error analysis of the
 caller holds whatever the order of the sums.
+
+The vertices ``q`` and ``n`` of the pieces (:func:`piece_vertices`) and ``scale``
+(:func:`bound_scales`) are compiled too, each the expression the caller once evaluated over numpy
+arrays, term for term in the same order, so the numbers are the same; the cosines and sines of the
+normals' angles stay numpy's (the caller's), whose results the kernels take as given.
 """
 
 from __future__ import annotations
