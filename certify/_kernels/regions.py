@@ -7,8 +7,9 @@ minimum over the vertex combinations ``(y, q, n)`` (4 each) of ``sum_g W[c, g] F
 rigorous rounding bound). Plain IEEE arithmetic (no fast-math), so the error analysis of the
 caller holds whatever the order of the sums.
 
-The vertices ``q`` and ``n`` of the pieces (:func:`piece_vertices`) and ``scale``
-(:func:`bound_scales`) are compiled too, each the expression the caller once evaluated over numpy
+The cells' corner directions ``y`` (:func:`cell_corners`: copies, no arithmetic), the vertices
+``q`` and ``n`` of the pieces (:func:`piece_vertices`) and ``scale`` (:func:`bound_scales`) are
+compiled too, the last two each the expression the caller once evaluated over numpy
 arrays, term for term in the same order, so the numbers are the same; the cosines and sines of the
 normals' angles stay numpy's (the caller's), whose results the kernels take as given.
 """
@@ -19,7 +20,7 @@ import numpy as np
 
 from .jit import kernel
 
-__all__ = ["piece_bounds", "piece_vertices", "bound_scales"]
+__all__ = ["piece_bounds", "piece_vertices", "bound_scales", "cell_corners"]
 
 
 @kernel
@@ -140,3 +141,22 @@ def bound_scales(Y, N, P0, P1, E, h, s0, s1, contact, fm, ow, cx, cy, L, rel):
                 top = v
         out[b] = top
     return out
+
+
+@kernel
+def cell_corners(face, box, axes, signs):
+    """Corner directions (B, 4, 3) of cells on the faces of the cube: cell ``b`` lies on face
+    ``face[b]``, the plane ``x[axes[f]] = signs[f]``, over ``box[b]`` = ``lo0, hi0, lo1, hi1`` of
+    the two other coordinates in axis order; corners ``(lo0, lo1), (lo0, hi1), (hi0, lo1), (hi0,
+    hi1)``."""
+    B = face.shape[0]
+    V = np.zeros((B, 4, 3))
+    for b in range(B):
+        ax = axes[face[b]]
+        f0 = 1 if ax == 0 else 0
+        f1 = 1 if ax == 2 else 2
+        for c in range(4):
+            V[b, c, ax] = signs[face[b]]
+            V[b, c, f0] = box[b, 0] if c < 2 else box[b, 1]
+            V[b, c, f1] = box[b, 2] if c % 2 == 0 else box[b, 3]
+    return V

@@ -66,7 +66,7 @@ import numpy as np
 
 from .. import models as registry
 from .._kernels.jit import kernel_array
-from .._kernels.regions import bound_scales, piece_bounds, piece_vertices
+from .._kernels.regions import bound_scales, cell_corners, piece_bounds, piece_vertices
 from ..core.certificates import Check, verify
 from ..core.closure import force_closure
 from ..core.grasp import Contact, Grasp
@@ -78,6 +78,8 @@ __all__ = ["FACES", "Geometry", "MAX_MERGED", "candidate_weights", "cells_certif
 
 #: The 6 faces of the direction cube: ``(axis, sign)`` (axis 0 ``y_fx``, 1 ``y_fy``, 2 ``y_tau``).
 FACES = ((0, 1), (0, -1), (1, 1), (1, -1), (2, 1), (2, -1))
+_FACE_AXES = np.array([f[0] for f in FACES], dtype=np.int64)
+_FACE_SIGNS = np.array([f[1] for f in FACES], dtype=float)
 #: Default budget, in work units (module docstring).
 DEFAULT_BUDGET = 200_000
 #: Finest cell width (a face is 2 wide) and finest piece width (fractions of an arc).
@@ -277,17 +279,7 @@ def _model(regions: RegionTuple) -> _Model:
 def cell_vertices(face: np.ndarray, box: np.ndarray) -> np.ndarray:
     """``(B, 4, 3)`` corner directions of cells: ``face`` (B,) indices into :data:`FACES`,
     ``box`` (B, 4) ``lo0, hi0, lo1, hi1`` of the two free coordinates (in axis order)."""
-    B = len(face)
-    V = np.zeros((B, 4, 3))
-    axes = np.array([f[0] for f in FACES])[face]
-    signs = np.array([f[1] for f in FACES], dtype=float)[face]
-    corners = np.stack([box[:, [0, 2]], box[:, [0, 3]], box[:, [1, 2]], box[:, [1, 3]]], axis=1)
-    for ax, (f0, f1) in enumerate(((1, 2), (0, 2), (0, 1))):
-        m = axes == ax
-        V[m, :, ax] = signs[m][:, None]
-        V[m, :, f0] = corners[m][:, :, 0]
-        V[m, :, f1] = corners[m][:, :, 1]
-    return V
+    return cell_corners(kernel_array(face, np.int64), kernel_array(box), _FACE_AXES, _FACE_SIGNS)
 
 
 def _normal_corners(arcs: Geometry, arc: np.ndarray, t0, t1):
