@@ -418,7 +418,13 @@ def _spatial_lower(sup: ConicSupport, ev: Evidence, norm: str, lo: float, key: s
     faces = surface_faces(V)
     if faces is None:
         return f"eps_evidence.{key}: the vertices span no full-dimensional hull"
-    reason, d2_lo, d2_hi = surface_minimum(V, EV, faces, lambda i: sup.exact_vertex(parts[i]))
+    return _surface_lower(V, EV, faces, lambda i: sup.exact_vertex(parts[i]), lo, key, col)
+
+
+def _surface_lower(V, EV, faces, exact_vertex, lo: float, key: str, col: str) -> str | None:
+    """Why the surface ``faces`` on the vertices ``V`` (within ``EV``) does not prove the stated
+    ``lo`` (:func:`surface_minimum`, then :func:`_within`); None when it does."""
+    reason, d2_lo, d2_hi = surface_minimum(V, EV, faces, exact_vertex)
     if reason:
         return f"eps_evidence.{key}: {reason}"
     return _within(lo, d2_lo, col, d2_hi)
@@ -646,10 +652,7 @@ def verify_bounds(grasp: Grasp, vals: dict, evs: dict, arrays=None) -> Check:
             if bad:
                 return Check(False, bad)
             continue
-        reason, d2_lo, d2_hi = surface_minimum(V, EV, faces, exact_vertex)
-        if reason:
-            return Check(False, f"eps_evidence.{key}: {reason}")
-        bad = _within(lo, d2_lo, col, d2_hi)
+        bad = _surface_lower(V, EV, faces, exact_vertex, lo, key, col)
         if bad:
             return Check(False, bad)
     return Check(True)

@@ -37,8 +37,8 @@ from ..core.grasp import Grasp
 from ..core.problem import grasp_system
 from ..core.wrench import force_column_errors, generator_layout, grasp_arrays, to_exact, variants_of
 
-__all__ = ["SHRINK", "surface_faces", "surfaces_faces", "oriented_surface", "hull_rows", "orient_faces", "generalised_cross",
-           "face_distances",
+__all__ = ["SHRINK", "surface_faces", "surfaces_faces", "oriented_surface", "hull_rows", "orient_faces",
+           "generalised_cross", "face_distances",
            "planar_generator_arrays", "sum_errors", "planar_support_choice", "planar_support_choices",
            "planar_support_vertices",
            "sum_rows", "sqrt_bounds", "vertex_scale", "ConicSupport"]
@@ -53,10 +53,11 @@ def surface_faces(points: np.ndarray) -> np.ndarray | None:
     """Faces of the hull of ``points`` (n, d), ordered outward about an interior origin: each
     float determinant ``det(v_1, ..., v_d)`` not negative in 3-D, and in 6-D oriented as one
     closed surface (:func:`orient_faces`: a sliver face's determinant may round negative; the
-    exact check settles it); None when the points span no full-dimensional hull. Compiled hulls give them, qhull where those decline: in
-    3-D (planar grasps) :func:`~qualgrasp.certify._kernels.hull.hull_faces`, in other dimensions
-    (6-D, spatial grasps) the facets of :func:`~qualgrasp.certify._kernels.hull.hull_facets`,
-    simplices, ordered by :func:`orient_faces` (qhull's where they do not close up)."""
+    exact check settles it); None when the points span no full-dimensional hull. Compiled hulls
+    give them, qhull where those decline: in 3-D (planar grasps)
+    :func:`~qualgrasp.certify._kernels.hull.hull_faces`, in other dimensions (6-D, spatial grasps)
+    the facets of :func:`~qualgrasp.certify._kernels.hull.hull_facets`, simplices, ordered by
+    :func:`orient_faces` (qhull's where they do not close up)."""
     if np.shape(points)[1:] == (3,):  # one set: without the batch's bookkeeping
         faces = hull_faces(kernel_array(points))
         if len(faces):

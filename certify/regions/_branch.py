@@ -455,8 +455,9 @@ def decide_branch(regions: RegionTuple, budget: int = DEFAULT_BUDGET, batch_item
                                 work=work, cells=covered, pending=list(batch) + list(queue))
         work += n_items
         it = _items(batch, k)
-        lb, best = bounds(regions, arcs, model, it["contact"], it["arc"], it["face"], it["box"],
-                          it["s0"], it["s1"], it["t0"], it["t1"])
+        corners = cell_vertices(np.array([b[0] for b in batch]), np.array([b[1] for b in batch]))  # once per cell
+        lb, best = bounds(regions, arcs, model, it["contact"], it["arc"], None, None,
+                          it["s0"], it["s1"], it["t0"], it["t1"], Y=corners[it["cell"]])
         good = lb > 0
         group_good = np.logical_and.reduceat(good, it["group_start"])
         covering = {}
@@ -471,7 +472,7 @@ def decide_branch(regions: RegionTuple, budget: int = DEFAULT_BUDGET, batch_item
         if not len(open_cells):
             continue
         # the centre directions of the open cells, and every region's best exact candidate there
-        yc_all = cell_vertices(np.array([b[0] for b in batch]), np.array([b[1] for b in batch])).mean(axis=1)
+        yc_all = corners.mean(axis=1)
         Yc = yc_all[open_cells]
         real = np.empty((k, len(open_cells)))
         pick = np.empty((k, len(open_cells)), dtype=np.int64)
@@ -592,11 +593,10 @@ def _items(batch, k):
     contact = P[:, 0].astype(np.int64)
     key = cell * k + contact
     start = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
-    offsets = np.r_[0, np.cumsum(counts)[:-1]]
-    return {"cell": cell, "cell_start": np.r_[0, np.cumsum(counts)], "piece": P, "contact": contact,
+    cell_start = np.r_[0, np.cumsum(counts)]
+    return {"cell": cell, "cell_start": cell_start, "piece": P, "contact": contact,
             "arc": P[:, 1].astype(np.int64), "s0": P[:, 2], "s1": P[:, 3],
-            "t0": P[:, 4], "t1": P[:, 5], "face": np.repeat([b[0] for b in batch], counts).astype(np.int64),
-            "box": np.repeat(np.array([b[1] for b in batch]), counts, axis=0), "row": np.arange(len(P)) - offsets[cell],
+            "t0": P[:, 4], "t1": P[:, 5], "row": np.arange(len(P)) - cell_start[cell],
             "group_start": start, "group_cell": cell[start], "group_contact": contact[start]}
 
 
