@@ -12,7 +12,7 @@ from scipy.spatial import ConvexHull
 
 from qualgrasp.certify._kernels.hull import (PLANE_TOL, grow_start, hull_faces, hull_facets, hull_grow, hulls_faces,
                                              live_facets)
-from qualgrasp.certify._kernels.surface import cycle_code, orient_cycle
+from qualgrasp.certify._kernels.surface import TRIANGLES_MAX, cycle_code, orient_cycle
 from qualgrasp.certify.quality.evidence import Evidence
 from qualgrasp.certify.quality.gws import orient_faces, oriented_surface, surfaces_faces
 
@@ -313,3 +313,68 @@ def test_a_surface_that_cannot_be_oriented_is_not_reported_closed():
     assert (np.unique(edges, axis=0, return_counts=True)[1] == 2).all()
     assert not orient_cycle(rp2, 6, 0, False)[1].any()
     assert cycle_code(rp2, 6) == 4
+
+
+def _triangle_sets():
+    """Triangle sets on at most 30 vertices: closed hulls of random points (oriented), and the same with a
+    face turned over, dropped, repeated, or with one index changed (to another vertex, possibly
+    one the face already has)."""
+    @st.composite
+    def sets(draw):
+        n = draw(st.integers(4, 30))
+        seed = draw(st.integers(0, 2**32 - 1))
+        P = np.random.default_rng(seed).normal(size=(n, 3))
+        faces = hull_faces(P).copy()
+        flip, reached = orient_cycle(faces, n, 0, False)
+        assert reached.all()
+        faces[flip] = faces[flip][:, [1, 0, 2]]
+        kind = draw(st.sampled_from(["closed", "turned", "dropped", "repeated", "index"]))
+        f = draw(st.integers(0, len(faces) - 1))
+        if kind == "turned":
+            faces[f, [0, 1]] = faces[f, [1, 0]]
+        elif kind == "dropped":
+            faces = np.delete(faces, f, axis=0)
+        elif kind == "repeated":
+            faces = np.vstack([faces, faces[f:f + 1]])
+        elif kind == "index":
+            faces[f, draw(st.integers(0, 2))] = draw(st.integers(0, n - 1))
+        return np.ascontiguousarray(faces), n, kind
+    return sets()
+
+
+@settings(max_examples=300, deadline=None)
+@given(_triangle_sets())
+def test_triangles_are_checked_as_the_sorted_ridges_check_them(case):
+    """:func:`cycle_code` checks triangle sets on few vertices by a table of directed edges; past
+    ``TRIANGLES_MAX`` vertices it sorts the ridges. Both give the same code (the same set checked
+    with the vertex count raised past the table's limit takes the sorting route), closed hulls
+    included, and an index out of range is code 1 either way."""
+    faces, n, kind = case
+    code = cycle_code(faces, n)
+    assert code == cycle_code(faces, n + TRIANGLES_MAX)
+    assert (code == 0) == (kind == "closed") or kind in ("index", "turned")
+    assert cycle_code(faces, int(faces.max())) in (1, 2)
+
+
+def test_face_normals_in_3d_are_leibniz_sums_bit_for_bit():
+    """:func:`face_bounds` writes out the 3-D cofactors and their error bounds: each float is the
+    one the general Leibniz loop gives (run as Python), on wide magnitudes, zeros of both signs,
+    and infinities."""
+    from qualgrasp.certify._kernels.surface import _leibniz_normal, _normal3, leibniz_tables
+
+    perms, signs = leibniz_tables(2)
+    rng = np.random.default_rng(12)
+    special = np.array([0.0, -0.0, np.inf, -np.inf, 1e-308, -5e-324, 1e308])
+    for t in range(3000):
+        D = rng.normal(size=(2, 3)) * 10.0 ** rng.integers(-200, 200, size=(2, 3))
+        ED = np.abs(rng.normal(size=(2, 3))) * 10.0 ** rng.integers(-300, 0, size=(2, 3))
+        if t % 3 == 0:
+            D.flat[rng.integers(0, 6, 2)] = rng.choice(special, 2)
+            ED.flat[rng.integers(0, 6)] = 0.0
+        g = 3.0 * 7 * 2.0**-53 / (1 - 7 * 2.0**-53)
+        fast = np.empty(3), np.empty(3)
+        loop = np.empty(3), np.empty(3)
+        _normal3(D, ED, g, *fast)
+        _leibniz_normal.py_func(D, ED, perms, signs, g, *loop)
+        for a, b in zip(fast, loop):
+            assert np.array_equal(a.view(np.uint64), b.view(np.uint64)), (D, ED, a, b)

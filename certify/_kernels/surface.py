@@ -21,7 +21,8 @@ from .jit import kernel
 from .linalg import U, gamma
 from .order import radix_argsort, stable_argsort
 
-__all__ = ["face_bounds", "face_bounds_laplace", "leibniz_tables", "planar_h_bounds", "cycle_code", "orient_cycle"]
+__all__ = ["face_bounds", "face_bounds_laplace", "leibniz_tables", "planar_h_bounds", "cycle_code", "orient_cycle",
+           "TRIANGLES_MAX"]
 
 
 @functools.lru_cache(maxsize=None)
@@ -83,9 +84,13 @@ def face_bounds(V, EV, faces, perms, psign):
     ok, lo, hi = np.zeros(F, dtype=np.bool_), np.zeros(F), np.full(F, np.inf)
     D, ED, n, en = np.empty((d - 1, d)), np.empty((d - 1, d)), np.empty(d), np.empty(d)
     g = 3.0 * gamma(d + perms.shape[0] + 2)
+    spatial3 = d == 3 and _pair_table(perms, psign)
     for f in range(F):
         i0 = _edges(V, EV, faces, f, D, ED)
-        _leibniz_normal(D, ED, perms, psign, g, n, en)
+        if spatial3:
+            _normal3(D, ED, g, n, en)
+        else:
+            _leibniz_normal(D, ED, perms, psign, g, n, en)
         ok[f], lo[f], hi[f] = _distance_bounds(V, EV, i0, n, en)
     return ok, lo, hi
 
@@ -147,6 +152,34 @@ def _leibniz_normal(D, ED, perms, psign, g, n, en):
             pe_sum += pe
         n[r] = s if r % 2 == 0 else -s
         en[r] = (pe_sum - pa_sum) + g * pe_sum
+
+
+@kernel
+def _pair_table(perms, psign):
+    """Whether ``perms``/``psign`` are :func:`leibniz_tables` of 2: ``(0, 1)`` with +1, ``(1, 0)``
+    with -1."""
+    return (perms.shape[0] == 2 and perms.shape[1] == 2 and perms[0, 0] == 0 and perms[0, 1] == 1
+            and perms[1, 0] == 1 and perms[1, 1] == 0 and psign[0] == 1.0 and psign[1] == -1.0)
+
+
+@kernel
+def _normal3(D, ED, g, n, en):
+    """:func:`_leibniz_normal` of a face in 3-D with the table of :func:`leibniz_tables` of 2,
+    written out: the same operations in the same order (each sum from ``0.0``, each product from
+    the sign or ``1.0``), so the same floats, without the table's loops (the planar surfaces'
+    checks spend most of their time here)."""
+    for r in range(3):
+        c0 = 1 if r == 0 else 0  # the columns other than r, ascending
+        c1 = 1 if r == 2 else 2
+        a0, a1, b0, b1 = D[0, c0], D[0, c1], D[1, c0], D[1, c1]
+        s = 0.0 + (1.0 * a0) * b1
+        s = s + (-1.0 * a1) * b0
+        pa = 0.0 + (1.0 * abs(a0)) * abs(b1)
+        pa = pa + (1.0 * abs(a1)) * abs(b0)
+        pe = 0.0 + (1.0 * (abs(a0) + ED[0, c0])) * (abs(b1) + ED[1, c1])
+        pe = pe + (1.0 * (abs(a1) + ED[0, c1])) * (abs(b0) + ED[1, c0])
+        n[r] = s if r % 2 == 0 else -s
+        en[r] = (pe - pa) + g * pe
 
 
 @kernel
@@ -267,6 +300,40 @@ def _paired(keys):
     return order
 
 
+#: Most vertices of a triangulated surface :func:`cycle_code` checks by :func:`_closed_triangles`
+#: (an ``nv`` by ``nv`` table of directed edges); larger ones are sorted.
+TRIANGLES_MAX = 128
+
+
+@kernel
+def _closed_triangles(faces, nv):
+    """Whether the triangles ``faces`` (F, 3) on ``nv`` vertices form a closed oriented cycle, as
+    :func:`cycle_code` returning 0 states it, in time linear in ``F``: every index in range, no
+    face repeating a vertex, and each edge of a face, directed along the face's vertex order
+    (``a -> b -> c -> a``), in no other face in that direction and in one face in the other.
+    That is :func:`cycle_code`'s condition: the sign of ridge ``k`` (:func:`_ridge_keys`) is +1
+    exactly when the edge it leaves, so directed, goes from the smaller index to the larger, so
+    two faces sharing a ridge have opposite signs exactly when they run along it in opposite
+    directions."""
+    F = faces.shape[0]
+    for f in range(F):
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        if min(a, b, c) < 0 or max(a, b, c) >= nv or a == b or b == c or a == c:
+            return False
+    seen = np.zeros((nv, nv), dtype=np.bool_)
+    for f in range(F):
+        for k in range(3):
+            u, v = faces[f, k], faces[f, (k + 1) % 3]
+            if seen[u, v]:
+                return False
+            seen[u, v] = True
+    for f in range(F):
+        for k in range(3):
+            if not seen[faces[f, (k + 1) % 3], faces[f, k]]:
+                return False
+    return True
+
+
 @kernel
 def cycle_code(faces, nv):
     """Whether ``faces`` (F, d) on ``nv`` vertices form a closed oriented cycle: 0 yes; 1 an
@@ -275,6 +342,8 @@ def cycle_code(faces, nv):
     vertex, sign ``(-1)^k`` times the parity of sorting the rest) are encoded as integers in
     base ``nv`` (the caller keeps ``nv^(d-1)`` below ``2^62``)."""
     F, d = faces.shape
+    if d == 3 and 0 < nv <= TRIANGLES_MAX and _closed_triangles(faces, nv):
+        return 0
     keys = np.empty(F * d, dtype=np.int64)
     sgn = np.empty(F * d, dtype=np.int64)
     code = _ridge_keys(faces, nv, keys, sgn)
