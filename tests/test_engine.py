@@ -51,7 +51,8 @@ def test_parquet_and_jsonl_give_the_same_results(grasp_files, tmp_path):
     ra, rb = _rows(a)[:n], _rows(b)
     assert pq.read_schema(b).names[:4] == ["id", "line", "dim", "status"]
     for x, y in zip(ra, rb):
-        assert (x["id"], x["status"], x["form_status"], x["margin"]) == (y["id"], y["status"], y["form_status"], y["margin"])
+        keys = ("id", "status", "form_status", "margin")
+        assert [x[k] for k in keys] == [y[k] for k in keys]
         assert x["certificate"] == y["certificate"]
     assert not verify_file(b, parquet, workers=2).failures
     assert not verify_file(a, jsonl).failures
@@ -92,6 +93,36 @@ def test_kill_9_and_resume_loses_and_duplicates_nothing(grasp_files, tmp_path, f
     ids = [r["id"] for r in rows]
     assert len(rows) == total and len(set(map(str, ids))) == len(ids)
     assert _comparable(rows) == _comparable(_rows(ref))
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_parquet_output_is_written_in_the_schema_of_all_its_parts(tmp_path, workers):
+    """Parquet parts are appended as they complete while they share the first part's schema; a
+    carried field whose type changes between chunks (null, then text, then a list) puts every part
+    in the schema of them all (JSON text), and one that keeps its type keeps it. Either way every
+    row is there, in input order, with its value: the table a run in one chunk writes."""
+    grasps = random_grasps(5, 300, dim=2, n_contacts=3)
+    notes = {"changing": ([None] * 100 + [f"s{i}" for i in range(100, 200)]
+                          + [[i, i + 1] for i in range(200, 300)]),
+             "steady": [f"s{i}" for i in range(300)]}
+    for kind, values in notes.items():
+        src = tmp_path / f"{kind}.jsonl"
+        write_grasps(src, grasps)
+        lines = [dict(json.loads(x), note=v) for x, v in zip(src.read_text().splitlines(), values)]
+        src.write_text("".join(json.dumps(x) + "\n" for x in lines))
+        out = tmp_path / f"{kind}.parquet"
+        certify_file(src, out, quality=False, chunk_size=100, workers=workers)
+        table = pq.read_table(out)
+        assert table.column("id").to_pylist() == [g.id for g in grasps]
+        field = table.schema.field("note")
+        if kind == "changing":
+            assert field.metadata == {b"qualgrasp": b"json"}
+            assert [None if v is None else json.loads(v) for v in table.column("note").to_pylist()] == values
+        else:
+            assert field.metadata is None and table.column("note").to_pylist() == values
+        whole = tmp_path / f"{kind}-one-chunk.parquet"
+        certify_file(src, whole, quality=False, chunk_size=300, workers=workers)
+        assert table.equals(pq.read_table(whole), check_metadata=True)
 
 
 def test_resume_refuses_other_options(grasp_files, tmp_path):

@@ -9,9 +9,11 @@ client, which writes them, so a remote cluster needs no shared filesystem and th
 per row stays a copy). Parts of a Parquet output are Arrow IPC
 files (``.arrow``, LZ4): cheap to write and to read back, so the Parquet encoding is done once.
 The main process appends the parts in chunk order to a temporary results file in the parts folder
-(JSON Lines parts as they complete; Parquet parts when the last one is in, in one schema: the
-columns carried from JSON rows may differ between chunks), renamed to ``RESULTS`` at the end;
-then the parts folder is removed.
+as they complete, renamed to ``RESULTS`` at the end; then the parts folder is removed. A Parquet
+output is written in one schema, that of all its parts (the columns carried from JSON rows may
+differ between chunks): its parts are appended as they complete while they share the first one's,
+and all are written again at the end, in the schema of them all, when one does not (the file is
+the same either way; the workers' parts then overlap with its encoding instead of waiting).
 
 A run killed at any moment leaves only complete parts (plus temporaries, discarded).
 ``resume=True`` keeps the complete parts whose sums match (a part truncated by a crash or a disk
@@ -275,9 +277,9 @@ def _remove_parts(parts: Path) -> None:
 
 class _Assembler:
     """Appends complete parts, in chunk order, to the results' temporary file (in the checkpoint
-    folder): JSON Lines parts as they arrive, Parquet parts at :meth:`close`, in the one schema of
-    them all; :meth:`close` then renames it to the results and removes the parts (a run killed
-    before that leaves the parts, from which a resumed run assembles again)."""
+    folder) as they arrive; a Parquet output in the one schema of them all (:meth:`_stream`);
+    :meth:`close` then renames it to the results and removes the parts (a run killed before that
+    leaves the parts, from which a resumed run assembles again)."""
 
     def __init__(self, parts: Path, results: Path) -> None:
         self.parts, self.results = parts, results
@@ -285,6 +287,7 @@ class _Assembler:
         self.parquet = is_parquet(results)
         self.out = None  # opened with the first part, so that nothing is left if no run starts
         self.next, self.ready = 0, set()
+        self.schema, self.streaming = None, self.parquet  # the Parquet schema written as parts come
 
     def _open(self, schema: pa.Schema = RESULT_SCHEMA):
         """The output, opened on first use (Parquet: with the parts' schema, the results columns
@@ -298,16 +301,39 @@ class _Assembler:
         self.ready.add(index)
         while self.next in self.ready:
             self.ready.remove(self.next)
-            if not self.parquet:  # Parquet parts are written at the close, under one schema
-                with (self.parts / _part_name(self.next, self.results)).open("rb") as fh:
+            part = self.parts / _part_name(self.next, self.results)
+            if self.parquet:
+                self._stream(part)
+            else:
+                with part.open("rb") as fh:
                     shutil.copyfileobj(fh, self._open())
             self.next += 1
 
+    def _stream(self, part: Path) -> None:
+        """Append a Parquet part in the schema of the first (:func:`unified_schema` of it alone)
+        while each part's schema adds nothing to it; a part that would change it stops the
+        appending and drops what was written (:meth:`_write_parquet` writes every part at the
+        close)."""
+        if not self.streaming:
+            return
+        schema = _part_schema(part)
+        if self.schema is None:
+            self.schema = unified_schema([schema])
+        if not unified_schema([self.schema, schema]).equals(self.schema, check_metadata=True):
+            self.streaming = False
+            self.abort()
+            return
+        self._open(self.schema).write_table(conform(_read_part(part), self.schema))
+
     def _write_parquet(self, n_chunks: int) -> None:
         """Every part, in order, in the schema of them all (:func:`unified_schema`: the columns
-        carried from JSON rows may differ between parts, in presence or type)."""
+        carried from JSON rows may differ between parts, in presence or type), unless
+        :meth:`_stream` has written them all in that schema already."""
         parts = [self.parts / _part_name(i, self.results) for i in range(n_chunks)]
         schema = unified_schema([_part_schema(p) for p in parts]) if parts else RESULT_SCHEMA
+        if self.streaming and self.out is not None and schema.equals(self.schema, check_metadata=True):
+            return
+        self.abort()
         writer = self._open(schema)
         for part in parts:
             writer.write_table(conform(_read_part(part), schema))
@@ -324,6 +350,7 @@ class _Assembler:
         _remove_parts(self.parts)
 
     def abort(self) -> None:
+        """Close and remove the temporary output (the parts stay)."""
         if self.out is not None:
             try:
                 self.out.close()
@@ -462,7 +489,8 @@ def _fault(err: Exception, results: Path) -> str:
     """One line for a write that failed mid-run (full disk, file-size limit, read-only folder):
     what failed, and that the finished parts are kept for ``--resume``."""
     target = getattr(err, "filename", None) or results
-    message = write_error(target, err) if isinstance(err, OSError) else f"cannot write {results}: {str(err).splitlines()[0][:200]}"
+    message = (write_error(target, err) if isinstance(err, OSError)
+               else f"cannot write {results}: {str(err).splitlines()[0][:200]}")
     return message + _kept(results)
 
 
