@@ -351,15 +351,79 @@ def test_triangles_are_checked_as_the_sorted_ridges_check_them(case):
     included, and an index out of range is code 1 either way."""
     faces, n, kind = case
     code = cycle_code(faces, n)
-    assert code == cycle_code(faces, n + TRIANGLES_MAX)
-    assert (code == 0) == (kind == "closed") or kind in ("index", "turned")
+    assert code == cycle_code(faces, n + TRIANGLES_MAX) == _cycle_reference(faces, n)
+    assert (code == 0) == (kind == "closed") or kind == "index"
     assert cycle_code(faces, int(faces.max())) in (1, 2)
+
+
+def _cycle_reference(faces, nv):
+    """:func:`cycle_code`'s rule in Python, from its docstring: the first face with an index out of
+    range (1) or repeating a vertex (2), its vertices in order; then an odd number of ridges (3);
+    then the ridges grouped by their sorted vertices, in that order, the first group not of two
+    (3) or of two with the same sign (4)."""
+    ridges = []
+    for f in np.asarray(faces).tolist():
+        for q, v in enumerate(f):
+            if not 0 <= v < nv:
+                return 1
+            if v in f[:q]:
+                return 2
+        for k in range(3):
+            a, b = [f[q] for q in range(3) if q != k]
+            ridges.append(((min(a, b), max(a, b)), (-1) ** k * (1 if a < b else -1)))
+    if len(ridges) % 2:
+        return 3
+    groups = {}
+    for key, sign in ridges:
+        groups.setdefault(key, []).append(sign)
+    for key in sorted(groups):
+        if len(groups[key]) != 2:
+            return 3
+        if sum(groups[key]):
+            return 4
+    return 0
+
+
+def _torus(rows, cols, shift=0):
+    """An oriented triangulated torus on ``rows * cols`` vertices (numbered from ``shift``)."""
+    v = lambda i, j: shift + (i % rows) * cols + j % cols  # noqa: E731
+    return np.array([t for i in range(rows) for j in range(cols)
+                     for t in ((v(i, j), v(i + 1, j), v(i + 1, j + 1)), (v(i, j), v(i + 1, j + 1), v(i, j + 1)))],
+                    dtype=np.int64)
+
+
+def test_every_small_triangle_set_and_tori_about_the_table_limit_get_the_rules_code():
+    """Every set of at most two triangles on at most 4 vertices, each index from -1 to ``nv`` (out
+    of range, repeated, reversed, repeated faces), and tori on 128 to 130 vertices whole, with a
+    face turned over, dropped or doubled, all turned over, or given one vertex too few or too many:
+    the code of the rule written
+    out in Python (:func:`_cycle_reference`), on both sides of ``TRIANGLES_MAX`` (128 vertices)."""
+    import itertools
+
+    for nv in range(5):
+        for F in range(3):
+            for flat in itertools.product(range(-1, nv + 1), repeat=3 * F):
+                faces = np.array(flat, dtype=np.int64).reshape(F, 3)
+                assert cycle_code(faces, nv) == _cycle_reference(faces, nv), (faces, nv)
+    for shape, shift in (((8, 16), 0), ((8, 16), 1), ((5, 26), 0), ((3, 43), 0)):
+        torus = _torus(*shape, shift=shift)
+        nv = shape[0] * shape[1] + shift
+        cases = [torus, torus[1:], np.vstack([torus, torus[:1]]), torus[:, [1, 0, 2]]]
+        turned = torus.copy()
+        turned[3] = turned[3, [1, 0, 2]]
+        cases.append(turned)
+        for faces in cases:
+            faces = np.ascontiguousarray(faces)
+            for n in (nv - 1, nv, nv + 1):
+                assert cycle_code(faces, n) == _cycle_reference(faces, n), (shape, shift, n)
+        assert cycle_code(torus, nv) == 0
 
 
 def test_face_normals_in_3d_are_leibniz_sums_bit_for_bit():
     """:func:`face_bounds` writes out the 3-D cofactors and their error bounds: each float is the
     one the general Leibniz loop gives (run as Python), on wide magnitudes, zeros of both signs,
     and infinities."""
+    from qualgrasp.certify._kernels.linalg import gamma
     from qualgrasp.certify._kernels.surface import _leibniz_normal, _normal3, leibniz_tables
 
     perms, signs = leibniz_tables(2)
@@ -371,7 +435,7 @@ def test_face_normals_in_3d_are_leibniz_sums_bit_for_bit():
         if t % 3 == 0:
             D.flat[rng.integers(0, 6, 2)] = rng.choice(special, 2)
             ED.flat[rng.integers(0, 6)] = 0.0
-        g = 3.0 * 7 * 2.0**-53 / (1 - 7 * 2.0**-53)
+        g = 3.0 * gamma(7)  # face_bounds' constant in 3-D
         fast = np.empty(3), np.empty(3)
         loop = np.empty(3), np.empty(3)
         _normal3(D, ED, g, *fast)

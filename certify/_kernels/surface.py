@@ -169,7 +169,7 @@ def _normal3(D, ED, g, n, en):
     the sign or ``1.0``), so the same floats, without the table's loops (the planar surfaces'
     checks spend most of their time here)."""
     for r in range(3):
-        c0 = 1 if r == 0 else 0  # the columns other than r, ascending
+        c0 = 1 if r == 0 else 0  # the loop's column map (c if c < r else c + 1) of c = 0 and 1
         c1 = 1 if r == 2 else 2
         a0, a1, b0, b1 = D[0, c0], D[0, c1], D[1, c0], D[1, c1]
         s = 0.0 + (1.0 * a0) * b1
@@ -308,7 +308,8 @@ TRIANGLES_MAX = 128
 @kernel
 def _closed_triangles(faces, nv):
     """Whether the triangles ``faces`` (F, 3) on ``nv`` vertices form a closed oriented cycle, as
-    :func:`cycle_code` returning 0 states it, in time linear in ``F``: every index in range, no
+    :func:`cycle_code` returning 0 states it, without sorting (time linear in ``F`` once an ``nv``
+    by ``nv`` table is cleared): every index in range, no
     face repeating a vertex, and each edge of a face, directed along the face's vertex order
     (``a -> b -> c -> a``), in no other face in that direction and in one face in the other.
     That is :func:`cycle_code`'s condition: the sign of ridge ``k`` (:func:`_ridge_keys`) is +1

@@ -12,8 +12,10 @@ The main process appends the parts in chunk order to a temporary results file in
 as they complete, renamed to ``RESULTS`` at the end; then the parts folder is removed. A Parquet
 output is written in one schema, that of all its parts (the columns carried from JSON rows may
 differ between chunks): its parts are appended as they complete while they share the first one's,
-and all are written again at the end, in the schema of them all, when one does not (the file is
-the same either way; the workers' parts then overlap with its encoding instead of waiting).
+and all are written again at the end, in the schema of them all, when one does not or its values
+do not convert to the first one's types (the file is the same either way; the workers' parts then
+overlap with its encoding instead of waiting, and a write that fails does so mid-run, keeping the
+parts finished by then).
 
 A run killed at any moment leaves only complete parts (plus temporaries, discarded).
 ``resume=True`` keeps the complete parts whose sums match (a part truncated by a crash or a disk
@@ -311,19 +313,26 @@ class _Assembler:
 
     def _stream(self, part: Path) -> None:
         """Append a Parquet part in the schema of the first (:func:`unified_schema` of it alone)
-        while each part's schema adds nothing to it; a part that would change it stops the
-        appending and drops what was written (:meth:`_write_parquet` writes every part at the
-        close)."""
+        while each part's schema adds nothing to it and its values convert; a part that would
+        change it, or whose values do not convert, stops the appending and drops what was written
+        (:meth:`_write_parquet` writes every part at the close)."""
         if not self.streaming:
             return
         schema = _part_schema(part)
         if self.schema is None:
             self.schema = unified_schema([schema])
-        if not unified_schema([self.schema, schema]).equals(self.schema, check_metadata=True):
+        table = None
+        if unified_schema([self.schema, schema]).equals(self.schema, check_metadata=True):
+            try:
+                table = conform(_read_part(part), self.schema)
+            except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError):
+                pass  # values the first part's types cannot hold (an integer past 2**53 in a float
+                # column) where the schema of all parts may (JSON text): the close decides
+        if table is None:
             self.streaming = False
             self.abort()
             return
-        self._open(self.schema).write_table(conform(_read_part(part), self.schema))
+        self._open(self.schema).write_table(table)
 
     def _write_parquet(self, n_chunks: int) -> None:
         """Every part, in order, in the schema of them all (:func:`unified_schema`: the columns
