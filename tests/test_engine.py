@@ -99,15 +99,16 @@ def test_kill_9_and_resume_loses_and_duplicates_nothing(grasp_files, tmp_path, f
 def test_parquet_output_is_written_in_the_schema_of_all_its_parts(tmp_path, workers):
     """Parquet parts are appended as they complete while they share the first part's schema; a
     carried field whose type changes between chunks (null, then text, then a list; or floats, then
-    integers past 2**53 that the floats' type cannot hold exactly, then text) puts every part in the
-    schema of them all (JSON text), and one that keeps its type keeps it. Either way every row is
-    there, in input order, with its value: the table a run in one chunk writes."""
+    integers past 2**53 that the floats' type cannot hold exactly, then text or floats again) puts
+    every part in the schema of them all (JSON text), and one that keeps its type keeps it. Either
+    way every row is there, in input order, with its value: the table a run in one chunk writes."""
     grasps = random_grasps(5, 300, dim=2, n_contacts=3)
     notes = {"changing": ([None] * 100 + [f"s{i}" for i in range(100, 200)]
                           + [[i, i + 1] for i in range(200, 300)]),
              "steady": [f"s{i}" for i in range(300)],
              # the second part's integers pass the first part's float type but do not convert
-             "unconvertible": [1.5] * 100 + [2**53 + i for i in range(100)] + ["t"] * 100}
+             "unconvertible": [1.5] * 100 + [2**53 + i for i in range(100)] + ["t"] * 100,
+             "unconvertible-numbers": [1.5] * 100 + [2**53 + i for i in range(100)] + [2.5] * 100}
     for kind, values in notes.items():
         src = tmp_path / f"{kind}.jsonl"
         write_grasps(src, grasps)

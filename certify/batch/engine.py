@@ -53,8 +53,8 @@ from .chunk import Options, certify_chunk_results, status_counts
 from ..errors import CertifyError, GraspFileError
 from ..files.outputs import check_output, lock_output, write_error
 from ..files.results import RESULT_SCHEMA, RESULT_WRITE_OPTIONS, carried_clash
-from ..files.reader import (Chunk, conform, input_format, is_parquet, iter_chunks, rows_to_table, table_to_rows,
-                            unified_schema)
+from ..files.reader import (JSON_TEXT, Chunk, conform, input_format, is_parquet, iter_chunks, rows_to_table,
+                            table_to_rows, unified_schema)
 from ..core.validation import TOP_LEVEL
 
 __all__ = ["RunSummary", "run", "check_paths", "certify_chunk", "encoded_chunk", "encode_part", "parts_folder",
@@ -339,10 +339,12 @@ class _Assembler:
         carried from JSON rows may differ between parts, in presence or type), unless
         :meth:`_stream` has written them all in that schema already."""
         parts = [self.parts / _part_name(i, self.results) for i in range(n_chunks)]
-        schema = unified_schema([_part_schema(p) for p in parts]) if parts else RESULT_SCHEMA
+        schemas = [_part_schema(p) for p in parts]
+        schema = unified_schema(schemas) if parts else RESULT_SCHEMA
         if self.streaming and self.out is not None and schema.equals(self.schema, check_metadata=True):
             return
         self.abort()
+        schema = _holding(schema, zip(parts, schemas))
         writer = self._open(schema)
         for part in parts:
             writer.write_table(conform(_read_part(part), schema))
@@ -367,6 +369,25 @@ class _Assembler:
                 pass
             self.out = None
         self.tmp.unlink(missing_ok=True)
+
+
+def _holding(schema: pa.Schema, parts) -> pa.Schema:
+    """``schema`` (:func:`unified_schema` of the ``(path, schema)`` pairs ``parts``) with each
+    column that some part's values do not convert to exactly (an integer past 2**53 into a float
+    column) as JSON text, as :func:`unified_schema` holds types that do not promote: no value is
+    changed, and the run does not fail on a cast a resume would fail on again."""
+    text = set()
+    for path, own in parts:
+        cast = [f.name for f in own if f.name not in text and schema.field(f.name).metadata != JSON_TEXT
+                and f.type != schema.field(f.name).type]
+        table = _read_part(path) if cast else None
+        for name in cast:
+            try:
+                table.column(name).cast(schema.field(name).type)
+            except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError):
+                text.add(name)
+    return pa.schema([pa.field(f.name, pa.large_string(), metadata=JSON_TEXT) if f.name in text else f
+                      for f in schema])
 
 
 class _LocalPool:
