@@ -40,13 +40,12 @@ from itertools import combinations
 
 import numpy as np
 import pyarrow as pa
-import scipy.sparse as sp
 
 from .._kernels.barrier import barrier_batch
 from .._kernels.evidence import generator_rows
 from .._kernels.jit import kernel_array
 from .._kernels.linalg import U as U_ROUND, projection_bound, world_values
-from .._kernels.planar import pair_null_rows, planar_batch, planar_generators, thin_screen
+from .._kernels.planar import pair_null_rows, planar_batch, thin_screen
 from .._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
 from ..core.certificates import Tolerances, verify
 from ..core.closure import decide, farkas_from_arrays
@@ -55,7 +54,7 @@ from ..files.columns import GraspColumns, grasp_columns
 from ..core.cones import LORENTZ
 from ..core.grasp import Contact, Grasp
 from ..core.problem import (Block, ClosureProblem, System, conic_block_arrays, conic_columns, grasp_problem,
-                            grasp_system, ray_block_arrays)
+                            grasp_system, ray_block_arrays, ray_problem)
 from ..quality.bounds import planar_epsilon_columns
 from ..solvers import BARRIER_NEAR_ZERO, FastSolver, make_solver
 from ..solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
@@ -240,10 +239,7 @@ def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
         return planar_pair_normal(P[i], N[i], mu[i], width[i], c[i], L[i], owner[cols], offset[cols], friction[cols])
 
     tight_rows: dict[int, np.ndarray] = {}
-    W = np.empty((len(rows), 3, k))
-    E = np.empty((len(rows), 3, k))
-    for r, i in enumerate(rows):
-        planar_generators(P[i], N[i], mu[i], width[i], c[i], L[i], owner, offset, friction, W[r], E[r])
+    W, E = generator_rows(*(kernel_array(a[rows]) for a in (P, N, mu, width, c, L)), owner, offset, friction)
     if k < 3:  # the kernel's float proof of its null direction failed: decided exactly
         for i in rows if k == 2 else ():
             z = pair_normal(i)
@@ -422,8 +418,7 @@ def _refuted(C, E, cols, y) -> bool:
 def _solve_generators(solver, W):
     """``(t, y)`` of the fast solver on the closure programme of the generator columns ``W``
     (``y`` None when it has none, ``t`` -inf when it fails: decide then goes by the rank)."""
-    k = W.shape[1]
-    problem = ClosureProblem(W, tuple(range(k)), (), sp.identity(k, format="csr"), System(W, (), "generators"))
+    problem = ray_problem(System(W, (), "generators"))
     try:
         sol = solver.solve(problem)
     except SolverError:

@@ -37,7 +37,7 @@ from .wrench import (contact_frame, force_columns, generator_columns, grasp_arra
 
 __all__ = ["Block", "block_arrays", "ray_block_arrays", "conic_block_arrays", "System", "ClosureProblem",
            "grasp_problem", "span_problem", "grasp_system", "span_system", "span_vectors", "is_polyhedral",
-           "DENSE_COLUMNS", "LorentzLayout", "lorentz_layout"]
+           "DENSE_COLUMNS", "LorentzLayout", "lorentz_layout", "ray_problem"]
 
 
 @dataclass(frozen=True)
@@ -157,14 +157,21 @@ class ClosureProblem:
 
 def span_problem(vectors) -> ClosureProblem:
     """Positive spanning of the rows of ``vectors`` (shape ``(k, d)``): every row is a ray."""
-    system = span_system(vectors)
+    return ray_problem(span_system(vectors))
+
+
+def ray_problem(system: System) -> ClosureProblem:
+    """The closure programme of a system of generator rays (layout ``generators``):
+    every column a ray ``x_j >= t``, and the identity as the value map, dense up to
+    :data:`DENSE_COLUMNS` columns (its values are the same, :meth:`ClosureProblem.values`)."""
     k = system.columns.shape[1]
     return ClosureProblem(system.columns, tuple(range(k)), (), _identity(k), system)
 
 
+@lru_cache(maxsize=64)
 def _identity(k: int):
-    """The value map of a programme over generator rays: the identity, dense up to
-    :data:`DENSE_COLUMNS` columns (its values are the same, :meth:`ClosureProblem.values`)."""
+    """The identity value map of ``k`` rays, built once per ``k`` and shared (never changed: the
+    programmes only read it)."""
     return np.eye(k) if k <= DENSE_COLUMNS else sp.identity(k, format="csr")
 
 
@@ -206,8 +213,7 @@ def grasp_problem(grasp: Grasp, *, frictionless: bool = False, socp: bool = Fals
             return _lorentz_problem(grasp, layout)
     system = grasp_system(grasp, frictionless=frictionless, socp=socp)
     if system.layout == "generators":
-        k = system.columns.shape[1]
-        return ClosureProblem(system.columns, tuple(range(k)), (), _identity(k), system)
+        return ray_problem(system)
     P, N, mu, params, c, L = grasp_arrays(grasp)
     models = tuple(contact.model for contact in grasp.contacts)
     columns, rays, cones, to_values = conic_columns(P, N, params, models, c, L)
