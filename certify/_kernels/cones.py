@@ -71,7 +71,7 @@ def _project_off_tight(C, first, width, tight, scale, v):
     ``np.linalg.qr`` and slice assignments slowly, and this runs on a first call."""
     d = C.shape[0]
     basis = np.empty((d, d))
-    rank = 0
+    rank = np.int64(0)  # an int literal would have numba compile _remove_components for it too
     q = np.empty(d)
     for b in range(first.shape[0]):
         if not tight[b]:

@@ -67,7 +67,8 @@ def _start(P, tol):
     plane), or -1 in the first entry when the points lie within ``tol`` of a plane."""
     n = P.shape[0]
     out = np.full(4, -1, dtype=np.int64)
-    best, i0, i1 = -1.0, 0, 0
+    # indices typed int64 from the start: an int literal would have numba compile _plane for it too
+    best, i0, i1 = -1.0, np.int64(0), np.int64(0)
     for r in range(3):
         lo, hi = 0, 0
         for i in range(n):
@@ -81,7 +82,7 @@ def _start(P, tol):
         return out
     dx, dy, dz = P[i1, 0] - P[i0, 0], P[i1, 1] - P[i0, 1], P[i1, 2] - P[i0, 2]
     dd = np.sqrt(dx * dx + dy * dy + dz * dz)
-    best, i2 = -1.0, -1
+    best, i2 = -1.0, np.int64(-1)
     for i in range(n):
         wx, wy, wz = P[i, 0] - P[i0, 0], P[i, 1] - P[i0, 1], P[i, 2] - P[i0, 2]
         cx, cy, cz = dy * wz - dz * wy, dz * wx - dx * wz, dx * wy - dy * wx

@@ -153,14 +153,17 @@ _PLANAR_KERNELS = _CHECK_KERNELS + (
     (planar_generators, (F2, F2, F1, F1, F1, FLOAT, I1, F1, F1, F2, F2)),
     (planar_epsilon_one, (F2, I1, INT, BOOL)),
     (minkowski_sums, (F3, F3, I1, INT)),  # the vertices of sums and support evidence
-    (used_vertices, (I2, I1, I1)),
 )
 #: ... the 3-D hulls (each of the two compiled in a process of its own on a cold cache, while
 #: this one compiles closure's: :func:`compile_ahead`), ...
 _HULL_KERNELS = (
-    (hulls_faces, (F2, I1)),  # every planar surface's faces
     (hull_faces, (F2,)),
     (orient_cycle, (I2, INT, INT, BOOL)),  # the faces of qhull's, where those decline
+)
+#: ... those of the columnar route alone (many surfaces at once), ...
+_COLUMN_KERNELS = (
+    (hulls_faces, (F2, I1)),  # every planar surface's faces
+    (used_vertices, (I2, I1, I1)),
 )
 #: ... and those of grasps with more than :data:`L1_ENUMERATION_MAX` generators or
 #: :data:`SUMS_MAX` sums (the L1 hull minimum, the L-infinity sweep, ``support`` evidence),
@@ -174,7 +177,8 @@ _LARGE_KERNELS = (
     (face_planes, (F2, I2)),
 )
 #: Those kernel sets by name (:func:`compile_ahead`; :mod:`qualgrasp.certify._kernels.jit`).
-KERNEL_SETS = {"quality-planar": _PLANAR_KERNELS, "quality-hulls": _HULL_KERNELS, "quality-planar-large": _LARGE_KERNELS,
+KERNEL_SETS = {"quality-planar": _PLANAR_KERNELS, "quality-hulls": _HULL_KERNELS,
+               "quality-planar-columns": _COLUMN_KERNELS, "quality-planar-large": _LARGE_KERNELS,
                "quality-spatial": _SURFACE_KERNELS}
 #: The sets the epsilons of each dimension need.
 _SETS = {2: ("quality-planar", "quality-hulls"), 3: ("quality-spatial",)}
@@ -268,13 +272,14 @@ def compile_ahead(dims) -> None:
                 compile_elsewhere(__name__, name)
 
 
-def _after_compiling(deadline: float | None, dim: int, large: bool = False) -> float | None:
-    """Compile (or load) the kernel sets of ``dim`` (:data:`KERNEL_SETS`; with ``large``, planar
-    grasps' large set too), first waiting for another process compiling a set
-    (:func:`compile_ahead`), and return ``deadline`` pushed back by the time that took: a time
-    limit counts computation, never compilation, so that a cold compile cache cannot change a
-    result."""
-    names = _SETS[dim] + (("quality-planar-large",) if large and dim == 2 else ())
+def _after_compiling(deadline: float | None, dim: int, large: bool = False, columns: bool = False) -> float | None:
+    """Compile (or load) the kernel sets of ``dim`` (:data:`KERNEL_SETS`; for planar grasps with
+    ``large`` the large set too, with ``columns`` the columnar route's), first waiting for another
+    process compiling a set (:func:`compile_ahead`), and return ``deadline`` pushed back by the
+    time that took: a time limit counts computation, never compilation, so that a cold compile
+    cache cannot change a result."""
+    names = _SETS[dim] + (("quality-planar-large",) if large and dim == 2 else ()) + (
+        ("quality-planar-columns",) if columns and dim == 2 else ())
     if all(compiled_here(KERNEL_SETS[name]) for name in names):  # every call after a process's first
         return deadline
     start = time.perf_counter()
@@ -519,7 +524,7 @@ def planar_epsilon_columns(W, E, owner, m: int, *, time_limit: float | None = No
     l1, linf : EvidenceColumns
         The evidence of each norm.
     """
-    _after_compiling(None, 2, _large(np.shape(W)[2], owner, m))
+    _after_compiling(None, 2, _large(np.shape(W)[2], owner, m), columns=True)
     W = np.ascontiguousarray(W, dtype=float)
     E = np.ascontiguousarray(E, dtype=float)
     owner = np.ascontiguousarray(owner, dtype=np.int64)

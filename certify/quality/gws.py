@@ -58,10 +58,10 @@ def surface_faces(points: np.ndarray) -> np.ndarray | None:
     :func:`~qualgrasp.certify._kernels.hull.hull_faces`, in other dimensions (6-D, spatial grasps)
     the facets of :func:`~qualgrasp.certify._kernels.hull.hull_facets`, simplices, ordered by
     :func:`orient_faces` (qhull's where they do not close up)."""
-    if np.shape(points)[1:] == (3,):  # one set: without the batch's bookkeeping
-        faces = hull_faces(kernel_array(points))
-        if len(faces):
-            return faces
+    if np.shape(points)[1:] == (3,):  # one set: without the batch's bookkeeping (and its kernel)
+        points = kernel_array(points)
+        faces = hull_faces(points)
+        return faces if len(faces) else _qhull_faces([points])[0]  # as hull_rows falls back
     return surfaces_faces([points])[0]
 
 
