@@ -309,9 +309,9 @@ TRIANGLES_MAX = 128
 def _closed_triangles(faces, nv):
     """Whether the triangles ``faces`` (F, 3) on ``nv`` vertices form a closed oriented cycle, as
     :func:`cycle_code` returning 0 states it, without sorting (time linear in ``F`` once an ``nv``
-    by ``nv`` table is cleared): every index in range, no
-    face repeating a vertex, and each edge of a face, directed along the face's vertex order
-    (``a -> b -> c -> a``), in no other face in that direction and in one face in the other.
+    by ``nv`` table is cleared): every index in range, no face repeating a vertex, and each edge of
+    a face, directed along the face's vertex order (``a -> b -> c -> a``), in no other face in that
+    direction and in one face in the other.
     That is :func:`cycle_code`'s condition: the sign of ridge ``k`` (:func:`_ridge_keys`) is +1
     exactly when the edge it leaves, so directed, goes from the smaller index to the larger, so
     two faces sharing a ridge have opposite signs exactly when they run along it in opposite

@@ -239,7 +239,10 @@ def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
         return planar_pair_normal(P[i], N[i], mu[i], width[i], c[i], L[i], owner[cols], offset[cols], friction[cols])
 
     tight_rows: dict[int, np.ndarray] = {}
-    W, E = generator_rows(*(kernel_array(a[rows]) for a in (P, N, mu, width, c, L)), owner, offset, friction)
+    if len(rows):
+        W, E = generator_rows(*(kernel_array(a[rows]) for a in (P, N, mu, width, c, L)), owner, offset, friction)
+    else:  # nothing to settle: no kernel to load or compile
+        W, E = np.empty((0, 3, k)), np.empty((0, 3, k))
     if k < 3:  # the kernel's float proof of its null direction failed: decided exactly
         for i in rows if k == 2 else ():
             z = pair_normal(i)

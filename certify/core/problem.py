@@ -168,10 +168,9 @@ def ray_problem(system: System) -> ClosureProblem:
     return ClosureProblem(system.columns, tuple(range(k)), (), _identity(k), system)
 
 
-@lru_cache(maxsize=64)
 def _identity(k: int):
-    """The identity value map of ``k`` rays, built once per ``k`` and shared (never changed: the
-    programmes only read it)."""
+    """The identity value map of ``k`` rays, a new one each time (a caller may change its
+    programme's map)."""
     return np.eye(k) if k <= DENSE_COLUMNS else sp.identity(k, format="csr")
 
 

@@ -148,7 +148,7 @@ _SURFACE_KERNELS = (
     (face_bounds_laplace, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)),
     (hull_grow, (F2, I2, F2, F1, B1, INT, F1, INT)), (weakest_plane, (F2, F1, B1, INT)), (live_facets, (I2, B1, INT)),
     (orient_cycle, (I2, INT, INT, BOOL)))
-#: The same for planar grasps, in three sets: these, ...
+#: The same for planar grasps, in four sets: these, ...
 _PLANAR_KERNELS = _CHECK_KERNELS + (
     (planar_generators, (F2, F2, F1, F1, F1, FLOAT, I1, F1, F1, F2, F2)),
     (planar_epsilon_one, (F2, I1, INT, BOOL)),
@@ -160,7 +160,8 @@ _HULL_KERNELS = (
     (hull_faces, (F2,)),
     (orient_cycle, (I2, INT, INT, BOOL)),  # the faces of qhull's, where those decline
 )
-#: ... those of the columnar route alone (many surfaces at once), ...
+#: ... those of the columnar route alone (many surfaces at once; compiled where that route first
+#: runs, never by :func:`compile_ahead`, which serves the per-grasp route), ...
 _COLUMN_KERNELS = (
     (hulls_faces, (F2, I1)),  # every planar surface's faces
     (used_vertices, (I2, I1, I1)),
