@@ -77,3 +77,106 @@ def test_schema_round_trip_keeps_everything():
     assert g.meta == {"regions": [3, 4]}
     assert grasp_from_dict(grasp_to_dict(g)) == g
     assert [c.model for c in g.contacts] == ["soft", "point", "frictionless"]
+
+
+# --- the scalar rules of one contact or grasp against the rules on arrays ---------------------------
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+import numpy as np  # noqa: E402
+
+from qualgrasp.certify import models as registry  # noqa: E402
+from qualgrasp.certify.batch import random_grasps  # noqa: E402
+from qualgrasp.certify.core.validation import (GraspData, check_contact, check_contacts, contact_data,  # noqa: E402
+                                               grasp_geometry, grasp_rules, param_names)
+from qualgrasp.certify.core.grasp import _checked_of  # noqa: E402
+
+_FLOATS = st.one_of(
+    st.floats(-3, 3), st.floats(allow_nan=True, allow_infinity=True), st.sampled_from([0.0, -0.0, 1.0, -1.0, 1e-160,
+                                                                                      5e-324, 1e6, 1e6 + 1, 1e154]),
+    st.integers(-3, 3), st.just(10**400), st.booleans(), st.just("1"))
+_VECTORS = st.one_of(st.lists(_FLOATS, min_size=1, max_size=4), st.tuples(st.floats(-2, 2), st.floats(-2, 2)),
+                     st.tuples(st.floats(-2, 2), st.floats(-2, 2), st.floats(-2, 2)),
+                     st.lists(st.floats(-2, 2), min_size=2, max_size=3).map(np.array),
+                     st.lists(st.floats(-1, 1), min_size=2, max_size=3).map(  # unit to within rounding
+                         lambda v: [x / math.hypot(*v) for x in v] if math.hypot(*v) > 0.1 else v), st.none())
+_PARAMS = st.one_of(st.none(), st.floats(0, 2), st.sampled_from([0.0, -0.0, -0.1, 1e-300, 5e-324, 1e7]),
+                    st.floats(allow_nan=True, allow_infinity=True), st.booleans(), st.integers(-1, 2))
+_MODELS = st.one_of(st.none(), st.sampled_from(registry.names()), st.just("sticky"), st.just(3))
+
+
+def _bits(values) -> list[str]:
+    return [float(v).hex() for v in values]
+
+
+def _reference_contact(value):
+    """The contact as the rules on arrays give it (None: a rule fails)."""
+    checked = check_contacts(contact_data([value]))
+    if checked.error[0] is not None:
+        return None
+    dim, model = int(checked.dim[0]), registry.get(int(checked.model[0]))
+    return (checked.p[0, :dim], checked.n[0, :dim], model.name,
+            [(name, checked.params[name][0]) for name in model.param_names])
+
+
+@settings(max_examples=1500, deadline=None, suppress_health_check=list(HealthCheck))
+@given(p=_VECTORS, n=_VECTORS, model=_MODELS, params=st.fixed_dictionaries({k: _PARAMS for k in param_names()}))
+def test_one_contacts_rules_give_the_array_rules_values_bit_for_bit(p, n, model, params):
+    value = {"p": p, "n": n, "model": model, **params}
+    fast, ref = check_contact(value), _reference_contact(value)
+    if fast is None:  # declined: the rules on arrays decide (a failed rule, a reduction, the default rule)
+        return
+    assert ref is not None, value
+    assert _bits(fast[0]) == _bits(ref[0]) and _bits(fast[1]) == _bits(ref[1]), value
+    assert fast[2] == ref[2] and [(k, float(v).hex()) for k, v in fast[3]] == [(k, float(v).hex()) for k, v in ref[3]]
+
+
+def test_ordinary_contacts_take_the_scalar_rules_and_keep_their_values():
+    """Every contact of random grasps of each model (and unit and non-unit normals) goes by the
+    scalar rules: the test above then compares real cases, and the contacts equal those built
+    by the rules on arrays."""
+    taken = 0
+    for dim, model in ((2, "point"), (2, "pad"), (2, "frictionless"), (3, "point"), (3, "soft"), (2, "patch")):
+        if dim not in registry.get(model).dims:
+            continue
+        for g in random_grasps(5, 40, dim=dim, model=model):
+            for c in g.contacts:
+                for n in (c.n, tuple(2.5 * x for x in c.n)):
+                    value = {"p": c.p, "n": n, "model": c.model, **dict(c.params)}
+                    fast, ref = check_contact(value), _reference_contact(value)
+                    assert fast is not None, value
+                    assert _bits(fast[0]) == _bits(ref[0]) and _bits(fast[1]) == _bits(ref[1])
+                    taken += 1
+    assert taken > 1000
+
+
+def _reference_geometry(contacts, center, length):
+    data = GraspData(np.array([len(contacts)]), np.zeros((1, 3)), np.full(1, -1), np.full(1, np.nan),
+                     np.zeros(1, dtype=bool), [None], [None], [{}])
+    if center is not None:
+        data.center[0, : len(center)], data.clen[0] = center, len(center)
+    if length is not None:
+        data.length[0], data.length_given[0] = length, True
+    checked = grasp_rules(data, _checked_of(contacts))
+    if checked.error[0] is not None:
+        return None
+    dim = int(checked.dim[0])
+    return checked.center[0, :dim], checked.length[0]
+
+
+_COORD = st.one_of(st.floats(-5, 5), st.sampled_from([0.0, -0.0, 1e-300, 1e-20, 1e6, -1e6]))
+
+
+@settings(max_examples=800, deadline=None, suppress_health_check=list(HealthCheck))
+@given(points=st.integers(2, 3).flatmap(lambda d: st.lists(st.tuples(*[_COORD] * d), min_size=1, max_size=6)),
+       center=st.one_of(st.none(), st.lists(_COORD, min_size=2, max_size=3), st.just([float("nan"), 0.0])),
+       length=st.one_of(st.none(), st.floats(0, 10), st.sampled_from([0.0, 1e-20, 1e-9, 4e6, 4e6 + 1]),
+                        st.just(float("inf"))),
+       copies=st.integers(1, 3))
+def test_one_grasps_rules_give_the_array_rules_center_and_length_bit_for_bit(points, center, length, copies):
+    contacts = tuple(Contact(q, (1.0,) + (0.0,) * (len(q) - 1)) for q in points) * copies
+    fast = grasp_geometry([c.p for c in contacts], center, length)
+    ref = _reference_geometry(contacts, center, length)
+    assert (fast is None) == (ref is None), (points, center, length)
+    if fast is not None:
+        assert _bits(fast[0]) == _bits(ref[0]) and float(fast[1]).hex() == float(ref[1]).hex()

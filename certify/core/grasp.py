@@ -34,8 +34,8 @@ from .. import models as registry
 from ..models import ModelName
 from ..errors import GraspError
 from .arguments import require
-from .validation import (Checked, CheckedGrasps, GraspData, check_contacts, contact_data, grasp_data,
-                         check_grasps, grasp_rules, number, numbers, param_names)
+from .validation import (Checked, CheckedGrasps, GraspData, check_contact, check_contacts, contact_data,
+                         grasp_data, check_grasps, grasp_geometry, grasp_rules, number, numbers, param_names)
 
 __all__ = ["Contact", "Grasp", "grasp_from_dict", "grasp_to_dict", "grasps_from_checked"]
 
@@ -95,6 +95,11 @@ class Contact:
             raise GraspError(f"unknown contact parameter(s) {unknown}; the models take "
                              f"{', '.join(param_names())}")
         value = {"p": p, "n": n, "model": model, "mu": mu, "torsion": torsion, **params}
+        fast = check_contact(value)  # the usual contact, by the same rules without arrays
+        if fast is not None:
+            for name, v in zip(("p", "n", "model", "params"), fast):
+                object.__setattr__(self, name, v)
+            return
         checked = check_contacts(contact_data([value]))
         if checked.error[0] is not None:
             raise GraspError(str(checked.error[0]))
@@ -193,6 +198,14 @@ class Grasp:
         contacts = tuple(self.contacts)
         if not all(isinstance(c, Contact) for c in contacts):
             raise GraspError("contacts must be Contact objects")
+        geometry = grasp_geometry([c.p for c in contacts], self.center, self.length)  # the usual grasp
+        center, length = geometry if geometry is not None else self._checked_geometry(contacts)
+        object.__setattr__(self, "contacts", contacts)
+        object.__setattr__(self, "center", center)
+        object.__setattr__(self, "length", length)
+
+    def _checked_geometry(self, contacts: tuple[Contact, ...]) -> tuple[tuple[float, ...], float]:
+        """``center`` and ``length`` by the grasp rules on arrays, which word any problem."""
         data = GraspData(np.array([len(contacts)]), np.zeros((1, 3)), np.full(1, -1), np.full(1, np.nan),
                          np.zeros(1, dtype=bool), [None], [None], [{}])
         if self.center is not None:
@@ -210,9 +223,7 @@ class Grasp:
         if checked.error[0] is not None:
             raise GraspError(str(checked.error[0]))
         dim = int(checked.dim[0])
-        object.__setattr__(self, "contacts", contacts)
-        object.__setattr__(self, "center", tuple(float(v) for v in checked.center[0, :dim]))
-        object.__setattr__(self, "length", float(checked.length[0]))
+        return tuple(float(v) for v in checked.center[0, :dim]), float(checked.length[0])
 
     @property
     def dim(self) -> int:
