@@ -59,7 +59,7 @@ import zlib
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
-from typing import Any, Callable, Iterable, Sequence
+from typing import Any, Callable, Iterable, Mapping, Sequence
 
 import numpy as np
 from scipy.stats import spearmanr
@@ -366,9 +366,11 @@ def explain(row: dict, physics: Physics = Physics()) -> str:
     return "unexplained"
 
 
-def validate_object(subject: Subject, settings: Validation = QUICK_VALIDATION, recheck: bool = False) -> list[dict]:
-    """Every physical trial of one object (module notes): rows of :data:`COLUMNS`."""
-    planned, outline = grasps_of(subject, settings)
+def validate_object(subject: Subject, settings: Validation = QUICK_VALIDATION, recheck: bool = False,
+                    planned: tuple[list[_Planned], Any] | None = None) -> list[dict]:
+    """Every physical trial of one object (module notes): rows of :data:`COLUMNS`. ``planned`` is
+    the object's :func:`grasps_of`, computed when not given."""
+    planned, outline = planned if planned is not None else grasps_of(subject, settings)
     if subject.geometry is not None:
         truth, polygon = boundary_of_polygon(subject.geometry), subject.geometry
     else:
@@ -638,12 +640,14 @@ def validate(images: Iterable[Any], out: str | Path, *, settings: str | Validati
     with trials.open("w", newline="", encoding="utf-8") as fh:  # rows as objects finish: a long run can be read early
         writer = csv.writer(fh)
         writer.writerow(COLUMNS)
+        plans = {}  # each object's grasps, for the filmstrip
         for k, got in enumerate(_objects(tasks, settings.workers)):
             if isinstance(got, tuple):
                 skipped.append(got)
             else:
-                rows += got
-                writer.writerows([_fmt(r.get(c)) for c in COLUMNS] for r in got)
+                rows += got.rows
+                plans[got.name] = got.planned
+                writer.writerows([_fmt(r.get(c)) for c in COLUMNS] for r in got.rows)
                 fh.flush()
             say(f"objects {k + 1}/{len(tasks)}")
     seconds = time.perf_counter() - start
@@ -662,7 +666,7 @@ def validate(images: Iterable[Any], out: str | Path, *, settings: str | Validati
     if plots:
         files += plot_all(out, rows, closed, settings.physics.floor, settings.outside_max,
                           {"default": settings.physics.label(), "fine": FINE.label()})
-        film = filmstrip(items, rows, settings)
+        film = filmstrip(items, rows, settings, plans)
         if film is not None:
             frames, obj, title = film
             files += plot_filmstrip(out, frames, obj.outline, settings.physics.finger_radius, obj.length, title)
@@ -702,17 +706,19 @@ def report(out: str | Path, settings: str | Validation = "full", images: Iterabl
     return summary, files
 
 
-def filmstrip(items: Sequence[Subject], rows: list[dict], settings: Validation):
+def filmstrip(items: Sequence[Subject], rows: list[dict], settings: Validation,
+              plans: Mapping[str, tuple[list[_Planned], Any]] | None = None):
     """A trial to show (``physics-filmstrip``): the qualitative grasp with the most fingers that held
     on the first object that has one, pushed in its weakest direction at 1.5 times what it
-    resisted: ``(frames, object, title)``, or None when no qualitative grasp held."""
+    resisted: ``(frames, object, title)``, or None when no qualitative grasp held. ``plans`` maps
+    objects' names to their :func:`grasps_of` where the run kept them (else computed again)."""
     for subject in items:
         held = [r for r in rows if r["object"] == subject.name and r["source"] == "qualitative"
                 and r["placement"] == "nominal" and r["setting"] == "default" and r["held"]]
         if not held:
             continue
         row = max(held, key=lambda r: (r["fingers"], r["resisted"]))
-        planned, outline = grasps_of(subject, settings)
+        planned, outline = (plans or {}).get(subject.name) or grasps_of(subject, settings)
         plan = next(p for p in planned if p.grasp.id == row["grasp"] and p.route == row["route"])
         truth = boundary_of_polygon(subject.geometry) if subject.geometry is not None else boundary(subject.image)
         obj = PlanarObject.from_polygon(subject.geometry if subject.geometry is not None else Polygon(truth.points))
@@ -739,10 +745,20 @@ def _objects(tasks: list[tuple], workers: int):
             yield f.result()
 
 
+@dataclass(frozen=True)
+class _Validated:
+    """One object's trials (``rows``) and the grasps they executed (``planned``, :func:`grasps_of`)."""
+
+    name: str
+    rows: list
+    planned: tuple
+
+
 def _guarded(subject: Subject, settings: Validation, recheck: bool):
-    """:func:`validate_object`, an image the vision cannot read becoming a skipped entry
-    ``(name, reason)``."""
+    """:func:`validate_object` as :class:`_Validated`, an image the vision cannot read becoming a
+    skipped entry ``(name, reason)``."""
     try:
-        return validate_object(subject, settings, recheck)
+        planned = grasps_of(subject, settings)
+        return _Validated(subject.name, validate_object(subject, settings, recheck, planned), planned)
     except (QualitativeError, ValueError) as err:  # unreadable image; a polygon the engine cannot take
         return subject.name, f"{type(err).__name__}: {err}"
