@@ -52,20 +52,41 @@ def _target(module: str, node: ast.ImportFrom, is_package: bool) -> str:
     return ".".join(base + ([node.module] if node.module else []))
 
 
+@functools.lru_cache(maxsize=None)
+def _parsed(path: pathlib.Path, stamp: tuple[int, int]) -> ast.Module:
+    """The syntax tree of a source file, parsed once per process for its size and modification
+    time ``stamp`` (several structure tests read every module). Callers must not change it."""
+    return ast.parse(path.read_text())
+
+
+def parse(path: pathlib.Path) -> ast.Module:
+    """The syntax tree of ``path`` (shared: do not change it)."""
+    st = path.stat()
+    return _parsed(path, (st.st_size, st.st_mtime_ns))
+
+
+@functools.lru_cache(maxsize=None)
+def _file_imports(module: str, path: pathlib.Path, stamp: tuple[int, int]) -> tuple[Import, ...]:
+    tree = parse(path)
+    inner = {id(n) for f in ast.walk(tree) if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef))
+             for n in ast.walk(f) if isinstance(n, (ast.Import, ast.ImportFrom))}
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            target = _target(module, node, path.name == "__init__.py")
+            out.append(Import(module, target, [a.name for a in node.names], id(node) in inner))
+        elif isinstance(node, ast.Import):
+            for a in node.names:
+                out.append(Import(module, a.name, [], id(node) in inner))
+    return tuple(out)
+
+
 def imports(found: dict[str, pathlib.Path] | None = None) -> Iterator[Import]:
     """Every import statement of the package's modules."""
     found = modules() if found is None else found
     for module, path in found.items():
-        tree = ast.parse(path.read_text())
-        inner = {id(n) for f in ast.walk(tree) if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef))
-                 for n in ast.walk(f) if isinstance(n, (ast.Import, ast.ImportFrom))}
-        for node in ast.walk(tree):
-            if isinstance(node, ast.ImportFrom):
-                target = _target(module, node, path.name == "__init__.py")
-                yield Import(module, target, [a.name for a in node.names], id(node) in inner)
-            elif isinstance(node, ast.Import):
-                for a in node.names:
-                    yield Import(module, a.name, [], id(node) in inner)
+        st = path.stat()
+        yield from _file_imports(module, path, (st.st_size, st.st_mtime_ns))
 
 
 def edges(found: dict[str, pathlib.Path] | None = None, *, inner: bool = False) -> dict[str, set[str]]:
@@ -160,7 +181,7 @@ def defined_public_names(found: dict[str, pathlib.Path] | None = None) -> dict[s
         if any(p.startswith("_") for p in module.split(".")):
             continue
         names = []
-        for node in ast.parse(path.read_text()).body:
+        for node in parse(path).body:
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
                 names.append(node.name)
             elif isinstance(node, (ast.Assign, ast.AnnAssign)):
@@ -179,7 +200,7 @@ def public_names(found: dict[str, pathlib.Path] | None = None) -> dict[str, list
     for module, path in found.items():
         if any(p.startswith("_") for p in module.split(".")):
             continue
-        tree = ast.parse(path.read_text())
+        tree = parse(path)
         names: list[str] = []
         listed = None
         for node in tree.body:

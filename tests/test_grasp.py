@@ -119,7 +119,7 @@ def _reference_contact(value):
             [(name, checked.params[name][0]) for name in model.param_names])
 
 
-@settings(max_examples=1500, deadline=None, suppress_health_check=list(HealthCheck))
+@settings(max_examples=800, deadline=None, suppress_health_check=list(HealthCheck))
 @given(p=_VECTORS, n=_VECTORS, model=_MODELS, params=st.fixed_dictionaries({k: _PARAMS for k in param_names()}))
 def test_one_contacts_rules_give_the_array_rules_values_bit_for_bit(p, n, model, params):
     value = {"p": p, "n": n, "model": model, **params}
@@ -167,7 +167,7 @@ def _reference_geometry(contacts, center, length):
 _COORD = st.one_of(st.floats(-5, 5), st.sampled_from([0.0, -0.0, 1e-300, 1e-20, 1e6, -1e6]))
 
 
-@settings(max_examples=800, deadline=None, suppress_health_check=list(HealthCheck))
+@settings(max_examples=500, deadline=None, suppress_health_check=list(HealthCheck))
 @given(points=st.integers(2, 3).flatmap(lambda d: st.lists(st.tuples(*[_COORD] * d), min_size=1, max_size=6)),
        center=st.one_of(st.none(), st.lists(_COORD, min_size=2, max_size=3), st.just([float("nan"), 0.0])),
        length=st.one_of(st.none(), st.floats(0, 10), st.sampled_from([0.0, 1e-20, 1e-9, 4e6, 4e6 + 1]),
