@@ -180,3 +180,14 @@ def test_one_grasps_rules_give_the_array_rules_center_and_length_bit_for_bit(poi
     assert (fast is None) == (ref is None), (points, center, length)
     if fast is not None:
         assert _bits(fast[0]) == _bits(ref[0]) and float(fast[1]).hex() == float(ref[1]).hex()
+
+
+def test_the_scalar_rules_read_values_in_the_order_of_the_array_rules():
+    """A value whose conversion raises is read only where the rules on arrays read it: ``n`` after
+    a valid ``p`` (a review found ``n`` read first), the parameters after both."""
+    bad = np.timedelta64(1, "s")  # an np.number whose float() raises
+    for p, message in ((None, "p: missing"), ([1.0], "p: expected 2"), ("ab", "p: expected 2")):
+        with pytest.raises(GraspError, match=message):
+            Contact(p, [bad, 0.0])
+    with pytest.raises(TypeError):
+        Contact([0.0, 1.0], [bad, 0.0])

@@ -378,30 +378,34 @@ def check_contact(value: Mapping[str, Any]) -> tuple | None:
     >>> check_contact({"p": [0, 1], "n": [0, -1], "model": "point", "mu": 0.0}) is None  # frictionless
     True
     """
-    p, n = numbers(value.get("p")), numbers(value.get("n"))
-    if p is None or n is None or len(p) != len(n) or len(p) not in (2, 3):
+    # the values are read in contact_data's order (p, then n, then every parameter), so that a
+    # value whose conversion raises raises here as it would there
+    p = numbers(value.get("p"))
+    if p is None or len(p) not in (2, 3):
         return None
+    n = numbers(value.get("n"))
+    if n is None or len(n) != len(p):
+        return None
+    given = {key: number(value[key]) for key in param_names() if value.get(key) is not None}
     if not all(math.isfinite(x) and abs(x) <= MAX_LENGTH for x in p) or not all(map(math.isfinite, n)):
         return None
-    name = value.get("model")
+    names, name = registry.names(), value.get("model")
     if name is None:  # the default rule
-        name = registry.POINT.name if value.get("mu") is not None else registry.FRICTIONLESS.name
-    if not isinstance(name, str) or name not in registry.names():
+        name = registry.POINT.name if given.get("mu") is not None else registry.FRICTIONLESS.name
+    if not isinstance(name, str) or name not in names:
         return None
-    model = registry.get(name)
+    model = registry.get(names.index(name))  # by position, as contact_data finds it
     if len(p) not in model.dims:
         return None
     params = []
     for par in model.params:
-        x = number(value.get(par.name))
-        if x is None or not (math.isfinite(x) and par.admissible(x)):
+        x = given.get(par.name)
+        if x is None or not (math.isfinite(x) and bool(par.admissible(np.array([x]))[0])):
             return None
         params.append((par.name, x))
-    for other in param_names():  # another model's parameter may only be 0
-        if other not in model.param_names and value.get(other) is not None and number(value.get(other)) != 0:
-            return None
-    given = dict(params)
-    if any(given[key] == 0 for key, _ in model.reductions):
+    if any(key not in model.param_names and x != 0 for key, x in given.items()):
+        return None  # another model's parameter may only be 0 (a value not a number: None, refused)
+    if any(given.get(key, 0.0) == 0 for key, _ in model.reductions):
         return None
     stored = _unit_normal(n)
     return None if stored is None else (p, stored, model.name, tuple(params))
