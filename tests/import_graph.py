@@ -67,7 +67,7 @@ def parse(path: pathlib.Path) -> ast.Module:
 
 @functools.lru_cache(maxsize=None)
 def _file_imports(module: str, path: pathlib.Path, stamp: tuple[int, int]) -> tuple[Import, ...]:
-    tree = parse(path)
+    tree = _parsed(path, stamp)
     inner = {id(n) for f in ast.walk(tree) if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef))
              for n in ast.walk(f) if isinstance(n, (ast.Import, ast.ImportFrom))}
     out = []

@@ -413,9 +413,7 @@ def check_contact(value: Mapping[str, Any]) -> tuple | None:
 
 def _unit_normal(n: tuple[float, ...]) -> tuple[float, ...] | None:
     """:func:`_unit_normals` of one finite normal, the same floats; None when it is too short."""
-    scale = max(abs(x) for x in n)
-    safe = scale if scale > 0 else 1.0
-    scaled = safe * math.sqrt(sum((x / safe) * (x / safe) for x in n))
+    scaled = _scaled_norm(n)
     plain = math.sqrt(sum(x * x for x in n))
     norm = plain if math.isfinite(plain) and plain > 1e-150 else scaled
     if not norm >= MIN_NORMAL:
@@ -590,10 +588,17 @@ def grasp_geometry(points: Sequence[tuple[float, ...]], center: Any = None,
 
 def _reach_one(d: tuple[float, ...]) -> float:
     """:func:`_reach` of one row, the same float."""
-    scale = max(abs(x) for x in d)
-    safe = scale if scale > 0 else 1.0
-    norm = scale * math.sqrt(sum((x / safe) * (x / safe) for x in d))
+    norm = _scaled_norm(d)
     return norm if math.isfinite(norm) else 0.0
+
+
+def _scaled_norm(v: tuple[float, ...]) -> float:
+    """The Euclidean norm of ``v`` scaled by its largest magnitude, so that neither tiny nor huge
+    coordinates underflow or overflow: the float :func:`_unit_normals` and :func:`_reach` compute
+    for one row (their ``safe`` and ``scale`` factors differ only where the sum is 0)."""
+    scale = max(abs(x) for x in v)
+    safe = scale if scale > 0 else 1.0
+    return scale * math.sqrt(sum((x / safe) * (x / safe) for x in v))
 
 
 def check_grasps(data: GraspData, contacts: ContactData) -> CheckedGrasps:
