@@ -158,7 +158,6 @@ _PLANAR_KERNELS = _CHECK_KERNELS + (
 #: this one compiles closure's: :func:`compile_ahead`), ...
 _HULL_KERNELS = (
     (hull_faces, (F2,)),
-    (orient_cycle, (I2, INT, INT, BOOL)),  # the faces of qhull's, where those decline
 )
 #: ... those of the columnar route alone (many surfaces at once; compiled where that route first
 #: runs, never by :func:`compile_ahead`, which serves the per-grasp route), ...
@@ -168,7 +167,10 @@ _COLUMN_KERNELS = (
 )
 #: ... and those of grasps with more than :data:`L1_ENUMERATION_MAX` generators or
 #: :data:`SUMS_MAX` sums (the L1 hull minimum, the L-infinity sweep, ``support`` evidence),
-#: compiled here when a grasp first needs them.
+#: compiled here when a grasp first needs them. They hold the orientation of qhull's faces where
+#: the compiled hull declines (rare: points near a plane), which smaller grasps compile on first
+#: use: only these grasps run under a time limit (the sweep, ``support`` rows), which must never
+#: count a compilation.
 _LARGE_KERNELS = (
     (support_rows, (F2, I1, INT, F2, BOOL)),
     (planar_edges, (F2, I1)),
@@ -176,6 +178,7 @@ _LARGE_KERNELS = (
     (support_choices, (F2, I1, INT, F2)),
     (vertex_sums, (F2, F2, I2)),
     (face_planes, (F2, I2)),
+    (orient_cycle, (I2, INT, INT, BOOL)),
 )
 #: Those kernel sets by name (:func:`compile_ahead`; :mod:`qualgrasp.certify._kernels.jit`).
 KERNEL_SETS = {"quality-planar": _PLANAR_KERNELS, "quality-hulls": _HULL_KERNELS,
