@@ -21,7 +21,7 @@ from importlib import metadata
 import typer
 from typer.core import TyperCommand, TyperGroup
 
-__all__ = ["COMMANDS", "app", "main"]
+__all__ = ["COMMANDS", "AHEAD", "app", "main"]
 
 _CERTIFY = "qualgrasp.certify.cli"
 _MESHES = "qualgrasp.certify.meshes.cli"
@@ -96,6 +96,13 @@ def reflow(text: str) -> str:
     return "\n\n".join(p if keep(p) else " ".join(line.strip() for line in p.split("\n")) for p in paragraphs)
 
 
+#: Commands that start work before their module loads: the function (its module and name) called
+#: with the command's arguments. On a cold compile cache ``certify`` has other processes compile
+#: quality's kernels meanwhile, on the cores its imports leave idle
+#: (:func:`qualgrasp.certify.warmup.compile_ahead_for_command`).
+AHEAD: dict[str, tuple[str, str]] = {"certify": ("qualgrasp.certify.warmup", "compile_ahead_for_command")}
+
+
 class _LazyGroup(TyperGroup):
     """The application's group: lists :data:`COMMANDS` from their summaries, loads one on use."""
 
@@ -118,6 +125,9 @@ class _LazyGroup(TyperGroup):
         name = args[0] if args else None
         if name not in COMMANDS:
             return super().resolve_command(ctx, args)
+        if name in AHEAD:
+            module, function = AHEAD[name]
+            getattr(importlib.import_module(module), function)(args[1:])
         return name, self.load_command(ctx, name), args[1:]
 
 

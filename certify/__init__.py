@@ -27,12 +27,18 @@ The subpackages, one concept each (each ``__init__`` lists its public names):
 'closure'
 """
 
-from .batch import Options, certify_arrow
-from .core import (Certificate, Check, Contact, Grasp, Tolerances, Verdict, force_closure, form_closure,
-                   grasp_from_dict, grasp_to_dict, positive_span, verify, verify_span)
+from ._lazy import lazy_names
 from .errors import (ArgumentError, CertificateError, CertifyError, GraspError, GraspFileError, OptionError,
                      QualgraspError, SolverError, WriteError)
-from .report import Report, certify_grasp
+
+# The other names load from their modules on first use: a process that needs one module of this
+# package (one compiling kernels) does not import them all.
+__getattr__, __dir__ = lazy_names(__name__, {
+    ".batch": ("Options", "certify_arrow"),
+    ".core": ("Certificate", "Check", "Contact", "Grasp", "Tolerances", "Verdict", "force_closure", "form_closure",
+              "grasp_from_dict", "grasp_to_dict", "positive_span", "verify", "verify_span"),
+    ".report": ("Report", "certify_grasp"),
+})
 
 __all__ = [
     "Contact", "Grasp", "grasp_from_dict", "grasp_to_dict",

@@ -36,7 +36,7 @@ from ..errors import CertifyError, GraspFileError
 from .fastpath import certify_table
 from ._recheck import recheck_table, schema_matches
 from ..report import certify_grasp, verify_row
-from ..quality.bounds import compile_ahead
+from ..warmup import compile_ahead
 from ..files.results import NAMES, carried_clash, carried_name, error_row
 from ..solvers import METHODS, Method, make_solver
 from ..core.arguments import choice, count_in, number_in, require

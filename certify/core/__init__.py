@@ -16,11 +16,17 @@ certificates.
 'closure'
 """
 
-from .certificates import Certificate, Check, Tolerances, verify, verify_span
-from .closure import Verdict, force_closure, form_closure, positive_span
-from .grasp import Contact, Grasp, grasp_from_dict, grasp_to_dict
-from .validation import MAX_CONTACTS
-from .wrench import contact_frame, cross, torque
+from .._lazy import lazy_names
+
+# The names load from their modules on first use (:mod:`qualgrasp.certify._lazy`): the kernels
+# import the cone codes of :mod:`.cones` alone.
+__getattr__, __dir__ = lazy_names(__name__, {
+    ".certificates": ("Certificate", "Check", "Tolerances", "verify", "verify_span"),
+    ".closure": ("Verdict", "force_closure", "form_closure", "positive_span"),
+    ".grasp": ("Contact", "Grasp", "grasp_from_dict", "grasp_to_dict"),
+    ".validation": ("MAX_CONTACTS",),
+    ".wrench": ("contact_frame", "cross", "torque"),
+})
 
 __all__ = [
     "Contact", "Grasp", "grasp_from_dict", "grasp_to_dict", "MAX_CONTACTS",

@@ -61,7 +61,8 @@ verdict and reports the bounds reached (planar L-infinity: ``hi`` the best suppo
 depend on the machine's speed; without the limit being hit they are deterministic. The clock
 counts computation only: it starts once the closure verdict is known, and the kernels are
 compiled (or loaded from numba's cache, or awaited from another process compiling them into a
-cold cache: :func:`compile_ahead`) before it runs, so a cold compile cache never changes a result.
+cold cache: :func:`qualgrasp.certify.warmup.compile_ahead`) before it runs, so a cold compile
+cache never changes a result.
 
 Epsilon is 0 for grasps not in closure (and for degenerate ones): the closure verdict is decided
 first, so flat hulls and rank-deficient sets never reach a hull.
@@ -86,16 +87,13 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import ConvexHull, QhullError
 
-from .._kernels.conic import support_points
 from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .._kernels.epsilon import planar_epsilon as epsilon_kernel
-from .._kernels.evidence import minkowski_sums, support_choices, surface_rows, vertex_sums
-from .._kernels.hull import (face_planes, grow_start, hull_faces, hull_grow, hulls_faces, live_facets,
-                             used_vertices, weakest_plane)
-from .._kernels.jit import (B1, BOOL, F1, F2, F3, FLOAT, I1, I2, INT, await_compiled, compile_elsewhere, compiled_here,
-                           kernel_array, mark_compiled, precompile)
-from .._kernels.planar import planar_generators
-from .._kernels.surface import cycle_code, face_bounds, face_bounds_laplace, leibniz_tables, orient_cycle
+from .._kernels.evidence import minkowski_sums, surface_rows
+from .._kernels.hull import face_planes, grow_start, hull_grow, live_facets, used_vertices, weakest_plane
+from .._kernels.jit import await_compiled, compiled_here, kernel_array, mark_compiled, precompile
+from .._kernels.sets import EPSILON_SETS, KERNEL_SETS
+from .._kernels.surface import leibniz_tables
 from ..core.arguments import count_in, number_in, require
 from ..errors import ArgumentError
 from ..core.closure import Verdict, force_closure
@@ -108,7 +106,7 @@ from ..solvers.clarabel_direct import settings
 
 __all__ = ["Norm", "NORMS", "Epsilon", "epsilon", "epsilons", "planar_epsilon", "planar_epsilons",
            "planar_epsilon_rows", "planar_epsilon_columns", "epsilon_of_points", "check_norm", "L1_ENUMERATION_MAX",
-           "LINF_ENUMERATION_MAX", "SUMS_MAX", "MAX_VERTICES", "SOCP_COST", "KERNEL_SETS", "compile_ahead"]
+           "LINF_ENUMERATION_MAX", "SUMS_MAX", "MAX_VERTICES", "SOCP_COST", "KERNEL_SETS"]
 
 #: A norm of the grasp wrench space.
 Norm = Literal["L1", "Linf"]
@@ -138,54 +136,6 @@ _SWEEP_BATCH = 64
 #: The planar support refinement adds the normals of twice this many weakest faces per round (the
 #: spatial one, that of its weakest face: more per round cost more hull than they save rounds).
 _ADD = 2
-#: The kernels checking planar surfaces, with the argument types the epsilons call them with:
-#: compiled before the time limit's clock runs (:func:`_after_compiling`).
-_CHECK_KERNELS = ((face_bounds, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)))
-#: The kernels the epsilon of spatial grasps calls: the support points, the checks of 6-D faces
-#: and the 6-D hulls.
-_SURFACE_KERNELS = (
-    (support_points, (F2, F2, F2, F2, I1, I1, BOOL, B1, I1, I2, I1, F2, F2, F1, F1, F1, F1)),
-    (face_bounds_laplace, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)),
-    (hull_grow, (F2, I2, F2, F1, B1, INT, F1, INT)), (weakest_plane, (F2, F1, B1, INT)), (live_facets, (I2, B1, INT)),
-    (orient_cycle, (I2, INT, INT, BOOL)))
-#: The same for planar grasps, in four sets: these, ...
-_PLANAR_KERNELS = _CHECK_KERNELS + (
-    (planar_generators, (F2, F2, F1, F1, F1, FLOAT, I1, F1, F1, F2, F2)),
-    (planar_epsilon_one, (F2, I1, INT, BOOL)),
-    (minkowski_sums, (F3, F3, I1, INT)),  # the vertices of sums and support evidence
-)
-#: ... the 3-D hulls (each of the two compiled in a process of its own on a cold cache, while
-#: this one compiles closure's: :func:`compile_ahead`), ...
-_HULL_KERNELS = (
-    (hull_faces, (F2,)),
-)
-#: ... those of the columnar route alone (many surfaces at once; compiled where that route first
-#: runs, never by :func:`compile_ahead`, which serves the per-grasp route), ...
-_COLUMN_KERNELS = (
-    (hulls_faces, (F2, I1)),  # every planar surface's faces
-    (used_vertices, (I2, I1, I1)),
-)
-#: ... and those of grasps with more than :data:`L1_ENUMERATION_MAX` generators or
-#: :data:`SUMS_MAX` sums (the L1 hull minimum, the L-infinity sweep, ``support`` evidence),
-#: compiled here when a grasp first needs them. They hold the orientation of qhull's faces where
-#: the compiled hull declines (rare: points near a plane), which smaller grasps compile on first
-#: use: only these grasps run under a time limit (the sweep, ``support`` rows), which must never
-#: count a compilation.
-_LARGE_KERNELS = (
-    (support_rows, (F2, I1, INT, F2, BOOL)),
-    (planar_edges, (F2, I1)),
-    (linf_sweep, (F2, I1, INT, F2, INT, INT, F1, F2)),
-    (support_choices, (F2, I1, INT, F2)),
-    (vertex_sums, (F2, F2, I2)),
-    (face_planes, (F2, I2)),
-    (orient_cycle, (I2, INT, INT, BOOL)),
-)
-#: Those kernel sets by name (:func:`compile_ahead`; :mod:`qualgrasp.certify._kernels.jit`).
-KERNEL_SETS = {"quality-planar": _PLANAR_KERNELS, "quality-hulls": _HULL_KERNELS,
-               "quality-planar-columns": _COLUMN_KERNELS, "quality-planar-large": _LARGE_KERNELS,
-               "quality-spatial": _SURFACE_KERNELS}
-#: The sets the epsilons of each dimension need.
-_SETS = {2: ("quality-planar", "quality-hulls"), 3: ("quality-spatial",)}
 
 
 @dataclass(frozen=True)
@@ -260,29 +210,13 @@ def _expired(deadline: float | None) -> bool:
     return deadline is not None and time.perf_counter() > deadline
 
 
-def compile_ahead(dims) -> None:
-    """Have other processes compile quality's kernels for grasps of ``dims`` (2, 3) into the
-    compile cache when it lacks them, one per kernel set, while this one certifies closure: on a
-    cold cache the cores compile at once (:func:`qualgrasp.certify._kernels.jit.compile_elsewhere`).
-    A no-op on a warm cache, and the results are the same either way.
-
-    Examples
-    --------
-    >>> compile_ahead([2])   # the cache holds them: nothing to do
-    """
-    for dim in sorted({int(d) for d in dims} & {2, 3}):
-        for name in _SETS[dim]:
-            if not compiled_here(KERNEL_SETS[name]):
-                compile_elsewhere(__name__, name)
-
-
 def _after_compiling(deadline: float | None, dim: int, large: bool = False, columns: bool = False) -> float | None:
     """Compile (or load) the kernel sets of ``dim`` (:data:`KERNEL_SETS`; for planar grasps with
     ``large`` the large set too, with ``columns`` the columnar route's), first waiting for another
-    process compiling a set (:func:`compile_ahead`), and return ``deadline`` pushed back by the
-    time that took: a time limit counts computation, never compilation, so that a cold compile
-    cache cannot change a result."""
-    names = _SETS[dim] + (("quality-planar-large",) if large and dim == 2 else ()) + (
+    process compiling a set (:func:`~qualgrasp.certify.warmup.compile_ahead`), and return
+    ``deadline`` pushed back by the time that took: a time limit counts computation, never
+    compilation, so that a cold compile cache cannot change a result."""
+    names = EPSILON_SETS[dim] + (("quality-planar-large",) if large and dim == 2 else ()) + (
         ("quality-planar-columns",) if columns and dim == 2 else ())
     if all(compiled_here(KERNEL_SETS[name]) for name in names):  # every call after a process's first
         return deadline
