@@ -39,6 +39,7 @@ __getattr__, __dir__ = lazy_names(__name__, {
               "grasp_from_dict", "grasp_to_dict", "positive_span", "verify", "verify_span"),
     ".report": ("Report", "certify_grasp"),
 })
+del lazy_names  # not a name of this package
 
 __all__ = [
     "Contact", "Grasp", "grasp_from_dict", "grasp_to_dict",

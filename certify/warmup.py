@@ -26,9 +26,9 @@ __all__ = ["compile_ahead", "compile_ahead_for_command", "first_grasp_dims", "PE
 
 #: Most bytes :func:`first_grasp_dims` reads of a file.
 PEEK_BYTES = 1 << 16
-#: Options after which :func:`compile_ahead_for_command` starts nothing: no quality, help, poses
-#: on a mesh (their grasps are made later), workers elsewhere (dask).
-_NOTHING_AHEAD = ("--no-quality", "--help", "--mesh", "--dask")
+#: Options with which :func:`compile_ahead_for_command` starts nothing: help, poses on a mesh
+#: (their grasps are made later), workers elsewhere (dask).
+_NOTHING_AHEAD = ("--help", "--mesh", "--dask")
 
 
 def compile_ahead(dims: Iterable) -> None:
@@ -82,15 +82,21 @@ def first_grasp_dims(path: str | Path) -> set[int]:
 def compile_ahead_for_command(args: Sequence[str]) -> None:
     """:func:`compile_ahead` for the grasps of a ``qualgrasp certify`` with arguments ``args``
     (those after the command's name): the dimensions of the first grasp of the first argument
-    naming a JSON Lines grasp file (:func:`first_grasp_dims`); nothing with ``--no-quality``,
-    ``--help``, ``--mesh`` or ``--dask``, or for a Parquet file. The command itself parses and
-    checks its arguments afterwards, as ever.
+    naming a JSON Lines grasp file (:func:`first_grasp_dims`). Nothing without an output
+    (``-o``), when the last of ``--quality`` and ``--no-quality`` is ``--no-quality``, with
+    ``--help``, ``--mesh`` or ``--dask``, or when no argument names such a file (a Parquet input:
+    its run starts them once it has read its first chunk). The command parses and checks its
+    arguments afterwards, as ever: one it then refuses for a bad value leaves the kernels
+    compiled in the cache, for the next run.
 
     Examples
     --------
     >>> compile_ahead_for_command(["no-such-file.jsonl", "-o", "out.jsonl"])   # nothing to do
     """
-    if any(a.split("=")[0] in _NOTHING_AHEAD for a in args):
+    options = [a.split("=")[0] for a in (args[:args.index("--")] if "--" in args else args)]
+    toggles = [a for a in options if a in ("--quality", "--no-quality")]
+    if (any(a in _NOTHING_AHEAD for a in options) or (toggles and toggles[-1] == "--no-quality")
+            or not {"-o", "--output"} & set(options)):
         return
     for a in args:
         try:

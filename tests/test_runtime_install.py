@@ -121,17 +121,47 @@ def test_await_compiled_waits_for_the_process_compiling_the_set(tmp_path, monkey
 
 
 def test_a_cold_cache_gets_a_kernel_set_compiled_by_another_process_once(tmp_path, monkeypatch):
+    from qualgrasp.certify._kernels import sets
     from qualgrasp.certify._kernels.jit import await_compiled, cache_dir, compile_elsewhere
-    from qualgrasp.certify.quality.bounds import KERNEL_SETS
 
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))  # the smallest set: the mechanism is the same
     folder = Path(cache_dir())
-    assert compile_elsewhere("qualgrasp.certify.quality.bounds", "quality-hulls")
+    assert compile_elsewhere(sets.__name__, "quality-hulls")  # as warmup.compile_ahead starts it
     await_compiled("quality-hulls")
     assert (folder / "quality-hulls.compiled").exists()
-    for fn, _ in KERNEL_SETS["quality-hulls"]:  # each kernel's cache index, written there
+    for fn, _ in sets.KERNEL_SETS["quality-hulls"]:  # each kernel's cache index, written there
         assert any(folder.rglob(f"*.{fn.__name__}-*.nbi")), fn.__name__
-    assert not compile_elsewhere("qualgrasp.certify.quality.bounds", "quality-hulls")  # marked: not again
+    assert not compile_elsewhere(sets.__name__, "quality-hulls")  # marked: not again
+
+
+def test_a_lock_file_that_cannot_be_opened_leaves_the_compiling_to_the_run(tmp_path, monkeypatch):
+    from qualgrasp.certify._kernels.jit import await_compiled, cache_dir, compile_elsewhere
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    (Path(cache_dir()) / "quality-hulls.lock").mkdir()  # not a file: os.open fails
+    assert not compile_elsewhere("qualgrasp.certify._kernels.sets", "quality-hulls")
+    await_compiled("quality-hulls", timeout=0.5)  # nobody holds a lock: at once, no error
+
+
+def test_a_file_system_without_locks_makes_nobody_wait(tmp_path, monkeypatch):
+    import errno
+    import time
+
+    from qualgrasp.certify._kernels import jit
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    (Path(jit.cache_dir()) / "quality-hulls.lock").touch()
+
+    def no_locks(fd, operation):
+        raise OSError(errno.ENOLCK, "No locks available")
+
+    def waited(seconds):
+        raise AssertionError("waited for a lock nobody can hold")
+
+    monkeypatch.setattr(jit.fcntl, "flock", no_locks)
+    monkeypatch.setattr(time, "sleep", waited)
+    assert not jit.compile_elsewhere("qualgrasp.certify._kernels.sets", "quality-hulls")
+    jit.await_compiled("quality-hulls")  # returns at once: the run compiles the set itself
 
 
 # Compile (or load) one kernel, then print how many kernels numba compiled and where the package is.

@@ -42,12 +42,22 @@ def test_the_first_grasp_gives_the_dimensions(tmp_path, started):
     assert started == [[2], [3]]
 
 
-@pytest.mark.parametrize("extra", [["--no-quality"], ["--help"], ["--mesh", "m.obj"], ["--mesh=m.obj"],
-                                   ["--dask", "local"]])
+@pytest.mark.parametrize("extra", [["--no-quality"], ["--quality", "--no-quality"], ["--help"], ["--mesh", "m.obj"],
+                                   ["--mesh=m.obj"], ["--dask", "local"]])
 def test_nothing_starts_where_the_run_needs_no_quality_kernels_here(tmp_path, started, extra):
     planar = _file(tmp_path, "p.jsonl", json.dumps(GRASP2).encode() + b"\n")
     warmup.compile_ahead_for_command([planar, "-o", "out.jsonl", *extra])
     assert started == []
+
+
+def test_the_last_quality_toggle_counts_and_an_output_is_needed(tmp_path, started):
+    planar = _file(tmp_path, "p.jsonl", json.dumps(GRASP2).encode() + b"\n")
+    warmup.compile_ahead_for_command([planar])  # no output: the command refuses it, nothing starts
+    warmup.compile_ahead_for_command([planar, "--", "-o"])  # after --, -o is no option
+    assert started == []
+    warmup.compile_ahead_for_command([planar, "--no-quality", "--output", "out.jsonl", "--quality"])
+    warmup.compile_ahead_for_command([planar, "--output=out.jsonl"])
+    assert started == [[2], [2]]
 
 
 @pytest.mark.parametrize("data", [

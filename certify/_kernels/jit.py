@@ -25,14 +25,17 @@ constants they import, so that a changed kernel source starts a fresh cache.
 
 A *kernel set* (a module's ``KERNEL_SETS[name]``, pairs for :func:`precompile`) can be compiled
 into the cache by another process while this one works on something else: on a cold cache the
-first ``qualgrasp certify`` with quality compiles closure's kernels here and quality's in a second
-process, on a second core (:func:`compile_elsewhere`, :func:`await_compiled`). The cache folder
-then holds ``NAME.compiled`` once the set is in it, and ``NAME.lock``, locked (``flock``) by the
-process compiling it. Where ``fcntl`` is missing (Windows) every process compiles what it needs.
+first ``qualgrasp certify`` with quality compiles closure's kernels and quality's two sets in
+processes of their own, on the other cores (:func:`compile_elsewhere`, :func:`await_compiled`,
+:mod:`qualgrasp.certify.warmup`). The cache folder then holds ``NAME.compiled`` once the set is in
+it, and ``NAME.lock``, locked (``flock``) by the process compiling it. Where ``fcntl`` is missing
+(Windows), or the cache's file system has no locks or a lock file cannot be opened, every process
+compiles what it needs.
 """
 
 from __future__ import annotations
 
+import errno
 import functools
 import hashlib
 import importlib
@@ -216,6 +219,9 @@ def compiled_here(signatures: Iterable[tuple[Callable, tuple]]) -> bool:
 #: Longest wait (s) for another process compiling a kernel set (:func:`await_compiled`): past it
 #: the waiting process compiles the set itself.
 WAIT_SECONDS = 300.0
+#: The ``flock`` errors meaning that another process holds the lock (any other: a file system
+#: without locks, where nobody waits).
+_BUSY = (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES)
 
 
 def _set_files(name: str) -> tuple[str, str] | None:
@@ -236,10 +242,13 @@ def compile_elsewhere(module: str, name: str) -> bool:
     files = _set_files(name)
     if files is None or os.path.exists(files[1]):
         return False
-    fd = os.open(files[0], os.O_RDWR | os.O_CREAT, 0o644)
+    try:  # a lock file this user cannot open (another user's, a folder): compile where needed
+        fd = os.open(files[0], os.O_RDWR | os.O_CREAT, 0o644)
+    except OSError:
+        return False
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:  # another process compiles it
+    except OSError:  # another process compiles it, or the file system has no locks
         os.close(fd)
         return False
     code = f"from qualgrasp.certify._kernels.jit import compile_set; compile_set({module!r}, {name!r})"
@@ -269,8 +278,8 @@ def await_compiled(name: str, timeout: float = WAIT_SECONDS) -> None:
             try:
                 fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
                 return
-            except OSError:
-                if time.monotonic() > end:
+            except OSError as err:
+                if err.errno not in _BUSY or time.monotonic() > end:  # not held (no locks here), or too long
                     return
                 time.sleep(0.02)
     finally:

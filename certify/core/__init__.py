@@ -27,6 +27,7 @@ __getattr__, __dir__ = lazy_names(__name__, {
     ".validation": ("MAX_CONTACTS",),
     ".wrench": ("contact_frame", "cross", "torque"),
 })
+del lazy_names  # not a name of this package
 
 __all__ = [
     "Contact", "Grasp", "grasp_from_dict", "grasp_to_dict", "MAX_CONTACTS",

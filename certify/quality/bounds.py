@@ -106,7 +106,7 @@ from ..solvers.clarabel_direct import settings
 
 __all__ = ["Norm", "NORMS", "Epsilon", "epsilon", "epsilons", "planar_epsilon", "planar_epsilons",
            "planar_epsilon_rows", "planar_epsilon_columns", "epsilon_of_points", "check_norm", "L1_ENUMERATION_MAX",
-           "LINF_ENUMERATION_MAX", "SUMS_MAX", "MAX_VERTICES", "SOCP_COST", "KERNEL_SETS"]
+           "LINF_ENUMERATION_MAX", "SUMS_MAX", "MAX_VERTICES", "SOCP_COST"]
 
 #: A norm of the grasp wrench space.
 Norm = Literal["L1", "Linf"]
