@@ -19,8 +19,8 @@ import json
 from pathlib import Path
 from typing import Iterable, Sequence
 
+from ._kernels import sets as kernel_sets
 from ._kernels.jit import compile_elsewhere, compiled_here
-from ._kernels.sets import EPSILON_SETS, KERNEL_SETS
 
 __all__ = ["compile_ahead", "compile_ahead_for_command", "first_grasp_dims", "PEEK_BYTES"]
 
@@ -42,9 +42,9 @@ def compile_ahead(dims: Iterable) -> None:
     >>> compile_ahead([2])   # the cache holds them: nothing to do
     """
     for dim in sorted({int(d) for d in dims} & {2, 3}):
-        for name in EPSILON_SETS[dim]:
-            if not compiled_here(KERNEL_SETS[name]):
-                compile_elsewhere(__name__.rpartition(".")[0] + "._kernels.sets", name)
+        for name in kernel_sets.EPSILON_SETS[dim]:
+            if not compiled_here(kernel_sets.KERNEL_SETS[name]):
+                compile_elsewhere(kernel_sets.__name__, name)
 
 
 def first_grasp_dims(path: str | Path) -> set[int]:
@@ -85,7 +85,7 @@ def compile_ahead_for_command(args: Sequence[str]) -> None:
     naming a JSON Lines grasp file (:func:`first_grasp_dims`). Nothing without an output
     (``-o``), when the last of ``--quality`` and ``--no-quality`` is ``--no-quality``, with
     ``--help``, ``--mesh`` or ``--dask``, or when no argument names such a file (a Parquet input:
-    its run starts them once it has read its first chunk). The command parses and checks its
+    its run compiles them when it needs them, as ever). The command parses and checks its
     arguments afterwards, as ever: one it then refuses for a bad value leaves the kernels
     compiled in the cache, for the next run.
 
