@@ -87,8 +87,9 @@ import numpy as np  # noqa: E402
 
 from qualgrasp.certify import models as registry  # noqa: E402
 from qualgrasp.certify.batch import random_grasps  # noqa: E402
-from qualgrasp.certify.core.validation import (GraspData, check_contact, check_contacts, contact_data,  # noqa: E402
-                                               grasp_geometry, grasp_rules, param_names)
+from qualgrasp.certify.core.validation import (MIN_NORMAL, GraspData, check_contact, check_contacts,  # noqa: E402
+                                               contact_arrays, contact_data, grasp_geometry, grasp_rules, param_names)
+from qualgrasp.certify.models import MAX_LENGTH  # noqa: E402
 from qualgrasp.certify.core.grasp import _checked_of  # noqa: E402
 
 _FLOATS = st.one_of(
@@ -191,3 +192,71 @@ def test_the_scalar_rules_read_values_in_the_order_of_the_array_rules():
             Contact(p, [bad, 0.0])
     with pytest.raises(TypeError):
         Contact([0.0, 1.0], [bad, 0.0])
+
+
+def _special_floats(rng, shape):
+    """Floats of every scale with zeros, signed zeros, subnormals, infinities and NaN mixed in."""
+    x = rng.standard_normal(shape) * np.exp(rng.uniform(-40, 40, shape))
+    specials = np.array([0.0, -0.0, 5e-324, 1e-160, 1e154, 1e6, np.inf, -np.inf, np.nan, 1.0, -1.0])
+    pick = rng.random(shape) < 0.15
+    x[pick] = rng.choice(specials, int(pick.sum()))
+    return x
+
+
+def _reference_normals(n):
+    """The normals and lengths of the validation's rules written with numpy's row reductions (the
+    columns' loops must give the same floats)."""
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        scale = np.abs(n).max(axis=1)
+        safe = np.where(scale > 0, scale, 1.0)
+        norm = safe * np.sqrt(((n / safe[:, None]) ** 2).sum(axis=1))
+        unit = np.abs(norm - 1.0) <= 1e-12
+        plain = np.sqrt((n * n).sum(axis=1))
+        norm = np.where(np.isfinite(plain) & (plain > 1e-150), plain, norm)
+        return np.where(unit[:, None], n, n / np.where(norm > 0, norm, 1.0)[:, None]), norm
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_the_rules_on_arrays_give_the_row_reductions_values_bit_for_bit(dim):
+    """Normals, errors, centers and lengths of 30,000 contacts of every scale (unit ones too) equal
+    those of numpy's row reductions (``max``, ``sum``, ``all`` along a row), which the rules
+    compute column by column for speed."""
+    rng = np.random.default_rng(dim)
+    k = 30_000
+    p, n = _special_floats(rng, (k, dim)), _special_floats(rng, (k, dim))
+    unit = rng.random(k) < 0.3
+    n[unit] = rng.standard_normal((int(unit.sum()), dim))
+    n[unit] /= np.linalg.norm(n[unit], axis=1)[:, None]
+    checked = check_contacts(contact_arrays(p, n, "frictionless"))
+    n3 = np.zeros((k, 3))
+    n3[:, :dim] = np.where(np.isfinite(n), n, 0.0)
+    stored, norm = _reference_normals(n3)
+    with np.errstate(invalid="ignore"):
+        valid = ((np.abs(p) <= MAX_LENGTH).all(axis=1) & np.isfinite(n).all(axis=1) & (norm >= MIN_NORMAL))
+    assert np.array_equal(checked.error == None, valid)  # noqa: E711
+    assert 0.2 * k < valid.sum() < 0.9 * k
+    assert checked.n[valid].tobytes() == stored[valid].tobytes()
+    # grasps of 1 to 5 of the valid contacts: default center and length as the row reductions give them
+    P = np.where(np.isfinite(p), p, 0.0)[valid]
+    P[np.abs(P) > 1e6] = 1e6
+    count = rng.integers(1, 6, len(P) // 3)
+    count = count[np.cumsum(count) <= len(P)]
+    P = P[: count.sum()]
+    data = GraspData(count, np.zeros((len(count), 3)), np.full(len(count), -1), np.full(len(count), np.nan),
+                     np.zeros(len(count), bool), [None] * len(count), [None] * len(count), [{}] * len(count))
+    normal = np.zeros((len(P), dim))
+    normal[:, 0] = 1.0
+    grasps = grasp_rules(data, check_contacts(contact_arrays(P, normal, "frictionless")))
+    offsets = np.concatenate([[0], np.cumsum(count)])
+    ok = grasps.error == None  # noqa: E711
+    assert ok.mean() > 0.5
+    for i in np.flatnonzero(ok)[:3000]:
+        q = np.zeros((count[i], 3))
+        q[:, :dim] = P[offsets[i]:offsets[i + 1]]
+        c = grasps.center[i]
+        d = q - c
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            scale = np.abs(d).max(axis=1)
+            far = (scale * np.sqrt(((d / np.where(scale > 0, scale, 1.0)[:, None]) ** 2).sum(axis=1))).max()
+        size = np.nan_to_num(np.abs(q)).max()
+        assert grasps.length[i] == (far if far > 8 * 2.0**-53 * size else 1.0)

@@ -290,6 +290,7 @@ class _Assembler:
         self.out = None  # opened with the first part, so that nothing is left if no run starts
         self.next, self.ready = 0, set()
         self.schema, self.streaming = None, self.parquet  # the Parquet schema written as parts come
+        self.schemas: dict[int, pa.Schema] = {}  # of the parts streamed: the close needs them again
 
     def _open(self, schema: pa.Schema = RESULT_SCHEMA):
         """The output, opened on first use (Parquet: with the parts' schema, the results columns
@@ -305,26 +306,27 @@ class _Assembler:
             self.ready.remove(self.next)
             part = self.parts / _part_name(self.next, self.results)
             if self.parquet:
-                self._stream(part)
+                self._stream(part, self.next)
             else:
                 with part.open("rb") as fh:
                     shutil.copyfileobj(fh, self._open())
             self.next += 1
 
-    def _stream(self, part: Path) -> None:
+    def _stream(self, part: Path, index: int) -> None:
         """Append a Parquet part in the schema of the first (:func:`unified_schema` of it alone)
         while each part's schema adds nothing to it and its values convert; a part that would
         change it, or whose values do not convert, stops the appending and drops what was written
         (:meth:`_write_parquet` writes every part at the close)."""
         if not self.streaming:
             return
-        schema = _part_schema(part)
+        read = _read_part(part)  # one read for the schema and the rows: most parts are appended
+        schema = self.schemas[index] = read.schema
         if self.schema is None:
             self.schema = unified_schema([schema])
         table = None
         if unified_schema([self.schema, schema]).equals(self.schema, check_metadata=True):
             try:
-                table = conform(_read_part(part), self.schema)
+                table = conform(read, self.schema)
             except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError):
                 pass  # values the first part's types cannot hold (an integer past 2**53 in a float
                 # column) where the schema of all parts may (JSON text): the close decides
@@ -339,7 +341,7 @@ class _Assembler:
         carried from JSON rows may differ between parts, in presence or type), unless
         :meth:`_stream` has written them all in that schema already."""
         parts = [self.parts / _part_name(i, self.results) for i in range(n_chunks)]
-        schemas = [_part_schema(p) for p in parts]
+        schemas = [self.schemas[i] if i in self.schemas else _part_schema(p) for i, p in enumerate(parts)]
         schema = unified_schema(schemas) if parts else RESULT_SCHEMA
         if self.streaming and self.out is not None and schema.equals(self.schema, check_metadata=True):
             return

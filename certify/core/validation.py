@@ -242,6 +242,41 @@ class Checked:
     variant: np.ndarray
 
 
+def _row_max(a: np.ndarray) -> np.ndarray:
+    """``a.max(axis=1)`` of a (k, c) array, c >= 1, NaN propagating: the same values, column by
+    column (a reduction along a short axis is several times slower in numpy)."""
+    out = a[:, 0].copy()
+    for j in range(1, a.shape[1]):
+        np.maximum(out, a[:, j], out=out)
+    return out
+
+
+def _row_sum_of_squares(a: np.ndarray) -> np.ndarray:
+    """``(a ** 2).sum(axis=1)`` of a (k, c) array, c >= 1: the same floats (numpy sums a short
+    row from left to right, as here; the scalar :func:`_scaled_norm` too), column by column."""
+    out = a[:, 0] * a[:, 0]
+    for j in range(1, a.shape[1]):
+        out += a[:, j] * a[:, j]
+    return out
+
+
+def _row_fmax(a: np.ndarray) -> np.ndarray:
+    """The largest of each row of a (k, c) array ignoring NaN (NaN where the whole row is), as
+    ``np.fmax.reduce(a, axis=1)``, column by column."""
+    out = a[:, 0].copy()
+    for j in range(1, a.shape[1]):
+        np.fmax(out, a[:, j], out=out)
+    return out
+
+
+def _rows_all(mask: np.ndarray) -> np.ndarray:
+    """``mask.all(axis=1)`` of a (k, c) boolean array, c >= 1, column by column."""
+    out = mask[:, 0].copy()
+    for j in range(1, mask.shape[1]):
+        out &= mask[:, j]
+    return out
+
+
 def _plain(value: Any) -> Any:
     """A Python value of an Arrow scalar (``as_py``), other values as they are."""
     return value.as_py() if hasattr(value, "as_py") else value
@@ -250,12 +285,12 @@ def _plain(value: Any) -> Any:
 def _unit_normals(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Normals as stored (unit, or kept when unit to within 1e-12) and their lengths, without
     overflow for huge components."""
-    scale = np.abs(n).max(axis=1)
+    scale = _row_max(np.abs(n))
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         safe = np.where(scale > 0, scale, 1.0)
-        norm = safe * np.sqrt(((n / safe[:, None]) ** 2).sum(axis=1))
+        norm = safe * np.sqrt(_row_sum_of_squares(n / safe[:, None]))
         unit = np.abs(norm - 1.0) <= 1e-12
-        plain = np.sqrt((n * n).sum(axis=1))  # exact rounding as before for ordinary data
+        plain = np.sqrt(_row_sum_of_squares(n))  # exact rounding as before for ordinary data
         norm = np.where(np.isfinite(plain) & (plain > 1e-150), plain, norm)
         stored = np.where(unit[:, None], n, n / np.where(norm > 0, norm, 1.0)[:, None])
     return stored, norm
@@ -293,10 +328,10 @@ def check_contacts(data: ContactData) -> Checked:
     p = np.where(cols, data.p, 0.0)
     n = np.where(cols, data.n, 0.0)
     with np.errstate(invalid="ignore"):
-        fail(~(np.isfinite(p) & (np.abs(p) <= MAX_LENGTH)).all(axis=1),
+        fail(~_rows_all(np.abs(p) <= MAX_LENGTH),  # False for NaN and infinities too
              lambda j: f"p: NaN or infinite coordinate, or one beyond {MAX_LENGTH:g}: expected 2 (planar) "
                        f"or 3 (spatial) finite numbers, got {raw(j, 'p', list(p[j, :plen[j]]))}")
-        fail(~np.isfinite(n).all(axis=1),
+        fail(~_rows_all(np.isfinite(n)),
              lambda j: f"n: NaN or infinite coordinate: expected 2 (planar) or 3 (spatial) finite "
                        f"numbers, got {raw(j, 'n', list(n[j, :plen[j]]))}")
     stored, norm = _unit_normals(np.where(np.isfinite(n), n, 0.0))
@@ -543,10 +578,10 @@ point whose coordinates are within ``MAX_LENGTH`` (``2 sqrt(3) MAX_LENGTH``)."""
 def _reach(d: np.ndarray) -> np.ndarray:
     """Euclidean norms of the rows of ``d``, scaled so that neither tiny nor huge coordinates
     underflow or overflow (0 for rows that are not finite)."""
-    scale = np.abs(d).max(axis=1) if d.size else np.zeros(len(d))
+    scale = _row_max(np.abs(d)) if d.size else np.zeros(len(d))
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         safe = np.where(scale > 0, scale, 1.0)
-        norm = scale * np.sqrt(((d / safe[:, None]) ** 2).sum(axis=1))
+        norm = scale * np.sqrt(_row_sum_of_squares(d / safe[:, None]))
     return np.where(np.isfinite(norm), norm, 0.0)
 
 
@@ -632,8 +667,8 @@ def grasp_rules(data: GraspData, checked: Checked) -> CheckedGrasps:
     has = data.count > 0
     dim[has] = checked.dim[offsets[:-1][has]]
     if len(owner):
-        mixed = np.zeros(g, dtype=bool)
-        np.logical_or.at(mixed, owner, checked.dim != dim[owner])
+        mixed = np.zeros(g, dtype=bool)  # a grasp's contacts are consecutive: one reduceat (.at is slow)
+        mixed[has] = np.logical_or.reduceat(checked.dim != dim[owner], offsets[:-1][has])
         fail(mixed, lambda i: "contacts: mix dimensions "
                               f"{sorted(set(checked.dim[offsets[i]:offsets[i + 1]].tolist()))}; "
                               "a grasp is planar or spatial")
@@ -641,7 +676,7 @@ def grasp_rules(data: GraspData, checked: Checked) -> CheckedGrasps:
     fail(given & (data.clen != dim),
          lambda i: f"center: center has {data.clen[i]} coordinates, the contacts have {dim[i]}")
     with np.errstate(invalid="ignore"):
-        finite = (np.isfinite(data.center) & (np.abs(data.center) <= MAX_LENGTH)).all(axis=1)
+        finite = _rows_all(np.abs(data.center) <= MAX_LENGTH)  # False for NaN and infinities too
         fail(given & ~finite, lambda i: f"center: NaN or infinite coordinate, or one beyond {MAX_LENGTH:g}: "
                                         f"expected {dim[i]} finite numbers, got {show(data.raw.get((i, 'center')))}")
         L = data.length
@@ -664,7 +699,9 @@ def grasp_rules(data: GraspData, checked: Checked) -> CheckedGrasps:
         if has.any():
             far[has] = np.maximum.reduceat(_reach(checked.p - center[owner]), offsets[:-1][has])
             with np.errstate(invalid="ignore"):
-                size[has] = np.maximum.reduceat(np.nan_to_num(np.abs(checked.p)).max(axis=1), offsets[:-1][has])
+                # NaN as 0 and infinity as the largest float, as np.nan_to_num before the maximum would
+                top = np.nan_to_num(_row_fmax(np.abs(checked.p)))
+                size[has] = np.maximum.reduceat(top, offsets[:-1][has])
         # contacts that coincide up to the rounding of their centroid: no lever arm to scale
         apart = far > 8 * 2.0**-53 * size
         length[need_l] = np.where(apart[need_l], far[need_l], 1.0)
