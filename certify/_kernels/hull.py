@@ -32,19 +32,17 @@ PLANE_TOL = 2.0**-40
 
 @kernel
 def _farthest_first(d2):
-    """Indices of ``d2`` (squared distances; negative for points to leave out) from the largest
-    down, ties in index order, the negative ones last (selection: the sets are small, and this
-    compiles in a fraction of a sort)."""
+    """Indices of ``d2`` (squared distances, no NaN; negative for points to leave out) from the
+    largest down, ties in index order, the negative ones last (an insertion sort, stable: the sets
+    are small, and this compiles in a fraction of numpy's sort)."""
     n = d2.shape[0]
     order = np.empty(n, dtype=np.int64)
-    left = d2.copy()
-    for k in range(n):
-        best = 0
-        for i in range(1, n):
-            if left[i] > left[best]:
-                best = i
-        order[k] = best
-        left[best] = -np.inf
+    for k in range(n):  # insertion: a stable sort, largest first
+        j = k
+        while j > 0 and d2[order[j - 1]] < d2[k]:
+            order[j] = order[j - 1]
+            j -= 1
+        order[j] = k
     return order
 
 
@@ -155,6 +153,10 @@ def hull_faces(P):
     taken = np.zeros(n, dtype=np.bool_)
     for q in range(4):
         taken[first[q]] = True
+    live = np.empty(cap, dtype=np.int64)  # the live faces, ascending: the scan skips dead ones
+    nl = 4
+    for f in range(4):
+        live[f] = f
     visible = np.empty(cap, dtype=np.int64)
     edges = np.empty((3 * cap, 2), dtype=np.int64)
     nxt = np.full(n, -1, dtype=np.int64)
@@ -169,12 +171,12 @@ def hull_faces(P):
         if taken[p]:
             continue
         nv = 0
-        for f in range(F):
-            if alive[f]:
-                h = plane[f, 0] * P[p, 0] + plane[f, 1] * P[p, 1] + plane[f, 2] * P[p, 2] - plane[f, 3]
-                if h > tol * size[f]:
-                    visible[nv] = f
-                    nv += 1
+        for q in range(nl):
+            f = live[q]
+            h = plane[f, 0] * P[p, 0] + plane[f, 1] * P[p, 1] + plane[f, 2] * P[p, 2] - plane[f, 3]
+            if h > tol * size[f]:
+                visible[nv] = f
+                nv += 1
         if nv == 0:
             continue
         ne = 0
@@ -185,9 +187,10 @@ def hull_faces(P):
                 twin = False
                 for q2 in range(nv):
                     g = visible[q2]
-                    for e2 in range(3):
-                        if face[g, e2] == b and face[g, (e2 + 1) % 3] == a:
-                            twin = True
+                    if ((face[g, 0] == b and face[g, 1] == a) or (face[g, 1] == b and face[g, 2] == a)
+                            or (face[g, 2] == b and face[g, 0] == a)):
+                        twin = True
+                        break
                 if not twin:
                     edges[ne, 0], edges[ne, 1] = a, b
                     ne += 1
@@ -212,6 +215,12 @@ def hull_faces(P):
             return empty
         for q in range(nv):
             alive[visible[q]] = False
+        w = 0
+        for q in range(nl):
+            if alive[live[q]]:
+                live[w] = live[q]
+                w += 1
+        nl = w
         for q in range(ne):
             a, b = edges[q, 0], edges[q, 1]
             nn = _plane(P, a, b, p, plane[F])
@@ -220,6 +229,8 @@ def hull_faces(P):
             face[F, 0], face[F, 1], face[F, 2] = a, b, p
             size[F] = nn
             alive[F] = True
+            live[nl] = F
+            nl += 1
             F += 1
         taken[p] = True
         if F > cap - 2 * n:  # compact: keep the live faces at the front
@@ -235,7 +246,9 @@ def hull_faces(P):
                     w += 1
             for f in range(w, F):
                 alive[f] = False
-            F = w
+            F = nl = w
+            for f in range(w):
+                live[f] = f
     count = 0
     for f in range(F):
         if alive[f]:
