@@ -443,3 +443,14 @@ def test_face_normals_in_3d_are_leibniz_sums_bit_for_bit():
             _leibniz_normal.py_func(D, ED, perms, signs, g, *loop)
         for a, b in zip(fast, loop):
             assert np.array_equal(a.view(np.uint64), b.view(np.uint64)), (D, ED, a, b)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.one_of(st.sampled_from([0.0, 1.0, 2.0, -1.0, np.inf]), st.floats(-1, 4)), min_size=1, max_size=40))
+def test_insertion_order_is_a_stable_sort_largest_first(d2):
+    """The hulls insert points farthest first, ties in index order, the left-out (negative) ones
+    last: numpy's stable argsort of ``-d2``, whatever the ties and infinities."""
+    from qualgrasp.certify._kernels.hull import _farthest_first
+
+    d2 = np.array(d2)
+    assert _farthest_first(d2).tolist() == np.argsort(-d2, kind="stable").tolist()
