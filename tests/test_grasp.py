@@ -89,6 +89,7 @@ from qualgrasp.certify import models as registry  # noqa: E402
 from qualgrasp.certify.batch import random_grasps  # noqa: E402
 from qualgrasp.certify.core.validation import (MIN_NORMAL, GraspData, check_contact, check_contacts,  # noqa: E402
                                                contact_arrays, contact_data, grasp_geometry, grasp_rules, param_names)
+from qualgrasp.certify.files.columns import value_columns  # noqa: E402
 from qualgrasp.certify.models import MAX_LENGTH  # noqa: E402
 from qualgrasp.certify.core.grasp import _checked_of  # noqa: E402
 
@@ -218,7 +219,7 @@ def _reference_normals(n):
 
 @pytest.mark.parametrize("dim", [2, 3])
 def test_the_rules_on_arrays_give_the_row_reductions_values_bit_for_bit(dim):
-    """Normals, errors, centers and lengths of 30,000 contacts of every scale (unit ones too) equal
+    """Normals, errors and default lengths of 30,000 contacts of every scale (unit ones too) equal
     those of numpy's row reductions (``max``, ``sum``, ``all`` along a row), which the rules
     compute column by column for speed."""
     rng = np.random.default_rng(dim)
@@ -260,3 +261,19 @@ def test_the_rules_on_arrays_give_the_row_reductions_values_bit_for_bit(dim):
             far = (scale * np.sqrt(((d / np.where(scale > 0, scale, 1.0)[:, None]) ** 2).sum(axis=1))).max()
         size = np.nan_to_num(np.abs(q)).max()
         assert grasps.length[i] == (far if far > 8 * 2.0**-53 * size else 1.0)
+
+
+def test_grasps_mixing_dimensions_and_empty_grasps_anywhere_get_their_own_errors():
+    """The dimension check reduces over each grasp's consecutive contacts: grasps without
+    contacts (first, last, in between) and mixed ones among valid ones each get their own error."""
+    rng = np.random.default_rng(4)
+    contact = {2: {"p": [0.0, 0.0], "n": [1.0, 0.0]}, 3: {"p": [0.0, 0.0, 0.0], "n": [1.0, 0.0, 0.0]}}
+    dims = [[], [2, 2]] + [list(rng.choice([2, 3], rng.integers(0, 5))) for _ in range(2000)] + [[3, 2], []]
+    cols = value_columns([{"contacts": [contact[int(d)] for d in ds]} for ds in dims])
+    for ds, error in zip(dims, cols.checked.error):
+        if not ds:
+            assert error == "contacts: a grasp needs at least one contact"
+        elif len(set(ds)) > 1:
+            assert error == "contacts: mix dimensions [2, 3]; a grasp is planar or spatial"
+        else:
+            assert error is None

@@ -319,17 +319,18 @@ class _Assembler:
         (:meth:`_write_parquet` writes every part at the close)."""
         if not self.streaming:
             return
-        read = _read_part(part)  # one read for the schema and the rows: most parts are appended
-        schema = self.schemas[index] = read.schema
-        if self.schema is None:
-            self.schema = unified_schema([schema])
         table = None
-        if unified_schema([self.schema, schema]).equals(self.schema, check_metadata=True):
-            try:
+        try:
+            read = _read_part(part)  # one read for the schema and the rows: most parts are appended
+            schema = self.schemas[index] = read.schema
+            if self.schema is None:
+                self.schema = unified_schema([schema])
+            if unified_schema([self.schema, schema]).equals(self.schema, check_metadata=True):
                 table = conform(read, self.schema)
-            except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError):
-                pass  # values the first part's types cannot hold (an integer past 2**53 in a float
-                # column) where the schema of all parts may (JSON text): the close decides
+        except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError):
+            pass  # values the first part's types cannot hold (an integer past 2**53 in a float
+            # column) where the schema of all parts may (JSON text), or a part that does not read:
+            # the close decides
         if table is None:
             self.streaming = False
             self.abort()
