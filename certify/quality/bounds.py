@@ -270,7 +270,9 @@ def _hull_minimum(W, owner, m, faces):
     at the normals (computed as the enumeration computes them) of the faces nearest the origin."""
     tri = np.sort(faces, axis=1)
     A, B, C = W.T[tri[:, 0]], W.T[tri[:, 1]], W.T[tri[:, 2]]
-    n = np.cross(B - A, C - A)
+    D, F = B - A, C - A  # np.cross's products and differences written out: np.cross costs 30 us a call
+    n = np.stack([D[:, 1] * F[:, 2] - D[:, 2] * F[:, 1], D[:, 2] * F[:, 0] - D[:, 0] * F[:, 2],
+                  D[:, 0] * F[:, 1] - D[:, 1] * F[:, 0]], axis=1)
     norm = np.linalg.norm(n, axis=1)
     good = norm > 0
     n = n[good] / norm[good, None]
@@ -689,7 +691,7 @@ def _support_surface(W, E, owner, m, eps, u, deadline):
     def fresh(rows):
         out = []
         for v, r in zip(rows, planar_support_choices(W, owner, m, np.array(rows))):
-            key = tuple(r)
+            key = r.tobytes()  # the choices (int64): equal rows, equal bytes; cheaper than a tuple
             if key not in seen:
                 seen.add(key)
                 out.append(v)

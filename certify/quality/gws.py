@@ -217,8 +217,11 @@ def planar_support_choice(W: np.ndarray, owner: np.ndarray, m: int, v: np.ndarra
     """The vertex of planar ``support`` evidence along ``v``: for each contact the first of its
     generators (columns of ``W``, ``owner`` sorted) with the largest ``v @ g``, or -1 (the
     origin) when that is not positive."""
-    vals = v @ W
-    start = np.searchsorted(owner, np.arange(m))
+    return _choice(v @ W, owner, np.searchsorted(owner, np.arange(m)))
+
+
+def _choice(vals: np.ndarray, owner: np.ndarray, start: np.ndarray) -> np.ndarray:
+    """:func:`planar_support_choice` from the values ``v @ W`` and each contact's first generator."""
     best = np.maximum.reduceat(vals, start)
     k = len(vals)
     first = np.minimum.reduceat(np.where(vals == best[owner], np.arange(k), k), start)
@@ -233,8 +236,11 @@ def planar_support_choices(W, owner, m, dirs: np.ndarray) -> np.ndarray:
     dirs = np.ascontiguousarray(dirs, dtype=float).reshape(-1, 3)
     R, sure = support_choices(np.ascontiguousarray(W, dtype=float), np.ascontiguousarray(owner, dtype=np.int64),
                               m, dirs)
-    for q in np.flatnonzero(~sure):
-        R[q] = planar_support_choice(W, owner, m, dirs[q])
+    unsure = np.flatnonzero(~sure)
+    if len(unsure):
+        start = np.searchsorted(owner, np.arange(m))
+        for q in unsure:
+            R[q] = _choice(dirs[q] @ W, owner, start)
     return R
 
 
