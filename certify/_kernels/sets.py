@@ -20,16 +20,20 @@ from .surface import cycle_code, face_bounds, face_bounds_laplace, orient_cycle
 
 __all__ = ["KERNEL_SETS", "EPSILON_SETS"]
 
+#: Kernels in more than one set, with the one argument list each is called with: a surface's
+#: closure, and the orientation of qhull's faces where the compiled hulls decline.
+_CYCLE = (cycle_code, (I2, INT))
+_ORIENT = (orient_cycle, (I2, INT, INT, BOOL))
 #: The kernels checking planar surfaces, with the argument types the epsilons call them with:
 #: compiled before the time limit's clock runs (``_after_compiling`` of :mod:`qualgrasp.certify.quality.bounds`).
-_CHECK_KERNELS = ((face_bounds, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)))
+_CHECK_KERNELS = ((face_bounds, (F2, F2, I2, I2, F1)), _CYCLE)
 #: The kernels the epsilon of spatial grasps calls: the support points, the checks of 6-D faces
 #: and the 6-D hulls.
 _SURFACE_KERNELS = (
     (support_points, (F2, F2, F2, F2, I1, I1, BOOL, B1, I1, I2, I1, F2, F2, F1, F1, F1, F1)),
-    (face_bounds_laplace, (F2, F2, I2, I2, F1)), (cycle_code, (I2, INT)),
+    (face_bounds_laplace, (F2, F2, I2, I2, F1)), _CYCLE,
     (hull_grow, (F2, I2, F2, F1, B1, INT, F1, INT)), (weakest_plane, (F2, F1, B1, INT)), (live_facets, (I2, B1, INT)),
-    (orient_cycle, (I2, INT, INT, BOOL)))
+    _ORIENT)
 #: The same for planar grasps, in four sets: these, ...
 _PLANAR_KERNELS = _CHECK_KERNELS + (
     (planar_generators, (F2, F2, F1, F1, F1, FLOAT, I1, F1, F1, F2, F2)),
@@ -61,7 +65,7 @@ _LARGE_KERNELS = (
     (support_choices, (F2, I1, INT, F2)),
     (vertex_sums, (F2, F2, I2)),
     (face_planes, (F2, I2)),
-    (orient_cycle, (I2, INT, INT, BOOL)),
+    _ORIENT,
 )
 #: Those kernel sets by name (:func:`~qualgrasp.certify.warmup.compile_ahead`; :mod:`qualgrasp.certify._kernels.jit`).
 KERNEL_SETS = {"quality-planar": _PLANAR_KERNELS, "quality-hulls": _HULL_KERNELS,

@@ -242,38 +242,13 @@ class Checked:
     variant: np.ndarray
 
 
-def _row_max(a: np.ndarray) -> np.ndarray:
-    """``a.max(axis=1)`` of a (k, c) array, c >= 1, NaN propagating: the same values, column by
-    column (a reduction along a short axis is several times slower in numpy)."""
+def _by_column(ufunc: np.ufunc, a: np.ndarray) -> np.ndarray:
+    """``ufunc.reduce(a, axis=1)`` of a (k, c) array, c >= 1, computed column by column from left
+    to right: the same values (numpy reduces a short row from left to right too, as the scalar
+    :func:`_scaled_norm` sums), several times faster than a reduction along a short axis."""
     out = a[:, 0].copy()
     for j in range(1, a.shape[1]):
-        np.maximum(out, a[:, j], out=out)
-    return out
-
-
-def _row_sum_of_squares(a: np.ndarray) -> np.ndarray:
-    """``(a ** 2).sum(axis=1)`` of a (k, c) array, c >= 1: the same floats (numpy sums a short
-    row from left to right, as here; the scalar :func:`_scaled_norm` too), column by column."""
-    out = a[:, 0] * a[:, 0]
-    for j in range(1, a.shape[1]):
-        out += a[:, j] * a[:, j]
-    return out
-
-
-def _row_fmax(a: np.ndarray) -> np.ndarray:
-    """The largest of each row of a (k, c) array ignoring NaN (NaN where the whole row is), as
-    ``np.fmax.reduce(a, axis=1)``, column by column."""
-    out = a[:, 0].copy()
-    for j in range(1, a.shape[1]):
-        np.fmax(out, a[:, j], out=out)
-    return out
-
-
-def _rows_all(mask: np.ndarray) -> np.ndarray:
-    """``mask.all(axis=1)`` of a (k, c) boolean array, c >= 1, column by column."""
-    out = mask[:, 0].copy()
-    for j in range(1, mask.shape[1]):
-        out &= mask[:, j]
+        ufunc(out, a[:, j], out=out)
     return out
 
 
@@ -285,12 +260,12 @@ def _plain(value: Any) -> Any:
 def _unit_normals(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Normals as stored (unit, or kept when unit to within 1e-12) and their lengths, without
     overflow for huge components."""
-    scale = _row_max(np.abs(n))
+    scale = _by_column(np.maximum, np.abs(n))
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         safe = np.where(scale > 0, scale, 1.0)
-        norm = safe * np.sqrt(_row_sum_of_squares(n / safe[:, None]))
+        norm = safe * np.sqrt(_by_column(np.add, (n / safe[:, None]) ** 2))
         unit = np.abs(norm - 1.0) <= 1e-12
-        plain = np.sqrt(_row_sum_of_squares(n))  # exact rounding as before for ordinary data
+        plain = np.sqrt(_by_column(np.add, n * n))  # exact rounding as before for ordinary data
         norm = np.where(np.isfinite(plain) & (plain > 1e-150), plain, norm)
         stored = np.where(unit[:, None], n, n / np.where(norm > 0, norm, 1.0)[:, None])
     return stored, norm
@@ -328,10 +303,10 @@ def check_contacts(data: ContactData) -> Checked:
     p = np.where(cols, data.p, 0.0)
     n = np.where(cols, data.n, 0.0)
     with np.errstate(invalid="ignore"):
-        fail(~_rows_all(np.abs(p) <= MAX_LENGTH),  # False for NaN and infinities too
+        fail(~_by_column(np.logical_and, np.abs(p) <= MAX_LENGTH),  # False for NaN and infinities too
              lambda j: f"p: NaN or infinite coordinate, or one beyond {MAX_LENGTH:g}: expected 2 (planar) "
                        f"or 3 (spatial) finite numbers, got {raw(j, 'p', list(p[j, :plen[j]]))}")
-        fail(~_rows_all(np.isfinite(n)),
+        fail(~_by_column(np.logical_and, np.isfinite(n)),
              lambda j: f"n: NaN or infinite coordinate: expected 2 (planar) or 3 (spatial) finite "
                        f"numbers, got {raw(j, 'n', list(n[j, :plen[j]]))}")
     stored, norm = _unit_normals(np.where(np.isfinite(n), n, 0.0))
@@ -578,10 +553,10 @@ point whose coordinates are within ``MAX_LENGTH`` (``2 sqrt(3) MAX_LENGTH``)."""
 def _reach(d: np.ndarray) -> np.ndarray:
     """Euclidean norms of the rows of ``d``, scaled so that neither tiny nor huge coordinates
     underflow or overflow (0 for rows that are not finite)."""
-    scale = _row_max(np.abs(d)) if d.size else np.zeros(len(d))
+    scale = _by_column(np.maximum, np.abs(d)) if d.size else np.zeros(len(d))
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         safe = np.where(scale > 0, scale, 1.0)
-        norm = scale * np.sqrt(_row_sum_of_squares(d / safe[:, None]))
+        norm = scale * np.sqrt(_by_column(np.add, (d / safe[:, None]) ** 2))
     return np.where(np.isfinite(norm), norm, 0.0)
 
 
@@ -676,7 +651,7 @@ def grasp_rules(data: GraspData, checked: Checked) -> CheckedGrasps:
     fail(given & (data.clen != dim),
          lambda i: f"center: center has {data.clen[i]} coordinates, the contacts have {dim[i]}")
     with np.errstate(invalid="ignore"):
-        finite = _rows_all(np.abs(data.center) <= MAX_LENGTH)  # False for NaN and infinities too
+        finite = _by_column(np.logical_and, np.abs(data.center) <= MAX_LENGTH)  # False for NaN and infinities too
         fail(given & ~finite, lambda i: f"center: NaN or infinite coordinate, or one beyond {MAX_LENGTH:g}: "
                                         f"expected {dim[i]} finite numbers, got {show(data.raw.get((i, 'center')))}")
         L = data.length
@@ -700,7 +675,7 @@ def grasp_rules(data: GraspData, checked: Checked) -> CheckedGrasps:
             far[has] = np.maximum.reduceat(_reach(checked.p - center[owner]), offsets[:-1][has])
             with np.errstate(invalid="ignore"):
                 # NaN as 0 and infinity as the largest float, as np.nan_to_num before the maximum would
-                top = np.nan_to_num(_row_fmax(np.abs(checked.p)))
+                top = np.nan_to_num(_by_column(np.fmax, np.abs(checked.p)))
                 size[has] = np.maximum.reduceat(top, offsets[:-1][has])
         # contacts that coincide up to the rounding of their centroid: no lever arm to scale
         apart = far > 8 * 2.0**-53 * size
