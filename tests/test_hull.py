@@ -123,10 +123,12 @@ _evidence = st.builds(Evidence, _kinds, _direction, _ints, _floats, _ints)
 
 
 @settings(max_examples=60, deadline=None)
-@given(st.lists(st.one_of(st.none(), st.tuples(_evidence, _evidence)), max_size=12), st.integers(1, 3))
-def test_evidence_columns_are_the_rows_and_their_arrow_column(pairs, split):
-    """Rows assembled from blocks give back each row's evidence, and their results column is the
-    one Arrow builds from the rows' JSON dicts (the route the columns replace)."""
+@given(st.lists(st.one_of(st.none(), st.tuples(_evidence, _evidence)), max_size=12), st.integers(1, 3),
+       st.booleans())
+def test_evidence_columns_are_the_rows_and_their_arrow_column(pairs, split, backwards):
+    """Rows assembled from blocks, in row order or not, give back each row's evidence, and their
+    results column is the one Arrow builds from the rows' JSON dicts (the route the columns
+    replace)."""
     import pyarrow as pa
 
     from qualgrasp.certify.batch._arrow import evidence_array
@@ -136,11 +138,11 @@ def test_evidence_columns_are_the_rows_and_their_arrow_column(pairs, split):
     at = np.array([i for i, p in enumerate(pairs) if p is not None], dtype=np.int64)
     cols = []
     for j in range(2):
-        local = np.arange(len(at))
+        local = np.arange(len(at))[::-1 if backwards else 1]
         blocks = [EvidenceColumns.block(part, [pairs[at[q]][j] for q in part]) for part in np.array_split(local, split)
                   if len(part)]
         cols.append(EvidenceColumns.assemble(len(at), blocks))
-        assert [cols[j].row(q) for q in local] == [pairs[i][j] for i in at]
+        assert [cols[j].row(q) for q in range(len(at))] == [pairs[i][j] for i in at]
     got = evidence_array(cols[0], cols[1], at, len(pairs))
     want = pa.array([None if p is None else {"l1": p[0].to_json(), "linf": p[1].to_json()} for p in pairs],
                     type=RESULT_SCHEMA.field("eps_evidence").type)

@@ -169,6 +169,18 @@ def _positions(starts: np.ndarray, lengths: np.ndarray) -> np.ndarray:
     return np.repeat(starts - before, lengths) + np.arange(int(lengths.sum()))
 
 
+def _scatter(blocks, name: str, start: np.ndarray, dtype) -> np.ndarray:
+    """The items of list ``name`` of every block, each row's at ``start[row]``."""
+    full = [b for b in blocks if name in b[3] and len(b[3][name][1])]
+    if len(full) == 1 and len(full[0][3][name][1]) == start[-1] and np.all(np.diff(full[0][0]) > 0):
+        # one block in row order holds every item: they are already where they go
+        return np.ascontiguousarray(full[0][3][name][1], dtype=dtype)
+    values = np.empty(int(start[-1]), dtype=dtype)
+    for rows, _, _, lists in full:
+        values[_positions(start[rows], lists[name][0])] = lists[name][1]
+    return values
+
+
 @dataclass(frozen=True, eq=False)
 class EvidenceColumns:
     """The :class:`Evidence` of one norm for ``B`` rows, held flat (as a results column holds
@@ -232,11 +244,7 @@ class EvidenceColumns:
         for name, dtype in LIST_FIELDS:
             start = np.zeros(B + 1, dtype=np.int64)
             np.cumsum(lengths[name], out=start[1:])
-            values = np.empty(int(start[-1]), dtype=dtype)
-            for rows, _, _, lists in blocks:
-                if name in lists and len(lists[name][1]):
-                    values[_positions(start[rows], lists[name][0])] = lists[name][1]
-            out[name], out[name + "_start"] = values, start
+            out[name], out[name + "_start"] = _scatter(blocks, name, start, dtype), start
         return cls(kind, direction, **out)
 
 
