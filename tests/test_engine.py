@@ -141,6 +141,40 @@ def test_resume_refuses_other_options(grasp_files, tmp_path):
         certify_file(jsonl, out, resume=True, quality=False)
 
 
+def test_resume_without_a_chunk_size_keeps_the_interrupted_runs(grasp_files, tmp_path):
+    """A run stopped mid-way (here by its progress callback) and resumed without a chunk size
+    goes on with its own (the default would differ), and gives the uninterrupted run's rows."""
+    _, parquet, n = grasp_files
+    whole, out = tmp_path / "whole.parquet", tmp_path / "o.parquet"
+    certify_file(parquet, whole, quality=False, chunk_size=50, workers=2)
+    seen = []
+
+    def stop(size):
+        seen.append(size)
+        if len(seen) == 3:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        certify_file(parquet, out, quality=False, chunk_size=50, progress=stop)
+    summary = certify_file(parquet, out, quality=False, resume=True, workers=2)
+    assert summary.resumed_chunks >= 3 and summary.chunks == -(-n // 50)
+    assert pq.read_table(out).equals(pq.read_table(whole))
+
+
+def test_the_default_chunk_size_gives_each_worker_chunks(grasp_files, tmp_path):
+    """Without a chunk size a run cuts its input by :func:`chunk_size_for`: here every grasp in
+    one chunk (fewer than 1024), the same rows as small chunks give."""
+    from qualgrasp.certify.batch.engine import chunk_size_for
+
+    _, parquet, n = grasp_files
+    a, b = tmp_path / "a.parquet", tmp_path / "b.parquet"
+    assert certify_file(parquet, a, quality=False, workers=2).chunks == 1 == -(-n // chunk_size_for(n, 2))
+    certify_file(parquet, b, quality=False, chunk_size=64, workers=2)
+    assert pq.read_table(a).equals(pq.read_table(b))
+    assert [chunk_size_for(x, w) for x, w in ((10**6, 2), (80_000, 2), (80_000, 4), (0, 2))] == [16384, 10000, 5000,
+                                                                                                16384]
+
+
 def test_dask_local_cluster_matches_local_processes(grasp_files, tmp_path):
     pytest.importorskip("distributed")
     _, parquet, _ = grasp_files

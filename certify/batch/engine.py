@@ -53,11 +53,11 @@ from .chunk import Options, certify_chunk_results, status_counts
 from ..errors import CertifyError, GraspFileError
 from ..files.outputs import check_output, lock_output, write_error
 from ..files.results import RESULT_SCHEMA, RESULT_WRITE_OPTIONS, carried_clash
-from ..files.reader import (JSON_TEXT, Chunk, conform, input_format, is_parquet, iter_chunks, rows_to_table,
+from ..files.reader import (JSON_TEXT, Chunk, conform, count_grasps, input_format, is_parquet, iter_chunks, rows_to_table,
                             table_to_rows, unified_schema)
 from ..core.validation import TOP_LEVEL
 
-__all__ = ["RunSummary", "run", "check_paths", "certify_chunk", "encoded_chunk", "encode_part", "parts_folder",
+__all__ = ["RunSummary", "run", "CHUNK_SIZE", "chunk_size_for", "check_paths", "certify_chunk", "encoded_chunk", "encode_part", "parts_folder",
            "MADE_BY"]
 
 
@@ -208,6 +208,28 @@ def _manifest(grasps: Path, results: Path, chunk_size: int, options: Options) ->
     return {"made_by": MADE_BY, "input": str(grasps.resolve()), "input_size": st.st_size,
             "input_mtime_ns": st.st_mtime_ns, "output": str(results.resolve()), "chunk_size": chunk_size,
             "options": asdict(options)}
+
+
+#: Most grasps in a chunk when the run does not say (:func:`chunk_size_for`).
+CHUNK_SIZE = 16384
+
+
+def chunk_size_for(n_grasps: int | None, workers: int) -> int:
+    """The chunk size of a run of ``n_grasps`` grasps on ``workers`` processes that does not give
+    one: :data:`CHUNK_SIZE`, or fewer (down to 1024) so that each worker gets four chunks.
+
+    A chunk has fixed costs (the columnar kernels' calls, its part, a results row group), about
+    10 % of a planar grasp's time at 4096 grasps a chunk; but the last chunks of a small run
+    leave workers idle.
+
+    Examples
+    --------
+    >>> chunk_size_for(1_000_000, 2), chunk_size_for(20_000, 2), chunk_size_for(100, 2), chunk_size_for(None, 2)
+    (16384, 2500, 1024, 16384)
+    """
+    if not n_grasps:
+        return CHUNK_SIZE
+    return max(1024, min(CHUNK_SIZE, -(-n_grasps // (4 * workers))))
 
 
 def parts_folder(results: str | Path) -> Path:
@@ -487,7 +509,7 @@ def check_paths(grasps: Path, results: Path, chunk_size: int = 1, others: Sequen
 
 def run(grasps: str | Path, results: str | Path, *, options: Options = Options(),
         workers: int | None = None, dask: str | None = None, resume: bool = False,
-        chunk_size: int = 4096,
+        chunk_size: int | None = None,
         progress: Callable[[int], None] | None = None) -> RunSummary:
     """Certify the grasp set ``grasps`` into ``results`` in parallel (the input's format is
     recognised by content, the output's by extension; see :func:`check_paths` for what is
@@ -501,21 +523,35 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
         ``"local"`` for a dask LocalCluster of ``workers`` processes, or a scheduler address.
     resume : bool
         Keep the complete chunks of an interrupted run and certify only the rest.
-    chunk_size : int
-        Grasps per chunk (the unit of work, of checkpointing and of memory).
+    chunk_size : int, optional
+        Grasps per chunk (the unit of work, of checkpointing and of memory). Default: with
+        ``resume``, the interrupted run's; else :func:`chunk_size_for` the input's grasps and
+        the workers.
     progress : callable, optional
         Called with the number of grasps of each chunk as it completes (or is found complete).
     """
     grasps, results = Path(grasps), Path(results)
-    check_paths(grasps, results, chunk_size, options.source.inputs() if options.source is not None else ())
+    check_paths(grasps, results, 1 if chunk_size is None else chunk_size,
+                options.source.inputs() if options.source is not None else ())
     with lock_output(results, "-o"):
         try:
+            if chunk_size is None:
+                chunk_size = (resume and _resumed_chunk_size(results)
+                              or chunk_size_for(count_grasps(grasps), workers or os.cpu_count() or 1))
             return _run(grasps, results, options, workers, dask, resume, chunk_size, progress)
         except (OSError, pa.ArrowException) as err:
             raise CertifyError(_fault(err, results)) from None
         except BrokenProcessPool:  # a worker killed (a signal, out of memory) or crashed: no Python error to give
             raise CertifyError("a worker process ended abruptly (killed by a signal or by the system, for example "
                                "out of memory)" + _kept(results)) from None
+
+
+def _resumed_chunk_size(results: Path) -> int | None:
+    """The chunk size of the interrupted run of ``results`` (its checkpoint folder's manifest),
+    None when there is none."""
+    old = _owned(parts_folder(results), results)
+    size = None if old is None else old.get("chunk_size")
+    return size if isinstance(size, int) and not isinstance(size, bool) and size >= 1 else None
 
 
 def _fault(err: Exception, results: Path) -> str:

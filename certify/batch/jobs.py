@@ -32,7 +32,7 @@ __all__ = ["Summary", "certify_file", "verify_file"]
 
 def certify_file(grasps_path: str | Path, results_path: str | Path, *, method: Method = "fast",
                  progress: Callable[[int], None] | None = None, workers: int | None = 1,
-                 dask: str | None = None, resume: bool = False, chunk_size: int = 4096,
+                 dask: str | None = None, resume: bool = False, chunk_size: int | None = None,
                  quality: bool = True, eps_gap: float = 0.01, eps_budget: int = 200_000,
                  eps_time: float | None = 10.0, source: Any = None) -> RunSummary:
     """Certify every grasp of ``grasps_path`` into ``results_path``: one results row per grasp,

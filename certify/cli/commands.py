@@ -48,7 +48,9 @@ def certify_command(
     workers: int = typer.Option(0, help="Local worker processes (0: all cores)."),
     dask: str = typer.Option(None, "--dask", help="'local' for a dask LocalCluster, or a scheduler address."),
     resume: bool = typer.Option(False, "--resume", help="Continue an interrupted run, keeping its complete chunks."),
-    chunk_size: int = typer.Option(4096, help="Grasps per chunk (unit of work and checkpoint)."),
+    chunk_size: int = typer.Option(None, help="Grasps per chunk (unit of work and checkpoint; default 16384, "
+                                   "fewer for a small input so that each worker gets four chunks; with "
+                                   "--resume, the interrupted run's)."),
     mesh: Path = typer.Option(None, "--mesh", help="Read GRASPS as gripper poses (JSON Lines or Parquet, as for "
                               "'qualgrasp contacts') and close each on this mesh (OBJ, STL, PLY, GLB, OFF) "
                               "first: contacts and certificates in one run, one results row per pose."),
@@ -86,7 +88,7 @@ def certify_command(
         fail(f"--eps-budget must be at least 1 direction cell, got {eps_budget}")
     if workers < 0:
         fail(f"--workers must be 0 (all cores) or a number of processes, got {workers}")
-    if chunk_size < 1:
+    if chunk_size is not None and chunk_size < 1:
         fail(f"--chunk-size must be at least 1 grasp, got {chunk_size}")
     mesh_options = {k: v for k, v in dict(gripper=gripper, convention=convention, units=units, mu=mu, model=model,
                                           mass=mass, points=points, hold=hold, gravity=gravity,
