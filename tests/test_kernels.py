@@ -1,13 +1,17 @@
 """Compiled helpers against their numpy meaning: the stable argsorts the kernels share (merge and
-radix), and the
+radix), the
 projection of a Farkas direction off its tight blocks, which must leave it orthogonal to every
-tight column however dependent those columns are."""
+tight column however dependent those columns are, and the planar epsilon enumeration against its
+definition in plain Python floats."""
+
+import math
 
 import numpy as np
 from hypothesis import given, settings, strategies as st
 from hypothesis.extra.numpy import arrays
 
 from qualgrasp.certify._kernels.cones import farkas_direction
+from qualgrasp.certify._kernels.epsilon import planar_epsilon_one
 from qualgrasp.certify._kernels.order import radix_argsort, stable_argsort
 
 
@@ -44,3 +48,61 @@ def test_farkas_direction_leaves_no_component_along_dependent_tight_columns():
         ok, out, is_tight = farkas_direction(C, *arrays_, noisy, 1e-7)
         assert ok and is_tight[: tight.shape[1]].all() and not is_tight[tight.shape[1]:].any()
         assert np.abs(tight.T @ out).max() <= 1e-13 * np.abs(C).max()
+
+
+def _support(W, owner, m, u, linf):
+    """The planar GWS's support at ``u`` as the kernels define it: per contact the largest
+    ``u . g`` of its generators (at least +0.0), in contact order summed (L-infinity) or maxed."""
+    out = 0.0
+    for i in range(m):
+        top = 0.0
+        for j in np.flatnonzero(owner == i):
+            v = W[0, j] * u[0] + W[1, j] * u[1] + W[2, j] * u[2]
+            top = v if v > top else top
+        out = out + top if linf else (top if top > out else out)
+    return out
+
+
+def _epsilon_by_definition(W, owner, m, linf):
+    """Every candidate normal (pairs of edges, L-infinity; triples of generators, L1) evaluated
+    in full at ``+u`` then ``-u``, the least kept (a later equal value does not replace it)."""
+    k = W.shape[1]
+    E = [tuple(W[:, a]) for a in range(k)]
+    if linf:
+        E += [tuple(W[:, a] - W[:, c]) for a in range(k) for c in range(a + 1, k) if owner[a] == owner[c]]
+        pairs = [(E[a], E[c]) for a in range(len(E)) for c in range(a + 1, len(E))]
+    else:
+        pairs = [(np.subtract(E[c], E[a]), np.subtract(E[q], E[a]))
+                 for a in range(k) for c in range(a + 1, k) for q in range(c + 1, k)]
+    scale = 0.0
+    for e in E:
+        scale = max(scale, abs(e[0]) + abs(e[1]) + abs(e[2]))
+    tiny = 1e-12 * max(1.0, scale * scale)
+    best, arg = math.inf, (0.0, 0.0, 0.0)
+    for x, y in pairs:
+        u = (x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0])
+        nu = math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
+        if nu <= tiny:
+            continue
+        u = (u[0] / nu, u[1] / nu, u[2] / nu)
+        for w in (u, (-u[0], -u[1], -u[2])):
+            value = _support(W, owner, m, w, linf)
+            if value < best:
+                best, arg = value, w
+    return best, arg
+
+
+_entries = st.integers(-3, 3).map(float) | st.floats(-1e3, 1e3, allow_nan=False, allow_subnormal=False)
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.lists(st.integers(1, 3), min_size=1, max_size=4), st.data(), st.booleans())
+def test_planar_epsilon_enumeration_is_its_definition_bit_for_bit(sizes, data, linf):
+    """The enumeration (which stops a candidate's support early once it cannot win) gives the
+    full enumeration's epsilon and direction exactly, ties and zeros included."""
+    owner = np.repeat(np.arange(len(sizes)), sizes)
+    W = np.array(data.draw(st.lists(_entries, min_size=3 * len(owner), max_size=3 * len(owner)))).reshape(3, -1)
+    eps, arg = planar_epsilon_one(W, owner, len(sizes), linf)
+    want, want_arg = _epsilon_by_definition(W, owner, len(sizes), linf)
+    assert float(eps).hex() == want.hex()
+    assert [x.hex() for x in arg.tolist()] == [float(x).hex() for x in want_arg]

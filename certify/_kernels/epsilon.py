@@ -84,24 +84,28 @@ def planar_epsilon_one(Wb, owner, m, linf):
     work = np.empty((2, m))
     arg = np.zeros(3)
     best = np.inf
+    grouped = True  # each contact's generators together, in contact order (as generator_layout lays them)
+    for j in range(1, k):
+        grouped = grouped and owner[j - 1] <= owner[j]
     for a in range(n):
         for c in range(a + 1, n):
             if linf:  # normal of a pair of edges
                 best = _candidate(Wb, owner, work, linf, E[a, 0], E[a, 1], E[a, 2],
-                                  E[c, 0], E[c, 1], E[c, 2], tiny, best, arg)
+                                  E[c, 0], E[c, 1], E[c, 2], tiny, best, arg, grouped)
                 continue
             for q in range(c + 1, n):  # normal of a triple of points
                 best = _candidate(Wb, owner, work, linf,
                                   E[c, 0] - E[a, 0], E[c, 1] - E[a, 1], E[c, 2] - E[a, 2],
                                   E[q, 0] - E[a, 0], E[q, 1] - E[a, 1], E[q, 2] - E[a, 2],
-                                  tiny, best, arg)
+                                  tiny, best, arg, grouped)
     return best, arg
 
 
 @kernel
-def _candidate(Wb, owner, work, linf, x0, x1, x2, y0, y1, y2, tiny, best, arg):
+def _candidate(Wb, owner, work, linf, x0, x1, x2, y0, y1, y2, tiny, best, arg, grouped):
     """Evaluate the support function at both unit normals ``+-(x cross y)``, ``+`` first; return
-    the least value so far (``arg`` holds its direction). ``work`` is (2, contacts)."""
+    the least value so far (``arg`` holds its direction). ``work`` is (2, contacts); ``grouped``:
+    ``owner`` is sorted (:func:`_support_both_below` may then stop early)."""
     u0 = x1 * y2 - x2 * y1
     u1 = x2 * y0 - x0 * y2
     u2 = x0 * y1 - x1 * y0
@@ -109,7 +113,10 @@ def _candidate(Wb, owner, work, linf, x0, x1, x2, y0, y1, y2, tiny, best, arg):
     if nu <= tiny:
         return best
     u0, u1, u2 = u0 / nu, u1 / nu, u2 / nu
-    plus, minus = _support_both(Wb, owner, work[0], work[1], u0, u1, u2, linf)
+    if grouped:
+        plus, minus = _support_both_below(Wb, owner, u0, u1, u2, linf, best)
+    else:
+        plus, minus = _support_both(Wb, owner, work[0], work[1], u0, u1, u2, linf)
     if plus < best:
         best = plus
         arg[0], arg[1], arg[2] = u0, u1, u2
@@ -139,6 +146,34 @@ def _support_both(Wb, owner, best, worst, u0, u1, u2, linf):
     for i in range(m):
         plus = plus + best[i] if linf else max(plus, best[i])
         minus = minus + worst[i] if linf else max(minus, worst[i])
+    return plus, minus
+
+
+@kernel
+def _support_both_below(Wb, owner, u0, u1, u2, linf, bound):
+    """:func:`_support_both` for generators grouped by contact in contact order (``owner``
+    sorted), combining each contact's value as soon as its generators are done, and stopping
+    once both values are at least ``bound``: then both are at most the full values, which are
+    not below ``bound`` either, since the combined values only grow (each contact's value is at
+    least 0, and adding it or taking a maximum never lowers a float). The full values are
+    :func:`_support_both`'s: a contact without generators would add ``+0.0``, which changes
+    no sum started at ``+0.0``."""
+    plus, minus = 0.0, 0.0
+    bp, bm = 0.0, 0.0
+    for j in range(Wb.shape[1]):
+        if j > 0 and owner[j] != owner[j - 1]:
+            plus = plus + bp if linf else max(plus, bp)
+            minus = minus + bm if linf else max(minus, bm)
+            if plus >= bound and minus >= bound:
+                return plus, minus
+            bp, bm = 0.0, 0.0
+        v = Wb[0, j] * u0 + Wb[1, j] * u1 + Wb[2, j] * u2
+        if v > bp:
+            bp = v
+        if -v > bm:
+            bm = -v
+    plus = plus + bp if linf else max(plus, bp)
+    minus = minus + bm if linf else max(minus, bm)
     return plus, minus
 
 
