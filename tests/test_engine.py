@@ -175,6 +175,24 @@ def test_the_default_chunk_size_gives_each_worker_chunks(grasp_files, tmp_path):
                                                                                                 16384]
 
 
+def test_parquet_results_dictionary_encode_names_and_indices(tmp_path):
+    """Every column the results writer names for a dictionary is a column of the file (pyarrow
+    ignores a name that is not), and the evidence's index lists are written with one."""
+    from qualgrasp.certify.files.results import RESULT_WRITE_OPTIONS
+
+    parquet, out = tmp_path / "g.parquet", tmp_path / "q.parquet"
+    write_grasps(parquet, random_grasps(3, 200, dim=2, n_contacts=3))
+    certify_file(parquet, out, quality=True, workers=1)
+    meta = pq.ParquetFile(out).metadata
+    encodings = {meta.row_group(0).column(i).path_in_schema: meta.row_group(0).column(i).encodings
+                 for i in range(meta.num_columns)}
+    named = RESULT_WRITE_OPTIONS["use_dictionary"]
+    assert set(named) <= set(encodings)
+    assert all("RLE_DICTIONARY" in encodings[f"eps_evidence.{norm}.{name}.list.element"]
+               for norm in ("l1", "linf") for name in ("ref", "faces") if (norm, name) != ("l1", "ref"))
+    assert "RLE_DICTIONARY" not in encodings["eps_l1_lo"]
+
+
 def test_dask_local_cluster_matches_local_processes(grasp_files, tmp_path):
     pytest.importorskip("distributed")
     _, parquet, _ = grasp_files

@@ -84,12 +84,17 @@ COLUMNS: tuple[Column, ...] = (
 NAMES = tuple(c.name for c in COLUMNS)
 RESULT_SCHEMA = pa.schema([(c.name, c.type) for c in COLUMNS])
 
-# Dictionary-encode only the columns of names: dictionary pages of float columns cost more
-# than half the time of writing results, and make the file larger.
+# Dictionary-encode only the columns of names and of small indices: dictionary pages of float
+# columns cost more than half the time of writing results, and make the file larger; the indices
+# of the epsilon evidence (faces, sums' generator choices) take a few bits each in a dictionary,
+# which made a million planar rows with quality 36 % smaller (269 -> 172 MB) and 45 % faster to
+# read, for the same time to write.
 RESULT_WRITE_OPTIONS = {"use_dictionary": [
     "status", "form_status", "certificate.force.kind", "certificate.force.layout",
     "certificate.form.kind", "certificate.form.layout", "eps_evidence.l1.kind",
-    "eps_evidence.linf.kind"]}
+    "eps_evidence.linf.kind"]
+    + [f"certificate.{c}.{name}.list.element" for c in ("force", "form") for name in ("basis", "tight")]
+    + [f"eps_evidence.{norm}.{name}.list.element" for norm in ("l1", "linf") for name in ("ref", "faces")]}
 
 
 def carried_name(name: str) -> str:
