@@ -18,6 +18,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from .. import models
+from ..batch.engine import tune_allocator
 from ..batch.jobs import certify_file, verify_file
 from ..errors import CertifyError
 from ..regions.files import DEFAULT_BUDGET, certify_region_file, verify_region_file
@@ -107,6 +108,7 @@ def certify_command(
         except CertifyError as err:
             fail(str(err))
     total = count_grasps(grasps)
+    tune_allocator()  # this process is the command's own
     with Progress(TextColumn("certify"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
                   console=console, disable=quiet) as bar:
         task = bar.add_task("certify", total=total)
