@@ -1,6 +1,7 @@
 """Resumable, parallel certification of large grasp sets.
 
-The input is read in chunks of a fixed number of grasps (:func:`qualgrasp.certify.files.reader.iter_chunks`).
+The input is read in chunks of a fixed number of grasps (:func:`qualgrasp.certify.files.reader.iter_chunks`;
+by default :func:`chunk_size_for` the input and the workers, or on resume the interrupted run's).
 Each chunk is certified by a worker (local processes by default, or a dask.distributed cluster)
 and its results are written to ``RESULTS.parts/part-NNNNNN.EXT`` under a temporary name, renamed
 atomically when complete, with ``part-NNNNNN.EXT.sum`` stating its rows, bytes and CRC-32 (local
@@ -16,6 +17,8 @@ and all are written again at the end, in the schema of them all, when one does n
 do not convert to the first one's types (the file is the same either way; the workers' parts then
 overlap with its encoding instead of waiting, and a write that fails does so mid-run, keeping the
 parts finished by then).
+
+Local workers keep the memory they free for the next chunk (:func:`tune_allocator`, glibc only).
 
 A run killed at any moment leaves only complete parts (plus temporaries, discarded).
 ``resume=True`` keeps the complete parts whose sums match (a part truncated by a crash or a disk
@@ -548,7 +551,7 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
     chunk_size : int, optional
         Grasps per chunk (the unit of work, of checkpointing and of memory). Default: with
         ``resume``, the interrupted run's; else :func:`chunk_size_for` the input's grasps and
-        the workers.
+        the workers (a dask cluster's as its scheduler counts them).
     progress : callable, optional
         Called with the number of grasps of each chunk as it completes (or is found complete).
     """
@@ -557,9 +560,6 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
                 options.source.inputs() if options.source is not None else ())
     with lock_output(results, "-o"):
         try:
-            if chunk_size is None:
-                chunk_size = (resume and _resumed_chunk_size(results)
-                              or chunk_size_for(count_grasps(grasps), workers or os.cpu_count() or 1))
             return _run(grasps, results, options, workers, dask, resume, chunk_size, progress)
         except (OSError, pa.ArrowException) as err:
             raise CertifyError(_fault(err, results)) from None
@@ -593,12 +593,15 @@ def _kept(results: Path) -> str:
 
 
 def _run(grasps: Path, results: Path, options: Options, workers: int | None, dask: str | None,
-         resume: bool, chunk_size: int, progress: Callable[[int], None] | None) -> RunSummary:
+         resume: bool, chunk_size: int | None, progress: Callable[[int], None] | None) -> RunSummary:
     start = time.perf_counter()
     workers = workers or os.cpu_count() or 1
     # The pool first: a scheduler that cannot be reached leaves nothing behind.
     pool = _DaskPool(dask, workers) if dask else (_LocalPool(workers) if workers > 1 else None)
     try:
+        if chunk_size is None:  # the pool's workers: a remote cluster's, not this machine's cores
+            chunk_size = (resume and _resumed_chunk_size(results)
+                          or chunk_size_for(count_grasps(grasps), pool.capacity // 2 if pool else 1))
         parts = _prepare(grasps, results, chunk_size, options, resume)
     except BaseException:
         if pool is not None:

@@ -10,6 +10,7 @@ Each command is a thin wrapper over a public function (:func:`qualgrasp.certify.
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
 import typer
@@ -18,7 +19,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from .. import models
-from ..batch.engine import tune_allocator
+from ..batch.engine import chunk_size_for, tune_allocator
 from ..batch.jobs import certify_file, verify_file
 from ..errors import CertifyError
 from ..regions.files import DEFAULT_BUDGET, certify_region_file, verify_region_file
@@ -108,6 +109,8 @@ def certify_command(
         except CertifyError as err:
             fail(str(err))
     total = count_grasps(grasps)
+    if chunk_size is None and not resume and dask is None:  # the count made once (a scan of JSON Lines)
+        chunk_size = chunk_size_for(total, workers or os.cpu_count() or 1)
     tune_allocator()  # this process is the command's own
     with Progress(TextColumn("certify"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
                   console=console, disable=quiet) as bar:

@@ -172,8 +172,11 @@ def _positions(starts: np.ndarray, lengths: np.ndarray) -> np.ndarray:
 def _scatter(blocks, name: str, start: np.ndarray, dtype) -> np.ndarray:
     """The items of list ``name`` of every block, each row's at ``start[row]``."""
     full = [b for b in blocks if name in b[3] and len(b[3][name][1])]
-    if len(full) == 1 and len(full[0][3][name][1]) == start[-1] and np.all(np.diff(full[0][0]) > 0):
-        # one block in row order holds every item: they are already where they go
+    rows = full[0][0] if len(full) == 1 else None
+    if (rows is not None and len(full[0][3][name][1]) == start[-1] and rows[0] >= 0
+            and np.all(np.diff(rows) > 0)):
+        # one block in row order holds every item: they are already where they go (the column
+        # is then the block's array itself, not a copy)
         return np.ascontiguousarray(full[0][3][name][1], dtype=dtype)
     values = np.empty(int(start[-1]), dtype=dtype)
     for rows, _, _, lists in full:
