@@ -35,6 +35,19 @@ def rotation(rng, dim):
     return q
 
 
+def interrupt_after(count: int):
+    """A progress callback that raises KeyboardInterrupt at its ``count``-th call (a run stopped
+    after ``count`` chunks, its parts kept)."""
+    calls = []
+
+    def progress(_size) -> None:
+        calls.append(_size)
+        if len(calls) == count:
+            raise KeyboardInterrupt
+
+    return progress
+
+
 def signal_after(proc, count_parts, count: int, sig=signal.SIGKILL) -> bool:
     """Send ``sig`` to the process group of ``proc`` once ``count_parts()`` reaches ``count``,
     while the run is still going. The run advances in steps of a few milliseconds between

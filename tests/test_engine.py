@@ -15,7 +15,7 @@ from qualgrasp.certify.batch import certify_file, verify_file
 from qualgrasp.certify.files import read_results, write_grasps
 from qualgrasp.certify.batch import random_grasps, textbook_grasps
 
-from helpers import signal_after
+from helpers import interrupt_after, signal_after
 
 BAD = '{"id": "bad", "contacts": [{"p": [0, 0], "n": [0, 0]}]}\n'
 
@@ -147,15 +147,8 @@ def test_resume_without_a_chunk_size_keeps_the_interrupted_runs(grasp_files, tmp
     _, parquet, n = grasp_files
     whole, out = tmp_path / "whole.parquet", tmp_path / "o.parquet"
     certify_file(parquet, whole, quality=False, chunk_size=50, workers=2)
-    seen = []
-
-    def stop(size):
-        seen.append(size)
-        if len(seen) == 3:
-            raise KeyboardInterrupt
-
     with pytest.raises(KeyboardInterrupt):
-        certify_file(parquet, out, quality=False, chunk_size=50, progress=stop)
+        certify_file(parquet, out, quality=False, chunk_size=50, progress=interrupt_after(3))
     summary = certify_file(parquet, out, quality=False, resume=True, workers=2)
     assert summary.resumed_chunks >= 3 and summary.chunks == -(-n // 50)
     assert pq.read_table(out).equals(pq.read_table(whole))

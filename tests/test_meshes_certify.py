@@ -19,6 +19,8 @@ from qualgrasp.certify.meshes.sampling import sample_poses
 from qualgrasp.certify.meshes.source import PoseSource
 from qualgrasp.cli import app
 
+from helpers import interrupt_after
+
 runner = CliRunner()
 TIMINGS = ("time_ms",)
 
@@ -107,16 +109,9 @@ def test_json_fields_of_changing_types_reach_parquet_as_json_text(tmp_path):
 def test_interrupted_run_resumes_and_refuses_another_mesh(scene, tmp_path):
     out = tmp_path / "r.jsonl"
     source = PoseSource.of(scene / "box.stl", units="mm")
-    seen = []
-
-    def stop_after_two(n):
-        seen.append(n)
-        if len(seen) == 2:
-            raise KeyboardInterrupt
-
     with pytest.raises(KeyboardInterrupt):
         run(scene / "poses.jsonl", out, options=Options(quality=False, source=source), workers=1, chunk_size=3,
-            progress=stop_after_two)
+            progress=interrupt_after(2))
     assert not out.exists()
     other = PoseSource.of(scene / "box.stl", units="mm", mu=0.2)
     with pytest.raises(CertifyError, match="other options"):
