@@ -12,7 +12,9 @@ from hypothesis import strategies as st
 
 from qualgrasp.certify import Grasp
 from qualgrasp.certify.batch import certify_file, verify_file
+from qualgrasp.certify.batch.engine import chunk_size_for
 from qualgrasp.certify.files import read_results, write_grasps
+from qualgrasp.certify.files.results import RESULT_WRITE_OPTIONS
 from qualgrasp.certify.batch import random_grasps, textbook_grasps
 
 from helpers import interrupt_after, signal_after
@@ -157,8 +159,6 @@ def test_resume_without_a_chunk_size_keeps_the_interrupted_runs(grasp_files, tmp
 def test_the_default_chunk_size_gives_each_worker_chunks(grasp_files, tmp_path):
     """Without a chunk size a run cuts its input by :func:`chunk_size_for`: here every grasp in
     one chunk (fewer than 1024), the same rows as small chunks give."""
-    from qualgrasp.certify.batch.engine import chunk_size_for
-
     _, parquet, n = grasp_files
     a, b = tmp_path / "a.parquet", tmp_path / "b.parquet"
     assert certify_file(parquet, a, quality=False, workers=2).chunks == 1 == -(-n // chunk_size_for(n, 2))
@@ -171,8 +171,6 @@ def test_the_default_chunk_size_gives_each_worker_chunks(grasp_files, tmp_path):
 def test_parquet_results_dictionary_encode_names_and_indices(tmp_path):
     """Every column the results writer names for a dictionary is a column of the file (pyarrow
     ignores a name that is not), and the evidence's index lists are written with one."""
-    from qualgrasp.certify.files.results import RESULT_WRITE_OPTIONS
-
     parquet, out = tmp_path / "g.parquet", tmp_path / "q.parquet"
     write_grasps(parquet, random_grasps(3, 200, dim=2, n_contacts=3))
     certify_file(parquet, out, quality=True, workers=1)

@@ -57,12 +57,12 @@ from .chunk import Options, certify_chunk_results, status_counts
 from ..errors import CertifyError, GraspFileError
 from ..files.outputs import check_output, lock_output, write_error
 from ..files.results import RESULT_SCHEMA, RESULT_WRITE_OPTIONS, carried_clash
-from ..files.reader import (JSON_TEXT, Chunk, conform, count_grasps, input_format, is_parquet, iter_chunks, rows_to_table,
-                            table_to_rows, unified_schema)
+from ..files.reader import (JSON_TEXT, Chunk, conform, count_grasps, input_format, is_parquet, iter_chunks,
+                            rows_to_table, table_to_rows, unified_schema)
 from ..core.validation import TOP_LEVEL
 
-__all__ = ["RunSummary", "run", "CHUNK_SIZE", "chunk_size_for", "tune_allocator", "check_paths", "certify_chunk", "encoded_chunk", "encode_part", "parts_folder",
-           "MADE_BY"]
+__all__ = ["RunSummary", "run", "CHUNK_SIZE", "chunk_size_for", "tune_allocator", "check_paths", "certify_chunk",
+           "encoded_chunk", "encode_part", "parts_folder", "MADE_BY"]
 
 
 @dataclass
