@@ -21,7 +21,7 @@ import pyarrow as pa
 
 from ..core.certificates import Tolerances
 from .chunk import STATUSES, Options, Quality, verify_chunk
-from .engine import RunSummary, run
+from .engine import RunSummary, chunk_size_for, run, tune_allocator
 from ..errors import CertifyError
 from ..files.reader import Chunk, chunk_values, count_grasps, input_format, is_parquet, iter_chunks
 from ..core.validation import show
@@ -181,7 +181,7 @@ class _Verifier:
     def __init__(self, tol: Tolerances, workers: int) -> None:
         self.tol = tol
         self.summary, self.quality = Summary(), Quality()
-        self.pool = ProcessPoolExecutor(workers) if workers > 1 else None
+        self.pool = ProcessPoolExecutor(workers, initializer=tune_allocator) if workers > 1 else None
         self.workers = workers
         self.futures: list = []
         self.paired = 0
@@ -333,7 +333,7 @@ def _concat(blocks: list[_Block]) -> _Block:
 
 def verify_file(results_path: str | Path, grasps_path: str | Path,
                 tol: Tolerances = Tolerances(), workers: int | None = 1,
-                chunk_size: int = 4096) -> Summary:
+                chunk_size: int | None = None) -> Summary:
     """Re-check every certificate of ``results_path`` against the grasps of ``grasps_path``.
 
     Each results row is paired with the grasp of the line it states (its ``line``; its ``id``
@@ -345,7 +345,8 @@ def verify_file(results_path: str | Path, grasps_path: str | Path,
     kind (a run computes quality for all rows or none). A malformed row is a failure with a
     message; each failure names the row's own id and its line. A results file that is neither
     JSON Lines nor Parquet raises :class:`qualgrasp.certify.errors.CertifyError`. Chunks are
-    verified in ``workers`` processes (``None``: every core).
+    verified in ``workers`` processes (``None``: every core), of ``chunk_size`` grasps (default
+    :func:`~qualgrasp.certify.batch.engine.chunk_size_for` the grasps and the workers).
 
     Memory stays bounded: rows whose lines increase (as certify writes them) are paired while
     both files stream; otherwise the rows are first spilled to a temporary folder in one bucket
@@ -355,6 +356,8 @@ def verify_file(results_path: str | Path, grasps_path: str | Path,
     workers = workers or os.cpu_count() or 1
     parsed = [0]
     input_format(grasps_path)  # a grasp file that is not one is refused before any work
+    if chunk_size is None:
+        chunk_size = chunk_size_for(count_grasps(grasps_path), workers)
     try:
         v = _Verifier(tol, workers)
         try:

@@ -158,6 +158,7 @@ def verify_command(
         if regions is not None:
             summary = verify_region_file(results, regions)
         else:
+            tune_allocator()  # this process is the command's own
             summary = verify_file(results, grasps, workers=workers or None)
     except CertifyError as err:
         fail(str(err))
