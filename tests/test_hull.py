@@ -13,6 +13,7 @@ from scipy.spatial import ConvexHull
 from qualgrasp.certify._kernels.hull import (PLANE_TOL, grow_start, hull_faces, hull_facets, hull_grow, hulls_faces,
                                              live_facets)
 from qualgrasp.certify._kernels.surface import TRIANGLES_MAX, cycle_code, orient_cycle
+from qualgrasp.certify.quality import evidence as evidence_module
 from qualgrasp.certify.quality.evidence import Evidence
 from qualgrasp.certify.quality.gws import orient_faces, oriented_surface, surfaces_faces
 
@@ -147,6 +148,35 @@ def test_evidence_columns_are_the_rows_and_their_arrow_column(pairs, split, back
     want = pa.array([None if p is None else {"l1": p[0].to_json(), "linf": p[1].to_json()} for p in pairs],
                     type=RESULT_SCHEMA.field("eps_evidence").type)
     assert got.equals(want)
+
+
+_items = st.one_of(st.integers(-(2**31) - 2, 2**31 + 2), st.floats(allow_nan=True), st.booleans(),
+                  st.integers(-5, 5).map(float), st.just("1"))
+_json_lists = st.one_of(st.none(), st.lists(_items, max_size=6), st.lists(st.integers(-40, 40), max_size=9),
+                        st.lists(st.floats(-1e3, 1e3), max_size=9),
+                        st.lists(st.integers(-(2**31) - 2, 2**31 + 2), max_size=3), st.lists(st.floats(), max_size=3))
+
+
+@settings(max_examples=300, deadline=None)
+@given(_kinds, _json_lists, _json_lists, _json_lists, _json_lists)
+def test_evidence_read_back_is_the_checks_item_by_item(kind, direction, ref, points, faces):
+    """Evidence.from_json takes plain lists as they are; anything else goes item by item: the
+    same evidence, or the same error, as the item-by-item checks alone give."""
+    d = {"kind": kind, "direction": direction, "ref": ref, "points": points, "faces": faces}
+
+    def read():
+        try:
+            return Evidence.from_json(d)
+        except ValueError as err:
+            return str(err)
+
+    got = read()
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(evidence_module, "_plain_numbers", lambda v, integer: False)
+        want = read()
+    assert got == want and type(got) is type(want)
+    if not isinstance(got, str):
+        assert [type(x) for x in got.ref + got.faces] == [int] * len(got.ref + got.faces)
 
 
 @settings(max_examples=200, deadline=None)

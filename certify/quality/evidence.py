@@ -137,6 +137,8 @@ class Evidence:
                 return None
             if not isinstance(v, (list, tuple)):
                 raise ValueError(f"evidence {key} must be a list")
+            if _plain_numbers(v, integer):  # the usual list: the loop's values, without its checks one by one
+                return tuple(v)
             out = []
             for x in v:
                 if isinstance(x, bool) or not isinstance(x, (int, float)):
@@ -156,6 +158,14 @@ class Evidence:
         direction = numbers("direction", False)
         return cls(kind, direction, numbers("ref", True) or (), numbers("points", False) or (),
                    numbers("faces", True) or ())
+
+
+def _plain_numbers(v: Sequence, integer: bool) -> bool:
+    """Whether every item of ``v`` is a plain ``int`` within 2^31 (``integer``) or a finite plain
+    ``float``: items :meth:`Evidence.from_json` keeps as they are."""
+    if integer:
+        return all(type(x) is int for x in v) and (not v or (-(2**31) <= min(v) and max(v) <= 2**31))
+    return all(type(x) is float for x in v) and all(map(math.isfinite, v))
 
 
 #: The list fields of :class:`Evidence` and the dtype each is held in by :class:`EvidenceColumns`.
