@@ -18,7 +18,8 @@ do not convert to the first one's types (the file is the same either way; the wo
 overlap with its encoding instead of waiting, and a write that fails does so mid-run, keeping the
 parts finished by then).
 
-Local workers keep the memory they free for the next chunk (:func:`tune_allocator`, glibc only).
+Local workers (and the ``qualgrasp certify`` and ``verify`` commands) keep the memory they free for
+the next chunk (:func:`tune_allocator`, glibc only).
 
 A run killed at any moment leaves only complete parts (plus temporaries, discarded).
 ``resume=True`` keeps the complete parts whose sums match (a part truncated by a crash or a disk
@@ -419,17 +420,18 @@ def _holding(schema: pa.Schema, parts) -> pa.Schema:
                       for f in schema])
 
 
-#: glibc ``mallopt`` settings of the local workers: blocks up to 32 MB from the heap, not from
-#: fresh mappings, and freed memory kept up to 256 MB instead of returned at once. A chunk's
-#: arrays are allocated and freed again chunk after chunk; by default each large one is a new
-#: mapping whose pages fault in anew, which took half of the workers' system time.
+#: glibc ``mallopt`` settings of a run's own processes (:func:`tune_allocator`): blocks up to
+#: 32 MB from the heap, not from fresh mappings, and freed memory kept up to 256 MB instead of
+#: returned at once. A chunk's arrays are allocated and freed again chunk after chunk; by default
+#: each large one is a new mapping whose pages fault in anew, which took half of the workers'
+#: system time.
 _MALLOPT = ((-3, 32 << 20), (-1, 256 << 20))  # M_MMAP_THRESHOLD, M_TRIM_THRESHOLD
 
 
 def tune_allocator() -> None:
     """Apply :data:`_MALLOPT` to this process where the C library is glibc (elsewhere nothing):
-    for processes of a run's own, its local workers and the ``qualgrasp certify`` command, not
-    for a caller's process, whose allocator is its own business."""
+    for processes of a run's own (local workers of certify and verify, the ``qualgrasp certify``
+    and ``verify`` commands), not for a caller's process, whose allocator is its own business."""
     if not sys.platform.startswith("linux"):
         return
     try:
@@ -510,8 +512,9 @@ class _DaskPool:
             self.cluster.close()
 
 
-def check_paths(grasps: Path, results: Path, chunk_size: int = 1, others: Sequence[Path] = ()) -> None:
-    """Refuse a run before any work: an input that is not a grasp set, a chunk size below 1, and
+def check_paths(grasps: Path, results: Path, chunk_size: int | None = None, others: Sequence[Path] = ()) -> None:
+    """Refuse a run before any work: an input that is not a grasp set, a chunk size below 1 (None:
+    the run's default), and
     an output that :func:`qualgrasp.certify.files.outputs.check_output` refuses (a folder, a FIFO or
     device, the input itself or one of the ``others`` files read (a source's mesh) through any
     link, a checkpoint folder ``RESULTS.parts`` that is or holds an input, a name too long for that
@@ -523,7 +526,7 @@ def check_paths(grasps: Path, results: Path, chunk_size: int = 1, others: Sequen
         With a one-line message naming the problem (:class:`GraspFileError` for the input and the
         chunk size, :class:`qualgrasp.certify.errors.OptionError` for the output).
     """
-    if chunk_size < 1:
+    if chunk_size is not None and chunk_size < 1:
         raise GraspFileError(f"the chunk size must be at least 1 grasp, got {chunk_size}")
     if input_format(grasps) == "parquet":  # raises for a file that is not JSON Lines or Parquet
         clash = carried_clash([n for n in pq.read_schema(grasps).names if n not in TOP_LEVEL])
@@ -556,8 +559,7 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
         Called with the number of grasps of each chunk as it completes (or is found complete).
     """
     grasps, results = Path(grasps), Path(results)
-    check_paths(grasps, results, 1 if chunk_size is None else chunk_size,
-                options.source.inputs() if options.source is not None else ())
+    check_paths(grasps, results, chunk_size, options.source.inputs() if options.source is not None else ())
     with lock_output(results, "-o"):
         try:
             return _run(grasps, results, options, workers, dask, resume, chunk_size, progress)
