@@ -7,7 +7,8 @@ grasps written to Parquet outside the timing: planar grasps of three point conta
 (both epsilons with their evidence) and without, a degenerate planar set (``qualgrasp sample
 --degenerate mixed``) and its generic counterpart (same model and contact count), and spatial grasps
 of three point contacts with and without quality. Sizes: 1,000,000 planar and 100,000 spatial rows;
-with ``quick`` 20,000 and 2,000.
+with ``quick`` 20,000 and 2,000. ``kinds`` (``--job``) runs only the jobs whose label contains
+one of its words.
 
 Each job row is set against two baselines timed in the same run, on a prefix of the same grasps, in
 this process: the build's own **per-grasp route** (:func:`qualgrasp.certify.report.certify_grasp`,
@@ -42,7 +43,7 @@ import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Sequence
 
 import pyarrow.parquet as pq
 from rich.console import Console
@@ -56,7 +57,7 @@ from ..certify.report import certify_grasp
 from ..certify.solvers import make_solver
 from .bench import DEGENERATE_KIND
 
-__all__ = ["JOB_KINDS", "SIZES", "QUICK_SIZES", "WORKERS", "JobRow", "StartRow", "run_jobs_bench",
+__all__ = ["JOB_KINDS", "SIZES", "QUICK_SIZES", "WORKERS", "JobRow", "StartRow", "select_jobs", "run_jobs_bench",
            "print_jobs_bench"]
 
 _GENERIC = {k: v for k, v in DEGENERATE_KIND.items() if k != "degenerate"}
@@ -203,20 +204,44 @@ def _start_rows(folder: Path, exe: str) -> list[StartRow]:
     return rows
 
 
+def select_jobs(words: Sequence[str] = ()) -> list[str]:
+    """The labels of :data:`JOB_KINDS` containing one of ``words`` (case-insensitive), in the
+    table's order; every label when ``words`` is empty.
+
+    Raises
+    ------
+    OptionError
+        When a word is in no label (naming the labels).
+
+    Examples
+    --------
+    >>> select_jobs(["degenerate"])
+    ['degenerate planar (mixed), 4 point contacts, --no-quality']
+    """
+    labels = list(JOB_KINDS)
+    for word in words:
+        if not any(word.lower() in label.lower() for label in labels):
+            raise OptionError(f"--job {word!r} is in no job's label: " + "; ".join(labels))
+    return [label for label in labels if not words or any(w.lower() in label.lower() for w in words)]
+
+
 def run_jobs_bench(*, quick: bool = False, seed: int = 0, reference_n: int = 300, sizes: dict | None = None,
-                   startup: bool = True,
+                   startup: bool = True, kinds: Sequence[str] = (),
                    progress: Callable[[str], None] | None = None) -> tuple[list[JobRow], list[StartRow]]:
-    """Run every job of :data:`JOB_KINDS` and its baselines, then (with ``startup``) the start-up
-    rows (module docstring), in a temporary folder removed at the end. ``sizes``: rows per job by
-    dimension, instead of :data:`SIZES` (:data:`QUICK_SIZES` with ``quick``)."""
+    """Run the jobs of :data:`JOB_KINDS` that ``kinds`` selects (:func:`select_jobs`: all when
+    empty) and their baselines, then (with ``startup``) the start-up rows (module docstring), in a
+    temporary folder removed at the end. ``sizes``: rows per job by dimension, instead of
+    :data:`SIZES` (:data:`QUICK_SIZES` with ``quick``)."""
     sizes = sizes or (QUICK_SIZES if quick else SIZES)
+    labels = select_jobs(kinds)
     exe = _qualgrasp()
     if exe is None:
         raise OptionError("bench --jobs runs the qualgrasp command: it is not installed beside this Python")
     jobs = []
     with tempfile.TemporaryDirectory(prefix="qualgrasp-bench-") as tmp:
         folder = Path(tmp)
-        for label, (kwargs, quality) in JOB_KINDS.items():
+        for label in labels:
+            kwargs, quality = JOB_KINDS[label]
             if progress:
                 progress(label)
             jobs.append(_job(label, kwargs, quality, sizes[kwargs["dim"]], seed, reference_n, folder, exe))

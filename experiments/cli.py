@@ -230,6 +230,8 @@ def bench_command(
                                                     "and first-call compile time."),
     quick: bool = typer.Option(False, "--quick", help="With --jobs: 20,000 planar and 2,000 spatial rows per job "
                                                       "instead of 1,000,000 and 100,000."),
+    job: list[str] = typer.Option([], "--job", help="With --jobs: only the jobs whose label contains this word "
+                                                    "(repeatable; e.g. degenerate, spatial)."),
     dexnet: Path | None = typer.Option(None, "--dexnet", show_default=False,
                                        help="With --single: the graspnetAPI 1.2.11 sdist (.tar.gz, its folder or "
                                             "its quality.py) to load Dex-Net from; without it Dex-Net's row is "
@@ -257,7 +259,7 @@ def bench_command(
     generic counterpart, spatial with and without quality; 1,000,000 planar and 100,000 spatial
     rows, 20,000 and 2,000 with --quick), each against the per-grasp route and cvxpy rebuilt per
     grasp on the same grasps (CPU per grasp); then CLI start-up and the first certify of one line
-    with a fresh compile cache.
+    with a fresh compile cache. --job selects jobs by a word of their label.
     """
     n = (2000 if single else 20000) if n is None else n
     if n < 1 or reference_n < 0:
@@ -270,11 +272,13 @@ def bench_command(
         fail("--jobs times the whole job; it does not go with --single, --quality or --contacts")
     if quick and not jobs:
         fail("--quick goes with --jobs")
+    if job and not jobs:
+        fail("--job goes with --jobs")
 
     if jobs:
         try:
             with Console(stderr=True).status("") as status:
-                measured = run_jobs_bench(quick=quick, seed=seed, reference_n=reference_n,
+                measured = run_jobs_bench(quick=quick, seed=seed, reference_n=reference_n, kinds=job,
                                           progress=lambda what: status.update(f"bench --jobs: {what}"))
         except OptionError as err:
             fail(str(err))
