@@ -1,6 +1,8 @@
 """The physical validation study (experiments/physics/study.py) and ``qualgrasp validate``
 (experiments/physics/cli.py)."""
 
+from dataclasses import replace
+
 import cv2
 import pytest
 import typer
@@ -9,8 +11,8 @@ from typer.testing import CliRunner
 pytest.importorskip("pymunk", reason="the physical validation needs pymunk (pip install 'qualgrasp[physics]')")
 
 from qualgrasp.experiments.physics.cli import register  # noqa: E402
-from qualgrasp.experiments.physics.study import (COLUMNS, Validation, explain, read_trials,  # noqa: E402
-                                                 summarise, validate)
+from qualgrasp.experiments.physics.study import (COLUMNS, VALIDATIONS, Validation, explain,  # noqa: E402
+                                                 read_trials, summarise, validate)
 from qualgrasp.qualitative.objects import render  # noqa: E402
 
 TINY = Validation(per_route=1, random=1, inside=2, outside=1, directions=6, recheck=1, workers=1)
@@ -119,8 +121,10 @@ def test_the_output_folder_is_never_the_input_folder(tmp_path):
     assert (folder / "physics-filmstrip.png").read_bytes() == before
 
 
-def test_validate_on_a_folder_of_images(tmp_path):
-    """An image without known geometry: the grasps are executed on the contour it shows."""
+def test_validate_on_a_folder_of_images(tmp_path, monkeypatch):
+    """An image without known geometry: the grasps are executed on the contour it shows. The
+    command's quick setting is made TINY without the re-run at FINE (which square_run covers)."""
+    monkeypatch.setitem(VALIDATIONS, "quick", replace(TINY, recheck=0))
     folder = tmp_path / "images"
     folder.mkdir()
     cv2.imwrite(str(folder / "square.png"), render("square", size=256))
