@@ -392,9 +392,8 @@ def test_compiled_sums_are_every_sum_within_their_bounds():
 
 
 def test_compiled_support_choices_are_planar_support_choice():
-    """Where the compiled choice states itself sure it is :func:`planar_support_choice`'s (the
-    largest value per contact, the first of ties, -1 when not positive); ties are never sure, so
-    they take that function."""
+    """The compiled choice is :func:`planar_support_choice`'s (the largest value per contact, the
+    first of ties, -1 when not positive), sure or not; ties are never sure."""
     from qualgrasp.certify._kernels.evidence import support_choices
     from qualgrasp.certify.quality.gws import planar_support_choice, planar_support_choices
 
@@ -407,14 +406,60 @@ def test_compiled_support_choices_are_planar_support_choice():
             dirs = np.vstack([np.eye(3), -np.eye(3), rng.normal(size=(20, 3))])
             R, sure = support_choices(W, owner, m, dirs)
             ref = np.array([planar_support_choice(W, owner, m, v) for v in dirs])
-            assert np.array_equal(R[sure], ref[sure])
+            assert np.array_equal(R, ref)
             assert np.array_equal(planar_support_choices(W, owner, m, dirs), ref)
             sure_seen += int(sure.sum())
             unsure_seen += int((~sure).sum())
     assert sure_seen > 500 and unsure_seen > 0  # the pads' equal forces tie along the force axes
     W = np.array([[1.0, 1.0], [0.0, 0.0], [2.0, -2.0]])  # one contact, a tie along (1, 0, 0)
     R, sure = support_choices(W, np.zeros(2, dtype=np.int64), 1, np.array([[1.0, 0, 0], [0, 0, 1.0]]))
-    assert not sure[0] and sure[1] and R[1, 0] == 0
+    assert not sure[0] and sure[1] and R[1, 0] == 0 and R[0, 0] == 0
+
+
+def _choice_in_python_floats(W, owner, m, v):
+    """The rule of planar_support_choice written out in Python floats (each operation rounded on
+    its own, never fused): values (v0 g0 + v1 g1) + v2 g2, per contact the first largest, -1
+    when it is not positive or a value is NaN."""
+    out = [-1] * m
+    for i in range(m):
+        cols = [j for j in range(W.shape[1]) if owner[j] == i]
+        vals = [(float(v[0]) * float(W[0, j]) + float(v[1]) * float(W[1, j])) + float(v[2]) * float(W[2, j])
+                for j in cols]
+        if not cols or any(x != x for x in vals):
+            continue
+        best = max(vals)
+        if best > 0:
+            out[i] = cols[vals.index(best)]
+    return out
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([(3, "point"), (10, "point"), (3, "pad")]),
+       st.sampled_from(["random", "faces", "axes"]))
+def test_support_choices_round_in_their_stated_order(seed, kind, dirs_kind):
+    """Both routes of the support choice (numpy, compiled) give the rule computed in Python floats
+    in its stated order, also on the ties of face normals of the GWS and of the axes (where a
+    BLAS product's fused multiply-adds would break ties differently)."""
+    from qualgrasp.certify._kernels.evidence import support_choices
+    from qualgrasp.certify.quality.gws import planar_support_choice
+
+    rng = np.random.default_rng(seed)
+    g = random_grasp(rng, dim=2, n_contacts=kind[0], model=kind[1])
+    W, E, owner = planar_generator_arrays(g)
+    m = len(g.contacts)
+    if dirs_kind == "random":
+        dirs = rng.normal(size=(8, 3))
+    elif dirs_kind == "axes":
+        dirs = np.vstack([np.eye(3), -np.eye(3)]) * rng.choice([1.0, 0.5, 3.0])
+    else:  # normals orthogonal to differences of a contact's generators: exact ties, rounded
+        a, b = rng.integers(0, W.shape[1], size=2)
+        d = W[:, a] - W[:, b]
+        dirs = np.cross(d, rng.normal(size=(8, 3)))
+    dirs = np.ascontiguousarray(dirs)
+    R = support_choices(W, owner, m, dirs)[0]
+    for v, r in zip(dirs, R):
+        ref = _choice_in_python_floats(W, owner, m, v)
+        assert list(planar_support_choice(W, owner, m, v)) == ref == list(r)
 
 
 def test_surfaces_faces_are_surface_faces():
@@ -539,3 +584,82 @@ def test_spatial_epsilon_looks_off_a_flat_set_of_support_points():
     report = certify_grasp(grasp)  # its evidence re-checked
     e = report.epsilons["L1"]
     assert report.verified and e.evidence.kind == "support" and 0 < e.lo <= e.hi and e.gap <= 0.01
+
+
+def _float_bits(a):
+    a = np.asarray(a)
+    return a.view(np.int64) if a.dtype == float else a
+
+
+@pytest.mark.parametrize("kwargs", [dict(n_contacts=10, model="point"), dict(n_contacts=20, model="point"),
+                                    dict(n_contacts=4, model="pad")])
+def test_compiled_support_refinement_is_the_loop_in_python(kwargs):
+    """The compiled refinement of planar ``support`` evidence keeps the directions, vertices,
+    error bounds and choices of the same loop run in Python from its first hull (the route it
+    hands over to where its hull declines), bit for bit (-0.0 of the axes included)."""
+    bounds = quality_module
+    n = 0
+    for g in random_grasps(7, 40, dim=2, **kwargs):
+        if not force_closure(g).closure:
+            continue
+        W, E, owner = planar_generator_arrays(g)
+        m = len(g.contacts)
+        u = np.array([0.3, -0.5, 0.2])
+        eps = 0.01 if W.shape[1] > 24 else planar_epsilon_one(W, owner, m, True)[0]
+        got, limited = bounds._support_surface(W, E, owner, m, float(eps), u, None)
+        first = np.vstack([np.eye(3), -np.eye(3), u[None]])
+        dirs, picks, seen = [], [], set()
+        for v, r in zip(first, bounds.planar_support_choices(W, owner, m, first)):
+            if r.tobytes() not in seen:
+                seen.add(r.tobytes())
+                dirs.append(v)
+                picks.append(r)
+        ref, ref_limited = bounds._refine_here(W, E, owner, m, float(eps) * (1 - bounds.EPS_TOL / 16), dirs, picks,
+                                               None)
+        assert not limited and not ref_limited and len(got) == len(ref) == 4
+        for a, b in zip(got, ref):
+            assert a.shape == b.shape and np.array_equal(_float_bits(a), _float_bits(b))
+        n += 1
+    assert n >= 5
+
+
+def test_planar_support_evidence_of_earlier_builds_is_rechecked(monkeypatch):
+    """Builds before 2026-11-28 broke a tie of the support choice by the values ``v @ W`` as the
+    BLAS library rounds them; the checker re-checks their evidence with those choices where the
+    stated order's do not prove the stated bound. The earlier build is replayed here: its
+    refinement in Python with the BLAS choices."""
+    from functools import partial
+
+    from qualgrasp.certify.core.problem import grasp_system
+    from qualgrasp.certify.quality import evidence as evidence_module
+    from qualgrasp.certify.quality.evidence import Evidence
+
+    blas_choices = partial(quality_module.planar_support_choices, blas=True)
+
+    def earlier_surface(W, E, owner, m, eps, u, deadline):
+        first = np.vstack([np.eye(3), -np.eye(3), u[None]])
+        dirs, picks, seen = [], [], set()
+        for v, r in zip(first, blas_choices(W, owner, m, first)):
+            if r.tobytes() not in seen:
+                seen.add(r.tobytes())
+                dirs.append(v)
+                picks.append(r)
+        return quality_module._refine_here(W, E, owner, m, eps * (1 - quality_module.EPS_TOL / 16), dirs, picks,
+                                           deadline)
+
+    grasps = _closure(random_grasps(11, 60, dim=2, n_contacts=10, model="point"))
+    with monkeypatch.context() as patch:
+        patch.setattr(quality_module, "_support_surface", earlier_surface)
+        patch.setattr(quality_module, "planar_support_choices", blas_choices)
+        rows = [certify_grasp(g).row(line=1) for g in grasps]
+    needed = 0
+    for g, row in zip(grasps, rows):
+        assert verify_epsilon(g, row, True), verify_epsilon(g, row, True).reason
+        ev = Evidence.from_json(row["eps_evidence"]["linf"])
+        if ev.kind == "support":
+            W, E, owner = planar_generator_arrays(g)
+            exact = partial(lambda g: grasp_system(g, exact=True).columns, g)
+            needed += bool(evidence_module._planar_lower(W, E, owner, 10, ev, exact, row["eps_linf_lo"], "linf",
+                                                         "eps_linf_lo"))
+    # on a machine whose BLAS fuses multiply-adds (most), some of them need the earlier choices
+    print(f"{needed} of {len(rows)} rows re-checked by the earlier builds' choices")

@@ -1,7 +1,7 @@
 """Planar epsilon evidence of many grasps at once, compiled (numba): the generator wrenches of a
 batch, the sums of one point per contact polytope (the vertices of ``sums`` evidence) and the
 rigorous float checks of many inscribed surfaces; and the vertices of ``support`` evidence
-along many directions.
+along many directions, with the refinement that picks those directions (:func:`support_refine`).
 
 The arithmetic is that of the per-grasp route (:mod:`qualgrasp.certify.quality.bounds`), so the
 floats are the same: the generators by :func:`~.planar.planar_generators`, each sum added
@@ -15,12 +15,22 @@ from __future__ import annotations
 
 import numpy as np
 
+from .hull import face_planes, hull_faces
 from .jit import kernel
 from .linalg import ETA, gamma
+from .order import stable_argsort
 from .planar import planar_generators
 from .surface import cycle_code, face_bounds
 
-__all__ = ["generator_rows", "minkowski_sums", "surface_rows", "support_choices", "vertex_sums"]
+__all__ = ["generator_rows", "minkowski_sums", "surface_rows", "support_choices", "vertex_sums", "support_refine",
+           "REFINED", "ROUNDS_SPENT", "NOT_HERE"]
+
+#: What :func:`support_refine` ends with: the refinement is over, ...
+REFINED = 0
+#: ... its rounds are spent (call it again to go on), ...
+ROUNDS_SPENT = 1
+#: ... or the compiled hull declined the vertices (or gave a NaN distance): the caller goes on.
+NOT_HERE = 2
 
 
 @kernel
@@ -128,12 +138,13 @@ def support_choices(W, owner, m, dirs):
     """The vertex of planar ``support`` evidence along each row of ``dirs`` (n, 3): for each
     contact the first of its generators (columns of ``W`` (3, k), ``owner`` sorted) with the
     largest ``v . g``, or -1 (the origin) when that is not positive, as
-    :func:`qualgrasp.certify.quality.gws.planar_support_choice` states it. Returns the choices
-    (n, m) and whether each row is sure: its dot products are computed here in one order, and
-    any order of the three products and two sums (fused or not) is within ``gamma_3`` of the
-    sum of their magnitudes of the exact value, so a row is sure when every contact's largest
-    value beats the others, and zero, by more than both errors (a tie, or a value at zero, is
-    never sure)."""
+    :func:`qualgrasp.certify.quality.gws.planar_support_choice` states it, with the values
+    ``v . g`` in its order, ``(v0 g0 + v1 g1) + v2 g2`` (products and sums rounded one by one),
+    and -1 for a contact with a NaN value. Returns the choices (n, m) and whether each row is
+    sure: any order of the three products and two sums (fused or not) is within ``gamma_3`` of
+    the sum of their magnitudes of the exact value, so a row is sure when every contact's
+    largest value beats the others, and zero, by more than both errors (a tie, or a value at
+    zero, is never sure: its choice is that of the stated order)."""
     n, k = dirs.shape[0], W.shape[1]
     R = np.full((n, m), -1, dtype=np.int64)
     sure = np.ones(n, dtype=np.bool_)
@@ -157,16 +168,22 @@ def support_choices(W, owner, m, dirs):
                 j1 += 1
             top = vals[best] - errs[best]  # below every value the best can take
             clear = True
+            nan = False
             high = -np.inf  # above every value of the contact
             for j in range(j0, j1):
+                nan = nan or vals[j] != vals[j]
                 high = max(high, vals[j] + errs[j])
                 if j != best and not vals[j] + errs[j] < top:
                     clear = False
-            if high < 0.0:
+            if nan:  # as numpy's maximum: a NaN is the largest value, which is not positive
+                R[q, i] = -1
+                sure[q] = False
+            elif high < 0.0:
                 R[q, i] = -1  # every value of the contact is negative
             elif clear and top > 0.0:
                 R[q, i] = best
             else:
+                R[q, i] = best if vals[best] > 0.0 else -1
                 sure[q] = False
             j0 = j1
     return R, sure
@@ -183,3 +200,82 @@ def vertex_sums(W, E, R):
     for q in range(n):
         _pick_sum(W, E, R[q], V[q], EV[q])
     return V, EV
+
+
+@kernel
+def support_refine(W, E, owner, m, u, cut, limit, add, dirs, picks, n, rounds):
+    """The refinement of planar ``support`` evidence (its directions and their vertices' generator
+    choices), as :func:`qualgrasp.certify.quality.bounds._support_surface` states it, for one
+    grasp: the coordinate directions and ``u`` first (on the first call, ``n == 0``), then per
+    round the hull of the vertices so far; the refinement is over when every face is at least
+    ``cut`` from the origin, ``limit`` directions are kept or no new vertex is found; else the
+    normals of the ``2 add`` faces nearest the origin (stable order) are tried, each kept when its
+    choice (:func:`support_choices`) is a new one.
+
+    ``dirs`` (cap, 3) and ``picks`` (cap, m) hold the ``n`` directions kept and their choices;
+    ``cap`` must be at least ``max(7, limit + 2 add)``. At most ``rounds`` rounds add
+    directions in one call. Returns the new ``n`` and :data:`REFINED`, :data:`ROUNDS_SPENT`
+    (the next call starts with the same hull) or :data:`NOT_HERE`."""
+    if n == 0:
+        first = np.zeros((7, 3))
+        for r in range(3):
+            first[r, r] = 1.0
+            for c in range(3):
+                first[3 + r, c] = -first[r, c]  # -0.0 off the diagonal, as -np.eye(3)
+            first[6, r] = u[r]
+        n = _fresh(W, owner, m, first, dirs, picks, n)
+    V = np.empty((dirs.shape[0], 3))
+    EV = np.empty((dirs.shape[0], 3))
+    for q in range(n):
+        _pick_sum(W, E, picks[q], V[q], EV[q])
+    done = 0
+    while True:
+        P = V[:n].copy()
+        faces = hull_faces(P)
+        if faces.shape[0] == 0:
+            return n, NOT_HERE
+        normal, dist = face_planes(P, faces)
+        least = np.inf
+        for f in range(dist.shape[0]):
+            if dist[f] != dist[f]:
+                return n, NOT_HERE
+            least = min(least, dist[f])
+        if least >= cut or n >= limit:
+            return n, REFINED
+        if done == rounds:
+            return n, ROUNDS_SPENT
+        order = stable_argsort(dist)
+        c = min(2 * add, order.shape[0])
+        cand = np.empty((c, 3))
+        for j in range(c):
+            cand[j] = normal[order[j]]
+        before = n
+        n = _fresh(W, owner, m, cand, dirs, picks, n)
+        if n == before:
+            return n, REFINED
+        for q in range(before, n):
+            _pick_sum(W, E, picks[q], V[q], EV[q])
+        done += 1
+
+
+@kernel
+def _fresh(W, owner, m, cand, dirs, picks, n):
+    """Append to ``dirs`` and ``picks`` (``n`` kept) each row of ``cand`` whose choice is not
+    among those kept, in order; the new ``n``."""
+    R = support_choices(W, owner, m, cand)[0]
+    for j in range(cand.shape[0]):
+        new = True
+        for q in range(n):
+            same = True
+            for i in range(m):
+                if picks[q, i] != R[j, i]:
+                    same = False
+                    break
+            if same:
+                new = False
+                break
+        if new:
+            dirs[n] = cand[j]
+            picks[n] = R[j]
+            n += 1
+    return n

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from .conic import support_points
 from .epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
-from .evidence import minkowski_sums, support_choices, vertex_sums
+from .evidence import minkowski_sums, support_choices, support_refine, vertex_sums
 from .hull import face_planes, hull_faces, hull_grow, hulls_faces, live_facets, used_vertices, weakest_plane
 from .jit import B1, BOOL, F1, F2, F3, FLOAT, I1, I2, INT
 from .planar import planar_generators
@@ -65,6 +65,7 @@ _LARGE_KERNELS = (
     (support_choices, (F2, I1, INT, F2)),
     (vertex_sums, (F2, F2, I2)),
     (face_planes, (F2, I2)),
+    (support_refine, (F2, F2, I1, INT, F1, FLOAT, INT, INT, F2, I2, INT, INT)),
     _ORIENT,
 )
 #: Those kernel sets by name (:func:`~qualgrasp.certify.warmup.compile_ahead`; :mod:`qualgrasp.certify._kernels.jit`).

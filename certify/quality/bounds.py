@@ -89,7 +89,7 @@ from scipy.spatial import ConvexHull, QhullError
 
 from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .._kernels.epsilon import planar_epsilon as epsilon_kernel
-from .._kernels.evidence import minkowski_sums, surface_rows
+from .._kernels.evidence import NOT_HERE, REFINED, minkowski_sums, support_refine, surface_rows
 from .._kernels.hull import face_planes, grow_start, hull_grow, live_facets, used_vertices, weakest_plane
 from .._kernels.jit import await_compiled, compiled_here, kernel_array, mark_compiled, precompile
 from .._kernels.sets import EPSILON_SETS, KERNEL_SETS
@@ -137,6 +137,8 @@ _SWEEP_BATCH = 64
 #: The planar support refinement adds the normals of twice this many weakest faces per round (the
 #: spatial one, that of its weakest face: more per round cost more hull than they save rounds).
 _ADD = 2
+#: Rounds of the compiled planar support refinement between two looks at the clock.
+_ROUNDS = 16
 
 
 @dataclass(frozen=True)
@@ -648,7 +650,7 @@ def _support_result(eps, u, l1_lo, found, limited):
     direction = tuple(float(v) for v in u)
     if found is not None and found[0] >= l1_lo:
         lo, dirs = found
-        points = tuple(float(x) for x in dirs.ravel())
+        points = tuple(np.asarray(dirs, dtype=float).ravel().tolist())  # the same floats, at once
         return lo, eps, direction, Evidence("support", direction, points=points), limited
     return min(l1_lo, eps), eps, direction, Evidence("l1", direction), limited
 
@@ -680,35 +682,61 @@ def _support_surface(W, E, owner, m, eps, u, deadline):
     """The vertices of ``support`` evidence: the hull of support points along the coordinate
     directions and ``u``, refined along the normals of its faces nearest the origin (each cut
     adds a vertex of the GWS beyond the face) until the hull reaches ``eps`` or
-    :data:`_PLANAR_DIRECTIONS` directions are used, or the ``deadline`` passes. Returns ``((directions,
-    vertices, their error bounds, generator choices) or None when the points span no hull,
-    limited)``."""
-    dirs = [np.array(v, dtype=float) for v in np.vstack([np.eye(3), -np.eye(3), u[None]])]
-    seen = set()
-    picks = []  # the generator choices of each direction kept
+    :data:`_PLANAR_DIRECTIONS` directions are used, or the ``deadline`` passes (looked at every
+    :data:`_ROUNDS` rounds). Returns ``((directions, vertices, their error bounds, generator
+    choices) or None when the points span no hull, limited)``.
+
+    The refinement is compiled (:func:`~qualgrasp.certify._kernels.evidence.support_refine`);
+    where its hull declines the vertices (points near a plane), it goes on here with qhull's
+    faces (:func:`_refine_here`)."""
+    W = np.ascontiguousarray(W, dtype=float)
+    E = np.ascontiguousarray(E, dtype=float)
+    owner = np.ascontiguousarray(owner, dtype=np.int64)
+    u = np.ascontiguousarray(u, dtype=float)
+    cap = max(7, _PLANAR_DIRECTIONS + 2 * _ADD)
+    dirs, picks = np.empty((cap, 3)), np.empty((cap, m), dtype=np.int64)
+    cut = eps * (1 - EPS_TOL / 16)
+    # a deadline already passed stops it after the first hull, as a look every round would
+    rounds = _PLANAR_DIRECTIONS if deadline is None else 0 if _expired(deadline) else _ROUNDS
+    n, limited = 0, False
+    while True:
+        n, state = support_refine(W, E, owner, m, u, cut, _PLANAR_DIRECTIONS, _ADD, dirs, picks, n, rounds)
+        if state == NOT_HERE:
+            return _refine_here(W, E, owner, m, cut, list(dirs[:n]), list(picks[:n]), deadline)
+        if state == REFINED:
+            break
+        if _expired(deadline):
+            limited = True
+            break
+        rounds = _ROUNDS
+    R = picks[:n].copy()
+    return (dirs[:n].copy(),) + sum_rows(W, E, R) + (R,), limited
+
+
+def _refine_here(W, E, owner, m, cut, dirs, picks, deadline):
+    """:func:`_support_surface` going on from the directions ``dirs`` and their choices
+    ``picks`` (lists), with the hulls of :func:`~qualgrasp.certify.quality.gws.surface_faces`
+    (qhull's where the compiled hull declines)."""
+    seen = {r.tobytes() for r in picks}  # the choices (int64): equal rows, equal bytes
 
     def fresh(rows):
         out = []
         for v, r in zip(rows, planar_support_choices(W, owner, m, np.array(rows))):
-            key = r.tobytes()  # the choices (int64): equal rows, equal bytes; cheaper than a tuple
+            key = r.tobytes()
             if key not in seen:
                 seen.add(key)
                 out.append(v)
                 picks.append(r)
         return out
 
-    dirs = fresh(dirs)
-    done, limited, pts = 0, False, None
+    limited = False
     while True:
-        # the new vertices, as planar_support_vertices gives them (each depends on its own row)
-        new_pts = sum_rows(W, E, np.array(picks[done:]))[0]
-        pts = np.vstack([pts, new_pts]) if done else new_pts
+        pts = sum_rows(W, E, np.array(picks))[0]
         faces = surface_faces(pts)
         if faces is None:
             return None, limited
-        done = len(dirs)
         normal, dist = face_planes(pts, faces)
-        if dist.min() >= eps * (1 - EPS_TOL / 16) or len(dirs) >= _PLANAR_DIRECTIONS:
+        if dist.min() >= cut or len(dirs) >= _PLANAR_DIRECTIONS:
             break
         if _expired(deadline):
             limited = True

@@ -215,40 +215,47 @@ def sum_errors(E: np.ndarray, mag: np.ndarray, terms: int) -> np.ndarray:
 
 def planar_support_choice(W: np.ndarray, owner: np.ndarray, m: int, v: np.ndarray) -> np.ndarray:
     """The vertex of planar ``support`` evidence along ``v``: for each contact the first of its
-    generators (columns of ``W``, ``owner`` sorted) with the largest ``v @ g``, or -1 (the
-    origin) when that is not positive."""
-    return _choice(v @ W, owner, np.searchsorted(owner, np.arange(m)))
+    generators (columns of ``W``, ``owner`` sorted) with the largest ``v . g``, or -1 (the
+    origin) when that is not positive (or is NaN).
 
-
-def _choice(vals: np.ndarray, owner: np.ndarray, start: np.ndarray) -> np.ndarray:
-    """:func:`planar_support_choice` from the values ``v @ W`` and each contact's first generator."""
+    The values are rounded in one stated order, ``(v0 g0 + v1 g1) + v2 g2``, each product and
+    sum on its own: a tie between generators is then broken the same way on every machine
+    (``v @ W`` would leave it to the BLAS library, whose fused multiply-adds vary with the
+    processor), so a certificate's re-check finds the vertices its run found."""
+    vals = v[0] * W[0] + v[1] * W[1] + v[2] * W[2]
+    start = np.searchsorted(owner, np.arange(m))
     best = np.maximum.reduceat(vals, start)
     k = len(vals)
     first = np.minimum.reduceat(np.where(vals == best[owner], np.arange(k), k), start)
     return np.where(best > 0, first, -1)
 
 
-def planar_support_choices(W, owner, m, dirs: np.ndarray) -> np.ndarray:
-    """The choices of :func:`planar_support_choice` along each row of ``dirs`` (n, m): compiled
-    for every direction whose choice rounding cannot change
-    (:func:`~qualgrasp.certify._kernels.evidence.support_choices`), by that function for the
-    others (ties, values at zero)."""
+def planar_support_choices(W, owner, m, dirs: np.ndarray, *, blas: bool = False) -> np.ndarray:
+    """The choices of :func:`planar_support_choice` along each row of ``dirs`` (n, m), compiled
+    (:func:`~qualgrasp.certify._kernels.evidence.support_choices`, in the same order of
+    rounding).
+
+    ``blas``: the choices of builds before 2026-11-28 for the directions whose choice rounding
+    can change (ties, values at zero): from the values ``v @ W`` as the BLAS library of the
+    machine at hand rounds them, so that the evidence those builds wrote can be re-checked."""
     dirs = np.ascontiguousarray(dirs, dtype=float).reshape(-1, 3)
     R, sure = support_choices(np.ascontiguousarray(W, dtype=float), np.ascontiguousarray(owner, dtype=np.int64),
                               m, dirs)
-    unsure = np.flatnonzero(~sure)
-    if len(unsure):
+    if blas:
         start = np.searchsorted(owner, np.arange(m))
-        for q in unsure:
-            R[q] = _choice(dirs[q] @ W, owner, start)
+        for q in np.flatnonzero(~sure):
+            vals = dirs[q] @ W
+            best = np.maximum.reduceat(vals, start)
+            first = np.minimum.reduceat(np.where(vals == best[owner], np.arange(len(vals)), len(vals)), start)
+            R[q] = np.where(best > 0, first, -1)
     return R
 
 
-def planar_support_vertices(W, E, owner, m, dirs: np.ndarray):
+def planar_support_vertices(W, E, owner, m, dirs: np.ndarray, *, blas: bool = False):
     """Float vertices, error bounds and generator choices (rows, -1 for the origin) of planar
-    ``support`` evidence along the rows of ``dirs`` (:func:`planar_support_choices`,
-    :func:`sum_rows`); each vertex depends on its own direction only."""
-    R = planar_support_choices(W, owner, m, dirs)
+    ``support`` evidence along the rows of ``dirs`` (:func:`planar_support_choices`, with
+    ``blas`` as there; :func:`sum_rows`); each vertex depends on its own direction only."""
+    R = planar_support_choices(W, owner, m, dirs, blas=blas)
     return sum_rows(W, E, R) + (R,)
 
 
