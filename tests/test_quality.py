@@ -663,3 +663,49 @@ def test_planar_support_evidence_of_earlier_builds_is_rechecked(monkeypatch):
                                                          "eps_linf_lo"))
     # on a machine whose BLAS fuses multiply-adds (most), some of them need the earlier choices
     print(f"{needed} of {len(rows)} rows re-checked by the earlier builds' choices")
+
+
+def _hull_minimum_in_numpy(W, owner, m, faces, top=16):
+    """The L1 hull minimum as hull_minima states it, in numpy: sorted face vertices, normals
+    (g_b - g_a) x (g_c - g_a) made unit by sqrt((n0^2 + n1^2) + n2^2), offsets
+    (n0 a0 + n1 a1) + n2 a2 made non-negative, the support at the `top` nearest (stable)."""
+    tri = np.sort(faces, axis=1)
+    A, B, C = W.T[tri[:, 0]], W.T[tri[:, 1]], W.T[tri[:, 2]]
+    p, q = B - A, C - A
+    n = np.stack([p[:, 1] * q[:, 2] - p[:, 2] * q[:, 1], p[:, 2] * q[:, 0] - p[:, 0] * q[:, 2],
+                  p[:, 0] * q[:, 1] - p[:, 1] * q[:, 0]], axis=1)
+    norm = np.sqrt((n[:, 0] * n[:, 0] + n[:, 1] * n[:, 1]) + n[:, 2] * n[:, 2])
+    good = norm > 0
+    n, A = n[good] / norm[good, None], A[good]
+    off = (n[:, 0] * A[:, 0] + n[:, 1] * A[:, 1]) + n[:, 2] * A[:, 2]
+    n[off < 0] *= -1
+    U = n[np.argsort(np.abs(off), kind="stable")[:top]]
+    h = np.array([max(max(0.0, max((float(U[r, 0]) * W[0, j] + float(U[r, 1]) * W[1, j]) + float(U[r, 2]) * W[2, j]
+                                   for j in range(W.shape[1]) if owner[j] == i)) for i in range(m))
+                  for r in range(len(U))])
+    j = int(np.argmin(h))
+    return h[j], U[j]
+
+
+@pytest.mark.parametrize("kwargs", [dict(n_contacts=9, model="point"), dict(n_contacts=20, model="point"),
+                                    dict(n_contacts=6, model="pad")])
+def test_compiled_hull_minima_are_their_stated_arithmetic(kwargs):
+    """The compiled L1 hull minimum of many grasps at once is its formula in numpy, bit for bit,
+    and within rounding of the enumeration's exact planar epsilon (an independent route)."""
+    from qualgrasp.certify._kernels.epsilon import hull_minima
+    from qualgrasp.certify.quality.gws import surfaces_faces
+
+    grasps = [g for g in random_grasps(13, 30, dim=2, **kwargs) if force_closure(g).closure]
+    arrays = [planar_generator_arrays(g) for g in grasps]
+    m = len(grasps[0].contacts)
+    owner = arrays[0][2]
+    faces = surfaces_faces([W.T.copy() for W, _, _ in arrays])
+    assert all(f is not None for f in faces)
+    fstart = np.cumsum([0] + [len(f) for f in faces]).astype(np.int64)
+    eps, arg = hull_minima(np.stack([W for W, _, _ in arrays]), owner, m, np.concatenate(faces), fstart, 16)
+    for b, (W, _, _) in enumerate(arrays):
+        h, u = _hull_minimum_in_numpy(W, owner, m, faces[b])
+        assert float(h).hex() == float(eps[b]).hex() and [x.hex() for x in map(float, u)] == \
+            [x.hex() for x in map(float, arg[b])]
+        exact = float(planar_epsilon_one(W, owner, m, False)[0])
+        assert abs(eps[b] - exact) <= 1e-12 * max(1.0, exact)

@@ -5,8 +5,9 @@ space.
 Two routes: :func:`planar_epsilon` enumerates the candidate normals (triples of generators for
 L1, pairs of edges for L-infinity), ``O(k^4)`` and ``O(k^3)`` for ``k`` generators, the fastest
 for a handful of contacts; :func:`linf_sweep` finds the L-infinity candidates by a sweep around
-the great circle orthogonal to each edge, ``O(k^2 log k)`` in all (the L1 route for many
-generators is the convex hull, in :mod:`qualgrasp.certify.quality.bounds`).
+the great circle orthogonal to each edge, ``O(k^2 log k)`` in all. The L1 route for many
+generators is the convex hull (:mod:`qualgrasp.certify.quality.bounds`), whose faces nearest the
+origin :func:`hull_minima` evaluates.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import numpy as np
 from .jit import kernel
 from .order import stable_argsort
 
-__all__ = ["planar_epsilon_one", "planar_epsilon", "planar_edges", "linf_sweep", "support_rows"]
+__all__ = ["planar_epsilon_one", "planar_epsilon", "planar_edges", "linf_sweep", "support_rows", "hull_minima"]
 
 
 @kernel
@@ -396,3 +397,58 @@ def linf_sweep(Wb, owner, m, E, first, last, top_val, top_u):
             if u0 * w0 + u1 * w1 + u2 * w2 < 0.0:
                 u0, u1, u2 = -u0, -u1, -u2
             _insert(top_val, top_u, val, u0, u1, u2)
+
+
+@kernel
+def hull_minima(W, owner, m, faces, fstart, top):
+    """Planar L1 epsilon of many grasps from their generators' hulls (``W`` (B, 3, k), grasp ``b``
+    owning ``faces[fstart[b]:fstart[b + 1]]``, indices into its generators): per face, its
+    vertices in ascending order ``a < b < c``, the normal ``(g_b - g_a) x (g_c - g_a)`` made
+    unit by ``sqrt((n0^2 + n1^2) + n2^2)`` and turned so that its offset
+    ``(n0 a0 + n1 a1) + n2 a2`` is not negative; the support function evaluated at the normals
+    of the ``top`` faces of least offset (stable order; faces of zero normal left out), its
+    least value and direction (the first of equal values) per grasp. A grasp without a face of
+    non-zero normal gets ``inf``."""
+    B = W.shape[0]
+    eps = np.full(B, np.inf)
+    arg = np.zeros((B, 3))
+    work = np.empty(m)
+    for b in range(B):
+        F = fstart[b + 1] - fstart[b]
+        U = np.empty((F, 3))
+        off = np.empty(F)
+        g = 0
+        for f in range(fstart[b], fstart[b + 1]):
+            i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
+            if i1 < i0:
+                i0, i1 = i1, i0
+            if i2 < i1:
+                i1, i2 = i2, i1
+                if i1 < i0:
+                    i0, i1 = i1, i0
+            a0, a1, a2 = W[b, 0, i0], W[b, 1, i0], W[b, 2, i0]
+            p0, p1, p2 = W[b, 0, i1] - a0, W[b, 1, i1] - a1, W[b, 2, i1] - a2
+            q0, q1, q2 = W[b, 0, i2] - a0, W[b, 1, i2] - a1, W[b, 2, i2] - a2
+            n0 = p1 * q2 - p2 * q1
+            n1 = p2 * q0 - p0 * q2
+            n2 = p0 * q1 - p1 * q0
+            norm = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+            if not norm > 0.0:
+                continue
+            n0, n1, n2 = n0 / norm, n1 / norm, n2 / norm
+            o = n0 * a0 + n1 * a1 + n2 * a2
+            if o < 0.0:
+                n0, n1, n2, o = -n0, -n1, -n2, -o
+            U[g, 0], U[g, 1], U[g, 2] = n0, n1, n2
+            off[g] = abs(o)
+            g += 1
+        if g == 0:
+            continue
+        near = stable_argsort(off[:g])
+        for r in range(min(top, g)):
+            u = U[near[r]]
+            h = _support_planar(W[b], owner, work, u[0], u[1], u[2], False)
+            if r == 0 or h < eps[b] or (h != h and eps[b] == eps[b]):  # as np.argmin: the first NaN, else least
+                eps[b] = h
+                arg[b, 0], arg[b, 1], arg[b, 2] = u[0], u[1], u[2]
+    return eps, arg

@@ -11,7 +11,7 @@ compiling at once.
 from __future__ import annotations
 
 from .conic import support_points
-from .epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
+from .epsilon import hull_minima, linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .evidence import minkowski_sums, support_choices, support_refine, vertex_sums
 from .hull import face_planes, hull_faces, hull_grow, hulls_faces, live_facets, used_vertices, weakest_plane
 from .jit import B1, BOOL, F1, F2, F3, FLOAT, I1, I2, INT
@@ -60,6 +60,7 @@ _COLUMN_KERNELS = (
 #: sweep, ``support`` rows), which must never count a compilation.
 _LARGE_KERNELS = (
     (support_rows, (F2, I1, INT, F2, BOOL)),
+    (hull_minima, (F3, I1, INT, I2, I1, INT)),
     (planar_edges, (F2, I1)),
     (linf_sweep, (F2, I1, INT, F2, INT, INT, F1, F2)),
     (support_choices, (F2, I1, INT, F2)),

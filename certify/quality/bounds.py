@@ -87,7 +87,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import ConvexHull, QhullError
 
-from .._kernels.epsilon import linf_sweep, planar_edges, planar_epsilon_one, support_rows
+from .._kernels.epsilon import hull_minima, linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .._kernels.epsilon import planar_epsilon as epsilon_kernel
 from .._kernels.evidence import NOT_HERE, REFINED, minkowski_sums, support_refine, surface_rows
 from .._kernels.hull import face_planes, grow_start, hull_grow, live_facets, used_vertices, weakest_plane
@@ -97,7 +97,6 @@ from .._kernels.surface import leibniz_tables
 from ..core.arguments import count_in, number_in, require
 from ..errors import ArgumentError
 from ..core.closure import Verdict, force_closure
-from ..core.wrench import cross
 from .evidence import EPS_TOL, Evidence, EvidenceColumns, stated_lo, surface_minimum
 from .gws import (ConicSupport, oriented_surface, planar_generator_arrays, planar_support_choices,
                   hull_rows, sum_rows, surface_faces, surfaces_faces)
@@ -269,21 +268,24 @@ def _lower(eps: float, bounds) -> float | None:
 
 
 def _hull_minimum(W, owner, m, faces):
-    """Planar L1 epsilon from the hull's triangles: the support function, evaluated directly,
-    at the normals (computed as the enumeration computes them) of the faces nearest the origin."""
-    tri = np.sort(faces, axis=1)
-    A, B, C = W.T[tri[:, 0]], W.T[tri[:, 1]], W.T[tri[:, 2]]
-    n = cross(B - A, C - A)  # np.cross's floats, without its 30 us of overhead a call
-    norm = np.linalg.norm(n, axis=1)
-    good = norm > 0
-    n = n[good] / norm[good, None]
-    off = np.einsum("fd,fd->f", n, A[good])
-    n[off < 0] *= -1
-    near = np.argsort(np.abs(off), kind="stable")[:_TOP]
-    U = np.ascontiguousarray(n[near])
-    h = support_rows(W, owner, m, U, False)
-    j = int(np.argmin(h))
-    return float(h[j]), U[j]
+    """Planar L1 epsilon ``(value, direction)`` of one grasp from its generators' hull
+    (:func:`_hull_minima`)."""
+    eps, arg = _hull_minima(W[None], owner, m, faces, np.array([0, len(faces)], dtype=np.int64))
+    return float(eps[0]), arg[0]
+
+
+def _hull_minima(W, owner, m, faces, fstart):
+    """Planar L1 epsilon of many grasps (``W`` (B, 3, k)) from the triangles of their generators'
+    hulls (grasp ``b`` owning ``faces[fstart[b]:fstart[b + 1]]``): the support function, evaluated
+    directly, at the normals of the :data:`_TOP` faces nearest the origin
+    (:func:`~qualgrasp.certify._kernels.epsilon.hull_minima`); the enumeration's where no face
+    has a normal (a hull of slivers)."""
+    W = np.ascontiguousarray(W, dtype=float)
+    eps, arg = hull_minima(W, owner, m, kernel_array(faces, np.int64), fstart, _TOP)
+    none = np.flatnonzero(np.isinf(eps))
+    if len(none):
+        eps[none], arg[none] = epsilon_kernel(W[none], owner, m, False)
+    return eps, arg
 
 
 def _large(k: int, owner, m: int) -> bool:
@@ -536,8 +538,8 @@ def _l1_rows(W, E, owner, m, rows, slow, vals):
     if k <= L1_ENUMERATION_MAX:
         eps, arg = epsilon_kernel(W[rows[have]], owner, m, False)
     else:
-        found = [_hull_minimum(W[b], owner, m, faces[fstart[q]:fstart[q + 1]]) for q, b in enumerate(rows) if have[q]]
-        eps, arg = np.array([e for e, _ in found]).reshape(-1), np.array([u for _, u in found]).reshape(-1, 3)
+        eps, arg = _hull_minima(W[rows], owner, m, faces, fstart)
+        eps, arg = eps[have], arg[have]
     decided, d2_lo, d2_hi = _flat_checks(V, EV, vstart, faces, fstart)
     ok = decided[have]
     slow[rows[~have]] = True
