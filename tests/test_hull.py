@@ -103,15 +103,20 @@ def test_degenerate_sets_are_declined(P):
 
 
 def test_many_sets_at_once():
+    """Many sets in one call (their work arrays shared, sized for the largest) give each set's
+    own faces, also after a larger set and after a declined one."""
     rng = np.random.default_rng(5)
-    sets = [rng.normal(size=(n, 3)) for n in (4, 9, 30)]
+    sets = [rng.normal(size=(n, 3)) for n in (4, 9, 30, 50, 5, 27)]
     sets.insert(1, np.c_[rng.normal(size=(6, 2)), np.zeros(6)])
+    sets.insert(5, np.c_[rng.normal(size=(40, 2)), np.zeros(40)])
+    cube = np.array([[x, y, z] for x in (-1.0, 1.0) for y in (-1.0, 1.0) for z in (-1.0, 1.0)])
+    sets.append(np.concatenate([cube, 0.5 * cube]))  # coplanar faces, interior points
     V = np.ascontiguousarray(np.concatenate(sets))
     vstart = np.cumsum([0] + [len(s) for s in sets]).astype(np.int64)
     faces, fstart = hulls_faces(V, vstart)
     for s, P in enumerate(sets):
         assert np.array_equal(faces[fstart[s]:fstart[s + 1]], hull_faces(P))
-    assert fstart[2] == fstart[1]
+    assert fstart[2] == fstart[1] and fstart[6] == fstart[5]
 
 
 # --- the evidence of many rows held in columns ----------------------------------------------------
@@ -485,4 +490,6 @@ def test_insertion_order_is_a_stable_sort_largest_first(d2):
     from qualgrasp.certify._kernels.hull import _farthest_first
 
     d2 = np.array(d2)
-    assert _farthest_first(d2).tolist() == np.argsort(-d2, kind="stable").tolist()
+    order = np.full(len(d2), -1, dtype=np.int64)
+    _farthest_first(d2, order)
+    assert order.tolist() == np.argsort(-d2, kind="stable").tolist()

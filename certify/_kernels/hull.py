@@ -22,7 +22,7 @@ import numpy as np
 from .jit import kernel
 from .order import stable_argsort
 
-__all__ = ["PLANE_TOL", "hull_faces", "hulls_faces", "face_planes", "used_vertices", "hull_planes", "planes_start",
+__all__ = ["PLANE_TOL", "hull_faces", "hull_work", "hulls_faces", "face_planes", "used_vertices", "hull_planes", "planes_start",
            "planes_insert", "live_planes", "weakest_plane", "hull_grow", "grow_start", "live_facets", "hull_facets"]
 
 #: Relative distance below which a point counts as on a face's plane (times the set's largest
@@ -31,19 +31,17 @@ PLANE_TOL = 2.0**-40
 
 
 @kernel
-def _farthest_first(d2):
-    """Indices of ``d2`` (squared distances, no NaN; negative for points to leave out) from the
-    largest down, ties in index order, the negative ones last (an insertion sort, stable: the sets
-    are small, and this compiles in a fraction of numpy's sort)."""
+def _farthest_first(d2, order):
+    """Into ``order``: the indices of ``d2`` (squared distances, no NaN; negative for points to
+    leave out) from the largest down, ties in index order, the negative ones last (an insertion
+    sort, stable: the sets are small, and this compiles in a fraction of numpy's sort)."""
     n = d2.shape[0]
-    order = np.empty(n, dtype=np.int64)
     for k in range(n):  # insertion: a stable sort, largest first
         j = k
         while j > 0 and d2[order[j - 1]] < d2[k]:
             order[j] = order[j - 1]
             j -= 1
         order[j] = k
-    return order
 
 
 @kernel
@@ -125,20 +123,36 @@ def hull_faces(P):
     sees the faces whose planes it lies more than the tolerance beyond, which are replaced by the
     cone from the point to their horizon. A new face of (near) zero area declines the set.
     """
+    return _hull(P, hull_work(P.shape[0]))
+
+
+@kernel
+def hull_work(n):
+    """The work arrays of :func:`_hull` for sets of up to ``n`` points (a batch of hulls
+    allocates them once)."""
+    cap = 8 * n + 16
+    return (np.empty((cap, 3), dtype=np.int64), np.empty((cap, 4)), np.empty(cap), np.zeros(cap, dtype=np.bool_),
+            np.empty(cap, dtype=np.int64), np.empty(cap, dtype=np.int64), np.empty((3 * cap, 2), dtype=np.int64),
+            np.empty(n, dtype=np.int64), np.empty(n), np.empty(n, dtype=np.int64), np.zeros(n, dtype=np.bool_))
+
+
+@kernel
+def _hull(P, work):
+    """:func:`hull_faces` of ``P`` in the work arrays of :func:`hull_work` (for at least as many
+    points)."""
+    face, plane, size, alive, live, visible, edges, nxt, far, order, taken = work
     n = P.shape[0]
-    empty = np.zeros((0, 3), dtype=np.int64)
     tol = _tolerance(P)
     if n < 4 or not tol >= 0.0:  # too few points, or one not finite
-        return empty
+        return np.zeros((0, 3), dtype=np.int64)
     s = tol / PLANE_TOL  # the largest absolute coordinate (exact: PLANE_TOL is a power of 2)
     first = _start(P, tol)
     if first[0] < 0:
-        return empty
+        return np.zeros((0, 3), dtype=np.int64)
     cap = 8 * n + 16
-    face = np.empty((cap, 3), dtype=np.int64)
-    plane = np.empty((cap, 4))
-    size = np.empty(cap)
-    alive = np.zeros(cap, dtype=np.bool_)
+    alive[:cap] = False
+    taken[:n] = False
+    nxt[:n] = -1
     F = 0
     for o4 in range(4):  # the tetrahedron's faces, each turned away from its fourth vertex
         i, j, k, o = first[0 if o4 > 0 else 1], first[1 if o4 > 1 else 2], first[2 if o4 > 2 else 3], first[o4]
@@ -150,24 +164,21 @@ def hull_faces(P):
         size[F] = nn
         alive[F] = True
         F += 1
-    taken = np.zeros(n, dtype=np.bool_)
     for q in range(4):
         taken[first[q]] = True
-    live = np.empty(cap, dtype=np.int64)  # the live faces, ascending: the scan skips dead ones
-    nl = 4
+    nl = 4  # live: the live faces, ascending (the scan skips dead ones)
     for f in range(4):
         live[f] = f
-    visible = np.empty(cap, dtype=np.int64)
-    edges = np.empty((3 * cap, 2), dtype=np.int64)
-    nxt = np.full(n, -1, dtype=np.int64)
-    far = np.empty(n)  # farthest from the tetrahedron's centre first: extreme points before the
-    for i in range(n):  # points on a facet or edge between them, which would make slivers
+    # farthest from the tetrahedron's centre first: extreme points before the points on a facet
+    # or edge between them, which would make slivers
+    for i in range(n):
         d2 = 0.0
         for r in range(3):
             x = P[i, r] - 0.25 * (P[first[0], r] + P[first[1], r] + P[first[2], r] + P[first[3], r])
             d2 += x * x
         far[i] = d2
-    for p in _farthest_first(far):
+    _farthest_first(far[:n], order)
+    for p in order[:n]:
         if taken[p]:
             continue
         nv = 0
@@ -212,7 +223,7 @@ def hull_faces(P):
         for q in range(ne):
             nxt[edges[q, 0]] = -1
         if not simple or F + ne > cap:
-            return empty
+            return np.zeros((0, 3), dtype=np.int64)
         for q in range(nv):
             alive[visible[q]] = False
         w = 0
@@ -225,7 +236,7 @@ def hull_faces(P):
             a, b = edges[q, 0], edges[q, 1]
             nn = _plane(P, a, b, p, plane[F])
             if not nn > tol * s:  # a sliver (the point on a horizon edge's line)
-                return empty
+                return np.zeros((0, 3), dtype=np.int64)
             face[F, 0], face[F, 1], face[F, 2] = a, b, p
             size[F] = nn
             alive[F] = True
@@ -276,13 +287,17 @@ def hulls_faces(V, vstart):
     S = vstart.shape[0] - 1
     fstart = np.zeros(S + 1, dtype=np.int64)
     faces = np.empty((max(16, 2 * (vstart[S] - vstart[0])), 3), dtype=np.int64)
+    most = 0
+    for s in range(S):
+        most = max(most, vstart[s + 1] - vstart[s])
+    work = hull_work(most)
     for s in range(S):
         n = vstart[s + 1] - vstart[s]
-        P = np.empty((n, 3))  # a copy in C order: the one specialisation of hull_faces
+        P = np.empty((n, 3))  # a copy in C order: the one specialisation of _hull
         for i in range(n):
             for r in range(3):
                 P[i, r] = V[vstart[s] + i, r]
-        f = hull_faces(P)
+        f = _hull(P, work)
         end = fstart[s] + f.shape[0]
         if end > faces.shape[0]:  # room for twice as many
             grown = np.empty((2 * end, 3), dtype=np.int64)
@@ -548,7 +563,9 @@ def planes_start(P):
         far[i] = d2
     for q in range(d + 1):
         far[first[q]] = -1.0  # taken: last, and skipped
-    for p in _farthest_first(far):
+    order = np.empty(n, dtype=np.int64)
+    _farthest_first(far, order)
+    for p in order:
         if far[p] < 0.0:
             continue
         verts, normal, off, alive, F, ok = _insert(P, p, verts, normal, off, alive, F, centre, tol, work, x, col)
