@@ -244,7 +244,7 @@ from qualgrasp.certify import certify_grasp  # noqa: E402
 from qualgrasp.certify.quality import bounds as quality_module  # noqa: E402
 from qualgrasp.certify._kernels.epsilon import planar_epsilon_one  # noqa: E402
 from qualgrasp.certify.quality.evidence import verify_epsilon  # noqa: E402
-from qualgrasp.certify.quality.gws import planar_generator_arrays  # noqa: E402
+from qualgrasp.certify.quality.gws import planar_generator_arrays, surface_faces  # noqa: E402
 from qualgrasp.certify.quality.bounds import epsilons, planar_epsilons  # noqa: E402
 
 PLANAR_KINDS = [dict(n_contacts=3, model="point"), dict(n_contacts=5, model="frictionless"),
@@ -595,8 +595,9 @@ def _float_bits(a):
                                     dict(n_contacts=4, model="pad")])
 def test_compiled_support_refinement_is_the_loop_in_python(kwargs):
     """The compiled refinement of planar ``support`` evidence keeps the directions, vertices,
-    error bounds and choices of the same loop run in Python from its first hull (the route it
-    hands over to where its hull declines), bit for bit (-0.0 of the axes included)."""
+    error bounds, choices and hull faces of the same loop run in Python from its first hull (the
+    route it hands over to where its hull declines), bit for bit (-0.0 of the axes included);
+    the faces are surface_faces' of the vertices."""
     bounds = quality_module
     n = 0
     for g in random_grasps(7, 40, dim=2, **kwargs):
@@ -616,9 +617,10 @@ def test_compiled_support_refinement_is_the_loop_in_python(kwargs):
                 picks.append(r)
         ref, ref_limited = bounds._refine_here(W, E, owner, m, float(eps) * (1 - bounds.EPS_TOL / 16), dirs, picks,
                                                None)
-        assert not limited and not ref_limited and len(got) == len(ref) == 4
+        assert not limited and not ref_limited and len(got) == len(ref) == 5
         for a, b in zip(got, ref):
             assert a.shape == b.shape and np.array_equal(_float_bits(a), _float_bits(b))
+        assert np.array_equal(got[4], surface_faces(got[1]))
         n += 1
     assert n >= 5
 

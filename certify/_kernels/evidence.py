@@ -214,8 +214,9 @@ def support_refine(W, E, owner, m, u, cut, limit, add, dirs, picks, n, rounds):
 
     ``dirs`` (cap, 3) and ``picks`` (cap, m) hold the ``n`` directions kept and their choices;
     ``cap`` must be at least ``max(7, limit + 2 add)``. At most ``rounds`` rounds add
-    directions in one call. Returns the new ``n`` and :data:`REFINED`, :data:`ROUNDS_SPENT`
-    (the next call starts with the same hull) or :data:`NOT_HERE`."""
+    directions in one call. Returns the new ``n``, :data:`REFINED`, :data:`ROUNDS_SPENT` (the
+    next call starts with the same hull) or :data:`NOT_HERE`, and the faces of the hull of the
+    ``n`` vertices (:func:`~.hull.hull_faces`; none with :data:`NOT_HERE`)."""
     if n == 0:
         first = np.zeros((7, 3))
         for r in range(3):
@@ -233,17 +234,17 @@ def support_refine(W, E, owner, m, u, cut, limit, add, dirs, picks, n, rounds):
         P = V[:n].copy()
         faces = hull_faces(P)
         if faces.shape[0] == 0:
-            return n, NOT_HERE
+            return n, NOT_HERE, faces
         normal, dist = face_planes(P, faces)
         least = np.inf
         for f in range(dist.shape[0]):
             if dist[f] != dist[f]:
-                return n, NOT_HERE
+                return n, NOT_HERE, faces[:0]
             least = min(least, dist[f])
         if least >= cut or n >= limit:
-            return n, REFINED
+            return n, REFINED, faces
         if done == rounds:
-            return n, ROUNDS_SPENT
+            return n, ROUNDS_SPENT, faces
         order = stable_argsort(dist)
         c = min(2 * add, order.shape[0])
         cand = np.empty((c, 3))
@@ -252,7 +253,7 @@ def support_refine(W, E, owner, m, u, cut, limit, add, dirs, picks, n, rounds):
         before = n
         n = _fresh(W, owner, m, cand, dirs, picks, n)
         if n == before:
-            return n, REFINED
+            return n, REFINED, faces
         for q in range(before, n):
             _pick_sum(W, E, picks[q], V[q], EV[q])
         done += 1

@@ -99,7 +99,7 @@ from ..errors import ArgumentError
 from ..core.closure import Verdict, force_closure
 from .evidence import EPS_TOL, Evidence, EvidenceColumns, stated_lo, surface_minimum
 from .gws import (ConicSupport, oriented_surface, planar_generator_arrays, planar_support_choices,
-                  hull_rows, sum_rows, surface_faces, surfaces_faces)
+                  hull_rows, sum_rows, surface_faces)
 from ..core.grasp import Grasp
 from ..core.problem import System, grasp_system
 from ..solvers.clarabel_direct import settings
@@ -594,29 +594,27 @@ def _linf_rows(W, E, owner, m, rows, slow, vals, limited, time_limit, exact):
 
 def _support_rows(W, E, owner, m, todo, eps, arg, vals, limited, time_limit, exact):
     """The L-infinity part of :func:`planar_epsilon_columns` beyond :data:`SUMS_MAX` sums: each
-    row's ``support`` surface refined on its own (:func:`_support_surface`), then the hulls'
-    faces oriented and their float checks run for all rows at once; a surface those cannot
-    settle is proved as :func:`_planar_support` proves it. Fills ``vals`` and ``limited`` and
+    row's ``support`` surface refined on its own (:func:`_support_surface`, which gives its
+    hull's faces), then the float checks of all rows at once; a surface those cannot settle is
+    proved as :func:`_planar_support` proves it. Fills ``vals`` and ``limited`` and
     returns the evidence as one block of :meth:`EvidenceColumns.assemble`."""
     refined = []
     for b, e, u in zip(todo, eps, arg):
         deadline = None if time_limit is None else time.perf_counter() + time_limit
         refined.append(_support_surface(W[b], E[b], owner, m, float(e), np.asarray(u, dtype=float), deadline))
-    have = [q for q, (surface, _) in enumerate(refined) if surface is not None]
-    faces = dict(zip(have, surfaces_faces([refined[q][0][1] for q in have])))
-    done = [q for q in have if faces[q] is not None]
+    done = [q for q, (surface, _) in enumerate(refined) if surface is not None]
     proved = dict(zip(done, _checked([refined[q][0][1] for q in done], [refined[q][0][2] for q in done],
-                                     [faces[q] for q in done])))
+                                     [refined[q][0][4] for q in done])))
     evs = []
     for q, (b, e, u) in enumerate(zip(todo, eps, arg)):
         surface, cut = refined[q]
         found = None
         if surface is not None:
-            dirs, V, EV, R = surface
+            dirs, V, EV, R, faces = surface
             bounds = proved.get(q)
-            if bounds is None:  # exact arithmetic needed, or no hull: as the per-grasp route
+            if bounds is None:  # exact arithmetic needed: as the per-grasp route
                 gens = _exact_once(None if exact is None else (lambda b=b: exact(b)))
-                bounds = _prove(V, EV, faces[q], _support_vertex(R, gens))
+                bounds = _prove(V, EV, faces, _support_vertex(R, gens))
             lo = _lower(float(e), bounds)
             found = None if lo is None else (lo, dirs)
         vals[b, 2], vals[b, 3], _, ev, limited[b] = _support_result(float(e), u, vals[b, 0], found, cut)
@@ -664,8 +662,8 @@ def _planar_support(W, E, owner, m, eps, u, deadline, gens):
     surface, limited = _support_surface(W, E, owner, m, eps, u, deadline)
     if surface is None:
         return None, limited
-    dirs, V, EV, R = surface
-    lo = _lower(eps, _prove(V, EV, surface_faces(V), _support_vertex(R, gens)))
+    dirs, V, EV, R, faces = surface
+    lo = _lower(eps, _prove(V, EV, faces, _support_vertex(R, gens)))
     return (None if lo is None else (lo, dirs)), limited
 
 
@@ -686,7 +684,8 @@ def _support_surface(W, E, owner, m, eps, u, deadline):
     adds a vertex of the GWS beyond the face) until the hull reaches ``eps`` or
     :data:`_PLANAR_DIRECTIONS` directions are used, or the ``deadline`` passes (looked at every
     :data:`_ROUNDS` rounds). Returns ``((directions, vertices, their error bounds, generator
-    choices) or None when the points span no hull, limited)``.
+    choices, the faces of their hull as surface_faces gives them) or None when the points span
+    no hull, limited)``.
 
     The refinement is compiled (:func:`~qualgrasp.certify._kernels.evidence.support_refine`);
     where its hull declines the vertices (points near a plane), it goes on here with qhull's
@@ -702,7 +701,7 @@ def _support_surface(W, E, owner, m, eps, u, deadline):
     rounds = _PLANAR_DIRECTIONS if deadline is None else 0 if _expired(deadline) else _ROUNDS
     n, limited = 0, False
     while True:
-        n, state = support_refine(W, E, owner, m, u, cut, _PLANAR_DIRECTIONS, _ADD, dirs, picks, n, rounds)
+        n, state, faces = support_refine(W, E, owner, m, u, cut, _PLANAR_DIRECTIONS, _ADD, dirs, picks, n, rounds)
         if state == NOT_HERE:
             return _refine_here(W, E, owner, m, cut, list(dirs[:n]), list(picks[:n]), deadline)
         if state == REFINED:
@@ -712,7 +711,7 @@ def _support_surface(W, E, owner, m, eps, u, deadline):
             break
         rounds = _ROUNDS
     R = picks[:n].copy()
-    return (dirs[:n].copy(),) + sum_rows(W, E, R) + (R,), limited
+    return (dirs[:n].copy(),) + sum_rows(W, E, R) + (R, faces), limited
 
 
 def _refine_here(W, E, owner, m, cut, dirs, picks, deadline):
@@ -748,7 +747,7 @@ def _refine_here(W, E, owner, m, cut, dirs, picks, deadline):
             break
         dirs += new
     R = np.array(picks)
-    return (np.array(dirs),) + sum_rows(W, E, R) + (R,), limited
+    return (np.array(dirs),) + sum_rows(W, E, R) + (R, faces), limited
 
 
 def _sweep(W, owner, m, deadline):
