@@ -215,7 +215,7 @@ def sum_errors(E: np.ndarray, mag: np.ndarray, terms: int) -> np.ndarray:
 
 def planar_support_choice(W: np.ndarray, owner: np.ndarray, m: int, v: np.ndarray) -> np.ndarray:
     """The vertex of planar ``support`` evidence along ``v``: for each contact the first of its
-    generators (columns of ``W``, ``owner`` sorted) with the largest ``v . g``, or -1 (the
+    generators (columns of ``W``, ``owner`` sorted) with the largest ``dot(v, g)``, or -1 (the
     origin) when that is not positive (or is NaN).
 
     The values are rounded in one stated order, ``(v0 g0 + v1 g1) + v2 g2``, each product and
