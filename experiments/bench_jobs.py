@@ -7,8 +7,8 @@ grasps written to Parquet outside the timing: planar grasps of three point conta
 (both epsilons with their evidence) and without, a degenerate planar set (``qualgrasp sample
 --degenerate mixed``) and its generic counterpart (same model and contact count), and spatial grasps
 of three point contacts with and without quality. Sizes: 1,000,000 planar and 100,000 spatial rows;
-with ``quick`` 20,000 and 2,000. ``kinds`` (``--job``) runs only the jobs whose label contains
-one of its words.
+with ``quick`` 20,000 and 2,000. ``kinds`` (``--job``) runs only the jobs whose label holds
+one of its words (:func:`select_jobs`).
 
 Each job row is set against two baselines timed in the same run, on a prefix of the same grasps, in
 this process: the build's own **per-grasp route** (:func:`qualgrasp.certify.report.certify_grasp`,
@@ -34,6 +34,7 @@ import collections
 import json
 import math
 import os
+import re
 import resource
 import shutil
 import statistics
@@ -205,24 +206,40 @@ def _start_rows(folder: Path, exe: str) -> list[StartRow]:
 
 
 def select_jobs(words: Sequence[str] = ()) -> list[str]:
-    """The labels of :data:`JOB_KINDS` containing one of ``words`` (case-insensitive), in the
-    table's order; every label when ``words`` is empty.
+    """The labels of :data:`JOB_KINDS` holding one of ``words`` (case-insensitive), in the table's
+    order; every label when ``words`` is empty. A word holds one or more whole words of a label,
+    in their order: ``quality`` is in the jobs with quality, not in those with ``--no-quality``
+    (``no-quality``).
 
     Raises
     ------
     OptionError
-        When a word is in no label (naming the labels).
+        When a word is empty or in no label (naming the labels).
 
     Examples
     --------
     >>> select_jobs(["degenerate"])
     ['degenerate planar (mixed), 4 point contacts, --no-quality']
+    >>> len(select_jobs(["quality"])), len(select_jobs(["no-quality"]))
+    (2, 4)
     """
     labels = list(JOB_KINDS)
     for word in words:
-        if not any(word.lower() in label.lower() for label in labels):
+        if not _tokens(word):
+            raise OptionError(f"--job {word!r} holds no word: give one of the labels' words")
+        if not any(_holds(label, word) for label in labels):
             raise OptionError(f"--job {word!r} is in no job's label: " + "; ".join(labels))
-    return [label for label in labels if not words or any(w.lower() in label.lower() for w in words)]
+    return [label for label in labels if not words or any(_holds(label, w) for w in words)]
+
+
+def _tokens(text: str) -> list[str]:
+    return [t.strip("-") for t in re.findall(r"[\w-]+", text.lower()) if t.strip("-")]
+
+
+def _holds(label: str, word: str) -> bool:
+    """Whether the words of ``word`` are consecutive words of ``label``."""
+    have, want = _tokens(label), _tokens(word)
+    return any(have[i:i + len(want)] == want for i in range(len(have) - len(want) + 1))
 
 
 def run_jobs_bench(*, quick: bool = False, seed: int = 0, reference_n: int = 300, sizes: dict | None = None,

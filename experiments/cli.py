@@ -230,8 +230,8 @@ def bench_command(
                                                     "and first-call compile time."),
     quick: bool = typer.Option(False, "--quick", help="With --jobs: 20,000 planar and 2,000 spatial rows per job "
                                                       "instead of 1,000,000 and 100,000."),
-    job: list[str] = typer.Option([], "--job", help="With --jobs: only the jobs whose label contains this word "
-                                                    "(repeatable; e.g. degenerate, spatial)."),
+    job: list[str] = typer.Option([], "--job", help="With --jobs: only the jobs whose label holds this word "
+                                                    "(repeatable; e.g. degenerate, spatial, no-quality)."),
     dexnet: Path | None = typer.Option(None, "--dexnet", show_default=False,
                                        help="With --single: the graspnetAPI 1.2.11 sdist (.tar.gz, its folder or "
                                             "its quality.py) to load Dex-Net from; without it Dex-Net's row is "

@@ -5,6 +5,7 @@ two workers, no row unverified, its baselines timed, and the options."""
 import pytest
 from typer.testing import CliRunner
 
+from qualgrasp.certify.errors import OptionError
 from qualgrasp.cli import app
 from qualgrasp.experiments.bench_jobs import JOB_KINDS, run_jobs_bench, select_jobs
 
@@ -19,6 +20,15 @@ def _check_jobs(jobs, labels):
         assert job.unverified == 0 and job.statuses.get("error", 0) == 0
         assert job.per_grasp_n == 6 and job.cvxpy_n == 2 and 0 <= job.cvxpy_failed <= 2
         assert min(job.wall, job.cpu, job.per_grasp, job.cvxpy) > 0
+
+
+def test_a_job_word_is_whole_words_of_the_labels():
+    assert select_jobs(["quality"]) == [label for label in JOB_KINDS if label.endswith(", quality")]
+    assert select_jobs(["NO-quality", "no-quality"]) == [label for label in JOB_KINDS if label.endswith("--no-quality")]
+    assert select_jobs(["point contacts, quality"]) == select_jobs(["quality"])
+    with pytest.raises(OptionError, match="in no job's label"):  # the words of no label in that order
+        select_jobs(["contacts, quality, spatial"])
+    assert select_jobs([]) == list(JOB_KINDS)
 
 
 def test_selected_jobs_certify_their_whole_sets_and_time_their_baselines():
@@ -45,6 +55,7 @@ def test_every_job_certifies_its_whole_set_and_times_its_baselines():
     (["--quick"], "--quick goes with --jobs"),
     (["--job", "spatial"], "--job goes with --jobs"),
     (["--jobs", "--job", "cylinder"], "'cylinder' is in no job's label"),
+    (["--jobs", "--job", " "], "holds no word"),
 ])
 def test_jobs_options_are_checked(args, message):
     result = runner.invoke(app, ["bench", *args])

@@ -4,6 +4,7 @@ independent fine linearisations, torque scaling, degenerate inputs, Steinitz eff
 import math
 import subprocess
 import sys
+import time
 from itertools import product
 
 import numpy as np
@@ -414,6 +415,12 @@ def test_compiled_support_choices_are_planar_support_choice():
     W = np.array([[1.0, 1.0], [0.0, 0.0], [2.0, -2.0]])  # one contact, a tie along (1, 0, 0)
     R, sure = support_choices(W, np.zeros(2, dtype=np.int64), 1, np.array([[1.0, 0, 0], [0, 0, 1.0]]))
     assert not sure[0] and sure[1] and R[1, 0] == 0 and R[0, 0] == 0
+    W = np.array([[1.0, 2.0, -1.0, 3.0], [0.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 1.0]])
+    for owner, m in ((np.array([0, 0, 2, 2]), 3), (np.array([0, 0, 1, 1]), 3)):  # a contact without generators
+        dirs = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.5]])
+        R = support_choices(W, owner, m, dirs)[0]
+        assert R.tolist() == [list(planar_support_choice(W, owner, m, v)) for v in dirs]
+        assert (R[:, 1 if owner[-1] == 2 else 2] == -1).all()
 
 
 def _choice_in_python_floats(W, owner, m, v):
@@ -591,14 +598,37 @@ def _float_bits(a):
     return a.view(np.int64) if a.dtype == float else a
 
 
+def _python_refinement(W, E, owner, m, eps, u, deadline=None):
+    """The refinement of planar support evidence as a loop in Python from its first directions
+    (``_refine_here``, the route the compiled one hands over to)."""
+    bounds = quality_module
+    first = np.vstack([np.eye(3), -np.eye(3), u[None]])
+    dirs, picks, seen = [], [], set()
+    for v, r in zip(first, bounds.planar_support_choices(W, owner, m, first)):
+        if r.tobytes() not in seen:
+            seen.add(r.tobytes())
+            dirs.append(v)
+            picks.append(r)
+    return bounds._refine_here(W, E, owner, m, eps * (1 - bounds.EPS_TOL / 16), dirs, picks, deadline)
+
+
+def _same_surface(got, ref):
+    (a, limited_a), (b, limited_b) = got, ref
+    assert limited_a == limited_b and (a is None) == (b is None)
+    if a is not None:
+        assert len(a) == len(b) == 5
+        for x, y in zip(a, b):
+            assert x.shape == y.shape and np.array_equal(_float_bits(x), _float_bits(y))
+
+
 @pytest.mark.parametrize("kwargs", [dict(n_contacts=10, model="point"), dict(n_contacts=20, model="point"),
                                     dict(n_contacts=4, model="pad")])
 def test_compiled_support_refinement_is_the_loop_in_python(kwargs):
     """The compiled refinement of planar ``support`` evidence keeps the directions, vertices,
     error bounds, choices and hull faces of the same loop run in Python from its first hull (the
     route it hands over to where its hull declines), bit for bit (-0.0 of the axes included);
-    the faces are surface_faces' of the vertices."""
-    bounds = quality_module
+    the faces are surface_faces' of the vertices. A deadline already passed stops both after
+    their first hull."""
     n = 0
     for g in random_grasps(7, 40, dim=2, **kwargs):
         if not force_closure(g).closure:
@@ -606,23 +636,45 @@ def test_compiled_support_refinement_is_the_loop_in_python(kwargs):
         W, E, owner = planar_generator_arrays(g)
         m = len(g.contacts)
         u = np.array([0.3, -0.5, 0.2])
-        eps = 0.01 if W.shape[1] > 24 else planar_epsilon_one(W, owner, m, True)[0]
-        got, limited = bounds._support_surface(W, E, owner, m, float(eps), u, None)
-        first = np.vstack([np.eye(3), -np.eye(3), u[None]])
-        dirs, picks, seen = [], [], set()
-        for v, r in zip(first, bounds.planar_support_choices(W, owner, m, first)):
-            if r.tobytes() not in seen:
-                seen.add(r.tobytes())
-                dirs.append(v)
-                picks.append(r)
-        ref, ref_limited = bounds._refine_here(W, E, owner, m, float(eps) * (1 - bounds.EPS_TOL / 16), dirs, picks,
-                                               None)
-        assert not limited and not ref_limited and len(got) == len(ref) == 5
-        for a, b in zip(got, ref):
-            assert a.shape == b.shape and np.array_equal(_float_bits(a), _float_bits(b))
-        assert np.array_equal(got[4], surface_faces(got[1]))
+        eps = float(planar_epsilon_one(W, owner, m, True)[0]) if W.shape[1] <= 24 else 0.01
+        got = quality_module._support_surface(W, E, owner, m, eps, u, None)
+        _same_surface(got, _python_refinement(W, E, owner, m, eps, u))
+        assert not got[1] and np.array_equal(got[0][4], surface_faces(got[0][1]))
+        past = time.perf_counter() - 1.0
+        cut = quality_module._support_surface(W, E, owner, m, eps, u, past)
+        _same_surface(cut, _python_refinement(W, E, owner, m, eps, u, past))
         n += 1
     assert n >= 5
+
+
+def test_compiled_support_refinement_hands_over_where_its_hull_declines(monkeypatch):
+    """Generators nearly in a plane: the compiled hull declines some vertex sets part-way (their
+    points within its tolerance of a plane), the refinement goes on in Python with qhull's faces,
+    and the result is the whole loop's in Python."""
+    rng = np.random.default_rng(11)
+    handed = []
+    refine_here = quality_module._refine_here
+    monkeypatch.setattr(quality_module, "_refine_here", lambda *a: handed.append(len(a[5])) or refine_here(*a))
+    mid = 0
+    for _ in range(300):
+        m = int(rng.integers(3, 15))
+        owner = np.repeat(np.arange(m), rng.integers(1, 6, size=m)).astype(np.int64)
+        W = rng.normal(size=(3, len(owner)))
+        W[2] = np.where(rng.random(len(owner)) < rng.uniform(0.5, 0.95), W[2] * rng.choice([1e-11, 1e-12, 1e-13]),
+                        W[2])
+        W, E = np.ascontiguousarray(W), np.abs(W) * 2.0**-52
+        u = rng.normal(size=3)
+        u /= np.linalg.norm(u)
+        eps = float(rng.choice([0.1, 1.0, 10.0]))
+        handed.clear()
+        got = quality_module._support_surface(W, E, owner, m, eps, u, None)
+        first = len(np.unique(quality_module.planar_support_choices(W, owner, m, np.vstack([np.eye(3), -np.eye(3),
+                                                                                          u[None]])), axis=0))
+        mid += bool(handed) and handed[0] > first
+        with monkeypatch.context() as patch:
+            patch.setattr(quality_module, "_refine_here", refine_here)
+            _same_surface(got, _python_refinement(W, E, owner, m, eps, u))
+    assert mid >= 3
 
 
 def test_planar_support_evidence_of_earlier_builds_is_rechecked(monkeypatch):

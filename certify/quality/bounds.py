@@ -279,7 +279,7 @@ def _hull_minima(W, owner, m, faces, fstart):
     hulls (grasp ``b`` owning ``faces[fstart[b]:fstart[b + 1]]``): the support function, evaluated
     directly, at the normals of the :data:`_TOP` faces nearest the origin
     (:func:`~qualgrasp.certify._kernels.epsilon.hull_minima`); the enumeration's where no face
-    has a normal (a hull of slivers)."""
+    has a normal (a hull of slivers). Every grasp must own at least one face."""
     W = np.ascontiguousarray(W, dtype=float)
     eps, arg = hull_minima(W, owner, m, kernel_array(faces, np.int64), fstart, _TOP)
     none = np.flatnonzero(np.isinf(eps))
@@ -537,9 +537,8 @@ def _l1_rows(W, E, owner, m, rows, slow, vals):
     have = np.diff(fstart) > 0
     if k <= L1_ENUMERATION_MAX:
         eps, arg = epsilon_kernel(W[rows[have]], owner, m, False)
-    else:
-        eps, arg = _hull_minima(W[rows], owner, m, faces, fstart)
-        eps, arg = eps[have], arg[have]
+    else:  # the rows without a hull own no faces: the others' ranges follow one another
+        eps, arg = _hull_minima(W[rows[have]], owner, m, faces, np.append(fstart[:-1][have], fstart[-1]))
     decided, d2_lo, d2_hi = _flat_checks(V, EV, vstart, faces, fstart)
     ok = decided[have]
     slow[rows[~have]] = True

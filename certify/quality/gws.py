@@ -222,12 +222,20 @@ def planar_support_choice(W: np.ndarray, owner: np.ndarray, m: int, v: np.ndarra
     sum on its own: a tie between generators is then broken the same way on every machine
     (``v @ W`` would leave it to the BLAS library, whose fused multiply-adds vary with the
     processor), so a certificate's re-check finds the vertices its run found."""
-    vals = v[0] * W[0] + v[1] * W[1] + v[2] * W[2]
-    start = np.searchsorted(owner, np.arange(m))
-    best = np.maximum.reduceat(vals, start)
-    k = len(vals)
-    first = np.minimum.reduceat(np.where(vals == best[owner], np.arange(k), k), start)
-    return np.where(best > 0, first, -1)
+    return _first_largest(v[0] * W[0] + v[1] * W[1] + v[2] * W[2], owner, m)
+
+
+def _first_largest(vals: np.ndarray, owner: np.ndarray, m: int) -> np.ndarray:
+    """Per contact the first of its generators (``owner`` sorted) with the largest of ``vals``,
+    or -1 when that is not positive, is NaN, or the contact has no generator."""
+    out = np.full(m, -1, dtype=np.int64)
+    start, end = np.searchsorted(owner, np.arange(m)), np.searchsorted(owner, np.arange(m), side="right")
+    for i in np.flatnonzero(end > start):
+        seg = vals[start[i]:end[i]]
+        best = seg.max()  # NaN when one is NaN, as the kernel takes it
+        if best > 0:
+            out[i] = start[i] + int(np.argmax(seg == best))
+    return out
 
 
 def planar_support_choices(W, owner, m, dirs: np.ndarray, *, blas: bool = False) -> np.ndarray:
@@ -242,12 +250,8 @@ def planar_support_choices(W, owner, m, dirs: np.ndarray, *, blas: bool = False)
     R, sure = support_choices(np.ascontiguousarray(W, dtype=float), np.ascontiguousarray(owner, dtype=np.int64),
                               m, dirs)
     if blas:
-        start = np.searchsorted(owner, np.arange(m))
         for q in np.flatnonzero(~sure):
-            vals = dirs[q] @ W
-            best = np.maximum.reduceat(vals, start)
-            first = np.minimum.reduceat(np.where(vals == best[owner], np.arange(len(vals)), len(vals)), start)
-            R[q] = np.where(best > 0, first, -1)
+            R[q] = _first_largest(dirs[q] @ W, owner, m)
     return R
 
 
