@@ -22,8 +22,9 @@ import numpy as np
 from .jit import kernel
 from .order import stable_argsort
 
-__all__ = ["PLANE_TOL", "hull_faces", "hull_work", "hulls_faces", "face_planes", "used_vertices", "hull_planes", "planes_start",
-           "planes_insert", "live_planes", "weakest_plane", "hull_grow", "grow_start", "live_facets", "hull_facets"]
+__all__ = ["PLANE_TOL", "hull_faces", "hull_work", "hulls_faces", "face_planes", "used_vertices", "hull_planes",
+           "planes_start", "planes_insert", "live_planes", "weakest_plane", "hull_grow", "grow_start", "live_facets",
+           "hull_facets"]
 
 #: Relative distance below which a point counts as on a face's plane (times the set's largest
 #: absolute coordinate).
