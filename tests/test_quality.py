@@ -688,23 +688,11 @@ def test_planar_support_evidence_of_earlier_builds_is_rechecked(monkeypatch):
     from qualgrasp.certify.quality import evidence as evidence_module
     from qualgrasp.certify.quality.evidence import Evidence
 
-    blas_choices = partial(quality_module.planar_support_choices, blas=True)
-
-    def earlier_surface(W, E, owner, m, eps, u, deadline):
-        first = np.vstack([np.eye(3), -np.eye(3), u[None]])
-        dirs, picks, seen = [], [], set()
-        for v, r in zip(first, blas_choices(W, owner, m, first)):
-            if r.tobytes() not in seen:
-                seen.add(r.tobytes())
-                dirs.append(v)
-                picks.append(r)
-        return quality_module._refine_here(W, E, owner, m, eps * (1 - quality_module.EPS_TOL / 16), dirs, picks,
-                                           deadline)
-
     grasps = _closure(random_grasps(11, 60, dim=2, n_contacts=10, model="point"))
-    with monkeypatch.context() as patch:
-        patch.setattr(quality_module, "_support_surface", earlier_surface)
-        patch.setattr(quality_module, "planar_support_choices", blas_choices)
+    with monkeypatch.context() as patch:  # the loop in Python, its choices the BLAS ones throughout
+        patch.setattr(quality_module, "_support_surface", _python_refinement)
+        patch.setattr(quality_module, "planar_support_choices",
+                      partial(quality_module.planar_support_choices, blas=True))
         rows = [certify_grasp(g).row(line=1) for g in grasps]
     needed = 0
     for g, row in zip(grasps, rows):

@@ -215,8 +215,9 @@ def support_refine(W, E, owner, m, u, cut, limit, add, dirs, picks, n, rounds):
     ``dirs`` (cap, 3) and ``picks`` (cap, m) hold the ``n`` directions kept and their choices;
     ``cap`` must be at least ``max(7, limit + 2 add)``. At most ``rounds`` rounds add
     directions in one call. Returns the new ``n``, :data:`REFINED`, :data:`ROUNDS_SPENT` (the
-    next call starts with the same hull) or :data:`NOT_HERE`, and the faces of the hull of the
-    ``n`` vertices (:func:`~.hull.hull_faces`; none with :data:`NOT_HERE`)."""
+    next call starts with the same hull) or :data:`NOT_HERE`, the faces of the hull of the ``n``
+    vertices (:func:`~.hull.hull_faces`; none with :data:`NOT_HERE`), and the vertices and their
+    error bounds (:func:`vertex_sums` of the choices)."""
     if n == 0:
         first = np.zeros((7, 3))
         for r in range(3):
@@ -234,17 +235,17 @@ def support_refine(W, E, owner, m, u, cut, limit, add, dirs, picks, n, rounds):
         P = V[:n].copy()
         faces = hull_faces(P)
         if faces.shape[0] == 0:
-            return n, NOT_HERE, faces
+            return n, NOT_HERE, faces, V[:n], EV[:n]
         normal, dist = face_planes(P, faces)
         least = np.inf
         for f in range(dist.shape[0]):
             if dist[f] != dist[f]:
-                return n, NOT_HERE, faces[:0]
+                return n, NOT_HERE, faces[:0], V[:n], EV[:n]
             least = min(least, dist[f])
         if least >= cut or n >= limit:
-            return n, REFINED, faces
+            return n, REFINED, faces, V[:n], EV[:n]
         if done == rounds:
-            return n, ROUNDS_SPENT, faces
+            return n, ROUNDS_SPENT, faces, V[:n], EV[:n]
         order = stable_argsort(dist)
         c = min(2 * add, order.shape[0])
         cand = np.empty((c, 3))
@@ -253,7 +254,7 @@ def support_refine(W, E, owner, m, u, cut, limit, add, dirs, picks, n, rounds):
         before = n
         n = _fresh(W, owner, m, cand, dirs, picks, n)
         if n == before:
-            return n, REFINED, faces
+            return n, REFINED, faces, V[:n], EV[:n]
         for q in range(before, n):
             _pick_sum(W, E, picks[q], V[q], EV[q])
         done += 1

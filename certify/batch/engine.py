@@ -537,8 +537,8 @@ def check_paths(grasps: Path, results: Path, chunk_size: int | None = None, othe
 
 def run(grasps: str | Path, results: str | Path, *, options: Options = Options(),
         workers: int | None = None, dask: str | None = None, resume: bool = False,
-        chunk_size: int | None = None,
-        progress: Callable[[int], None] | None = None) -> RunSummary:
+        chunk_size: int | None = None, progress: Callable[[int], None] | None = None,
+        grasp_count: int | None = None) -> RunSummary:
     """Certify the grasp set ``grasps`` into ``results`` in parallel (the input's format is
     recognised by content, the output's by extension; see :func:`check_paths` for what is
     refused before any work).
@@ -557,12 +557,15 @@ def run(grasps: str | Path, results: str | Path, *, options: Options = Options()
         the workers (a dask cluster's as its scheduler counts them).
     progress : callable, optional
         Called with the number of grasps of each chunk as it completes (or is found complete).
+    grasp_count : int, optional
+        The input's grasps (:func:`~qualgrasp.certify.files.reader.count_grasps`) when the caller
+        has counted them, for the default chunk size (else counted here: a scan of JSON Lines).
     """
     grasps, results = Path(grasps), Path(results)
     check_paths(grasps, results, chunk_size, options.source.inputs() if options.source is not None else ())
     with lock_output(results, "-o"):
         try:
-            return _run(grasps, results, options, workers, dask, resume, chunk_size, progress)
+            return _run(grasps, results, options, workers, dask, resume, chunk_size, progress, grasp_count)
         except (OSError, pa.ArrowException) as err:
             raise CertifyError(_fault(err, results)) from None
         except BrokenProcessPool:  # a worker killed (a signal, out of memory) or crashed: no Python error to give
@@ -595,7 +598,8 @@ def _kept(results: Path) -> str:
 
 
 def _run(grasps: Path, results: Path, options: Options, workers: int | None, dask: str | None,
-         resume: bool, chunk_size: int | None, progress: Callable[[int], None] | None) -> RunSummary:
+         resume: bool, chunk_size: int | None, progress: Callable[[int], None] | None,
+         grasp_count: int | None = None) -> RunSummary:
     start = time.perf_counter()
     workers = workers or os.cpu_count() or 1
     # The pool first: a scheduler that cannot be reached leaves nothing behind.
@@ -603,7 +607,8 @@ def _run(grasps: Path, results: Path, options: Options, workers: int | None, das
     try:
         if chunk_size is None:  # the pool's workers: a remote cluster's, not this machine's cores
             chunk_size = (resume and _resumed_chunk_size(results)
-                          or chunk_size_for(count_grasps(grasps), pool.capacity // 2 if pool else 1))
+                          or chunk_size_for(count_grasps(grasps) if grasp_count is None else grasp_count,
+                                            pool.capacity // 2 if pool else 1))
         parts = _prepare(grasps, results, chunk_size, options, resume)
     except BaseException:
         if pool is not None:

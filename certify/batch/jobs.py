@@ -34,17 +34,17 @@ def certify_file(grasps_path: str | Path, results_path: str | Path, *, method: M
                  progress: Callable[[int], None] | None = None, workers: int | None = 1,
                  dask: str | None = None, resume: bool = False, chunk_size: int | None = None,
                  quality: bool = True, eps_gap: float = 0.01, eps_budget: int = 200_000,
-                 eps_time: float | None = 10.0, source: Any = None) -> RunSummary:
+                 eps_time: float | None = 10.0, source: Any = None, grasp_count: int | None = None) -> RunSummary:
     """Certify every grasp of ``grasps_path`` into ``results_path``: one results row per grasp,
-    in input order. See :func:`qualgrasp.certify.batch.engine.run` for ``workers``, ``dask``, ``resume`` and
-    ``chunk_size`` (``workers=None`` uses every core); ``quality``, ``eps_gap``, ``eps_budget``,
+    in input order. See :func:`qualgrasp.certify.batch.engine.run` for ``workers``, ``dask``, ``resume``,
+    ``chunk_size`` and ``grasp_count`` (``workers=None`` uses every core); ``quality``, ``eps_gap``, ``eps_budget``,
     ``eps_time`` and ``source`` are :class:`qualgrasp.certify.batch.chunk.Options`' (``eps_time``
     in seconds per grasp, None for no limit; ``source`` turns the input's rows into grasps, such
     as :class:`qualgrasp.certify.meshes.source.PoseSource` for poses on a mesh)."""
     options = Options(method=method, quality=quality, eps_gap=eps_gap, eps_budget=eps_budget,
                       eps_time=eps_time, source=source)
     return run(grasps_path, results_path, options=options, workers=workers, dask=dask,
-               resume=resume, chunk_size=chunk_size, progress=progress)
+               resume=resume, chunk_size=chunk_size, progress=progress, grasp_count=grasp_count)
 
 
 @dataclass

@@ -10,7 +10,6 @@ Each command is a thin wrapper over a public function (:func:`qualgrasp.certify.
 from __future__ import annotations
 
 import math
-import os
 from pathlib import Path
 
 import typer
@@ -19,7 +18,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from .. import models
-from ..batch.engine import chunk_size_for, tune_allocator
+from ..batch.engine import tune_allocator
 from ..batch.jobs import certify_file, verify_file
 from ..errors import CertifyError
 from ..regions.files import DEFAULT_BUDGET, certify_region_file, verify_region_file
@@ -109,8 +108,6 @@ def certify_command(
         except CertifyError as err:
             fail(str(err))
     total = count_grasps(grasps)
-    if chunk_size is None and not resume and dask is None:  # the count made once (a scan of JSON Lines)
-        chunk_size = chunk_size_for(total, workers or os.cpu_count() or 1)
     tune_allocator()  # this process is the command's own
     with Progress(TextColumn("certify"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
                   console=console, disable=quiet) as bar:
@@ -120,7 +117,8 @@ def certify_command(
                                    progress=lambda n: bar.advance(task, n), quality=quality,
                                    eps_gap=eps_gap, eps_budget=eps_budget,
                                    eps_time=eps_time if eps_time > 0 else None, workers=workers or None,
-                                   dask=dask, resume=resume, chunk_size=chunk_size, source=source)
+                                   dask=dask, resume=resume, chunk_size=chunk_size, source=source,
+                                   grasp_count=total)
         except CertifyError as err:
             fail(str(err))
     if not quiet:

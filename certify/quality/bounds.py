@@ -700,7 +700,8 @@ def _support_surface(W, E, owner, m, eps, u, deadline):
     rounds = _PLANAR_DIRECTIONS if deadline is None else 0 if _expired(deadline) else _ROUNDS
     n, limited = 0, False
     while True:
-        n, state, faces = support_refine(W, E, owner, m, u, cut, _PLANAR_DIRECTIONS, _ADD, dirs, picks, n, rounds)
+        n, state, faces, V, EV = support_refine(W, E, owner, m, u, cut, _PLANAR_DIRECTIONS, _ADD, dirs, picks, n,
+                                                rounds)
         if state == NOT_HERE:
             return _refine_here(W, E, owner, m, cut, list(dirs[:n]), list(picks[:n]), deadline)
         if state == REFINED:
@@ -709,8 +710,7 @@ def _support_surface(W, E, owner, m, eps, u, deadline):
             limited = True
             break
         rounds = _ROUNDS
-    R = picks[:n].copy()
-    return (dirs[:n].copy(),) + sum_rows(W, E, R) + (R, faces), limited
+    return (dirs[:n].copy(), V, EV, picks[:n].copy(), faces), limited
 
 
 def _refine_here(W, E, owner, m, cut, dirs, picks, deadline):
