@@ -114,3 +114,66 @@ def test_strict_separation_with_small_products_is_a_certificate():
     assert verify(grasp, form.certificate, status="no_closure", frictionless=True).ok
     report = certify_grasp(grasp, quality=False)
     assert report.force.status == "closure" and report.verified
+
+
+def _exact_only(g, cert, frictionless, **claims):
+    """:func:`verify` by its exact route alone (rationals, no float proof first)."""
+    from qualgrasp.certify.core.certificates import verify_system
+    from qualgrasp.certify.core.problem import grasp_system
+
+    return verify_system(*grasp_system(g, frictionless=frictionless, exact=True), cert, **claims)
+
+
+def _tampered(g, v, other, rng):
+    """The certificate of verdict ``v`` of ``g`` with its claims, then tampered versions of it:
+    values or direction moved or negated, another basis, margins claimed a little or much off,
+    the wrong status, and ``other``'s certificate for ``g``."""
+    c, status = v.certificate, v.status
+    yield c, dict(status=status, margin=v.margin)
+    yield c, dict(status=status, margin=v.margin, exact_margin=True)
+    yield c, dict(status="no_closure" if status == "closure" else "closure")
+    yield other, dict(status=status)
+    if c.kind == "interior":
+        x = np.array(c.values)
+        yield dataclasses.replace(c, values=tuple(-x)), dict(status=status)
+        yield dataclasses.replace(c, values=tuple(x + 1e-3 * rng.normal(size=x.size))), dict(status=status)
+        yield dataclasses.replace(c, values=tuple(x * (1 + 1e-9))), dict(status=status, margin=v.margin)
+        yield dataclasses.replace(c, basis=tuple((b + 1) % len(x) for b in c.basis)), dict(status=status)
+        for factor in (1 + 3e-6, 1 + 6e-7, 1 - 6e-7, 1 - 3e-6, 2):
+            yield c, dict(status=status, margin=v.margin * factor, exact_margin=True)
+            yield c, dict(status=status, margin=v.margin * factor)
+    elif c.y is not None:
+        y = np.array(c.y)
+        yield dataclasses.replace(c, y=tuple(-y)), dict(status=status)
+        yield dataclasses.replace(c, y=tuple(y + 1e-3 * rng.normal(size=y.size))), dict(status=status)
+        yield dataclasses.replace(c, y=tuple(y + 1e-12 * rng.normal(size=y.size))), dict(status=status)
+
+
+def test_float_proofs_of_large_planar_grasps_agree_with_the_exact_route():
+    # From FLOAT_PROOF_CONTACTS contacts on, verify proves planar certificates with the
+    # rigorous float kernels first. Such a proof must never accept what the exact route refuses
+    # (genuine and tampered certificates alike), and it must prove most genuine ones (else the
+    # route is dead code and the test would pass vacuously).
+    from qualgrasp.certify.core import certificates
+
+    rng = np.random.default_rng(3)
+    grasps = (random_grasps(11, 24, dim=2, n_contacts=10) + random_grasps(12, 12, dim=2, n_contacts=20)
+              + random_grasps(13, 12, dim=2, n_contacts=8, model="pad"))
+    genuine = proved = checked = 0
+    for i, g in enumerate(grasps):
+        for fl in (False, True):
+            v = form_closure(g) if fl else force_closure(g)
+            other = (form_closure if fl else force_closure)(grasps[i - 1]).certificate
+            for n, (cert, claims) in enumerate(_tampered(g, v, other, rng)):
+                exact = bool(_exact_only(g, cert, fl, **claims))
+                fast = certificates._proved_in_floats(g, cert, claims.get("status"), claims.get("margin"), fl,
+                                                      certificates.Tolerances())
+                assert exact or not fast, (g, cert, claims)  # sound: never more than the exact route
+                assert bool(verify(g, cert, frictionless=fl, **claims)) == exact, (g, cert, claims)
+                checked += 1
+                large = len(g.contacts) >= certificates.FLOAT_PROOF_CONTACTS
+                if n == 0 and large and v.certificate.kind in ("interior", "farkas") and not v.certificate.tight:
+                    genuine += 1
+                    proved += fast
+    assert checked > 500 and genuine > 50
+    assert proved >= 0.9 * genuine, (proved, genuine)

@@ -245,7 +245,8 @@ from qualgrasp.certify import certify_grasp  # noqa: E402
 from qualgrasp.certify.quality import bounds as quality_module  # noqa: E402
 from qualgrasp.certify._kernels.epsilon import planar_epsilon_one  # noqa: E402
 from qualgrasp.certify.quality.evidence import verify_epsilon  # noqa: E402
-from qualgrasp.certify.quality.gws import planar_generator_arrays, surface_faces  # noqa: E402
+from qualgrasp.certify.core.wrench import planar_generator_arrays  # noqa: E402
+from qualgrasp.certify.quality.gws import surface_faces  # noqa: E402
 from qualgrasp.certify.quality.bounds import epsilons, planar_epsilons  # noqa: E402
 
 PLANAR_KINDS = [dict(n_contacts=3, model="point"), dict(n_contacts=5, model="frictionless"),

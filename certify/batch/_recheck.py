@@ -27,7 +27,7 @@ from .. import models as registry
 from .._kernels.jit import kernel_array
 from .._kernels.planar import planar_generators
 from .._kernels.recheck import null_rows, verify_farkas_general, verify_interior_general
-from ..core.certificates import Tolerances, margin_of, margin_tolerance
+from ..core.certificates import Tolerances, margin_matches
 from ..files.columns import GraspColumns
 from ..core.cones import CONES
 from ..quality.evidence import EPS_COLUMNS, Evidence, verify_bounds
@@ -196,13 +196,10 @@ def _eps_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, status: np.
 
 
 def _margin_ok(claimed: float, cone, first, width, n, mu, g, x) -> bool:
-    """The claimed margin is the margin the values certify (slack over total normal force) to
-    within the exact checker's tolerance, kept a little tighter here: the exact checker
-    corrects the values first, so a row near the edge goes to it."""
+    """:func:`margin_matches` of the blocks given as arrays."""
     blocks = [Block(CONES[cone[b]], tuple(range(first[b], first[b] + width[b])), tuple(n[b]), mu[b], g[b], b)
               for b in range(len(cone))]
-    t = margin_of(blocks, x)
-    return abs(claimed - t) <= 0.5 * margin_tolerance(t)
+    return margin_matches(claimed, blocks, x)
 
 
 def _claims(cols: GraspColumns, results: pa.Table, lines) -> np.ndarray:

@@ -1,7 +1,11 @@
 """Certificates of closure verdicts and their independent verification.
 
 A certificate is re-checked against the grasp with exact rational arithmetic on the float data
-(:mod:`qualgrasp.certify.core.exact`) and no solver:
+(:mod:`qualgrasp.certify.core.exact`) and no solver. For a planar grasp with many contacts
+(:data:`FLOAT_PROOF_CONTACTS`), :func:`verify` first tries the rigorous floating-point kernels
+(error bounds instead of rationals, as ``qualgrasp verify`` uses in bulk), which prove the same
+statements below; what they cannot prove goes to the rationals, which also give the reason of a
+failure.
 
 ``interior`` (closure)
     Values ``x`` over the certificate columns ``C`` (generator weights, or world-frame contact
@@ -37,11 +41,12 @@ import numpy as np
 from . import cones
 from . import exact as ex
 from .._kernels.cones import polar_values as kernel_polar_values
+from .._kernels.recheck import verify_farkas_general, verify_interior_general
 from ..errors import CertificateError
 from .arguments import number_in, require
 from .grasp import Grasp
-from .problem import Block, block_arrays, grasp_system, span_system, span_vectors
-from .wrench import to_exact
+from .problem import Block, block_arrays, grasp_system, ray_block_arrays, span_system, span_vectors
+from .wrench import planar_generator_arrays, to_exact
 
 __all__ = [
     "Tolerances",
@@ -51,6 +56,8 @@ __all__ = [
     "verify_span",
     "verify_system",
     "margin_tolerance",
+    "margin_matches",
+    "FLOAT_PROOF_CONTACTS",
 ]
 
 
@@ -175,7 +182,8 @@ def verify(grasp: Grasp, certificate: Certificate, *, status: str | None = None,
            margin: float | None = None, frictionless: bool = False,
            tol: Tolerances = Tolerances(), exact_margin: bool = False) -> Check:
     """Re-check ``certificate`` against ``grasp`` without a solver, in exact rational arithmetic
-    on the float data (module docstring).
+    on the float data, or first by rigorous float bounds for planar grasps of
+    :data:`FLOAT_PROOF_CONTACTS` contacts or more (module docstring).
 
     Parameters
     ----------
@@ -221,6 +229,8 @@ def verify(grasp: Grasp, certificate: Certificate, *, status: str | None = None,
     require(grasp, Grasp, "grasp")
     require(certificate, Certificate, "certificate")
     require(tol, Tolerances, "tol")
+    if _proved_in_floats(grasp, certificate, status, margin, frictionless, tol):
+        return Check(True)
     socp = certificate.layout == "forces"  # a planar grasp may be certified by its 2-D cones
     try:
         Cx, blocks, layout = grasp_system(grasp, frictionless=frictionless, socp=socp, exact=True)
@@ -228,6 +238,48 @@ def verify(grasp: Grasp, certificate: Certificate, *, status: str | None = None,
         return Check(False, f"certificate layout {certificate.layout!r}: {err}")
     return verify_system(Cx, blocks, layout, certificate, status=status, margin=margin, tol=tol,
                          exact_margin=exact_margin)
+
+
+#: Fewest contacts of a planar grasp whose certificate :func:`verify` first tries to prove with
+#: the rigorous floating-point kernels, as ``qualgrasp verify`` proves results in bulk: from 8
+#: contacts on, where the exact route costs about a millisecond and more a grasp and the floats
+#: a tenth of that. Smaller grasps go to the exact route only, which also spares a short run
+#: the kernels' compilation.
+FLOAT_PROOF_CONTACTS = 8
+
+
+def _proved_in_floats(grasp: Grasp, cert: Certificate, status, margin, frictionless: bool,
+                      tol: Tolerances) -> bool:
+    """Whether the rigorous float kernels (:func:`~qualgrasp.certify._kernels.recheck.verify_interior_general`,
+    :func:`~qualgrasp.certify._kernels.recheck.verify_farkas_general`: error bounds instead of
+    rationals) prove what :func:`verify` checks, for a planar grasp of at least
+    :data:`FLOAT_PROOF_CONTACTS` contacts whose models' float cone weights are exact: an
+    interior certificate whose claimed margin matches (:func:`margin_matches`), or a strict
+    Farkas one (no tight block). False decides nothing: the exact route then checks, and gives
+    the reason of a failure."""
+    if grasp.dim != 2 or cert.layout != "generators" or cert.kind not in ("interior", "farkas"):
+        return False
+    if (status is not None and _KIND.get(status) != cert.kind) or \
+            not all(c.contact_model.exact_in_floats for c in grasp.contacts):
+        return False
+    if len(grasp.contacts) < FLOAT_PROOF_CONTACTS:
+        return False
+    W, E, _ = planar_generator_arrays(grasp, frictionless=frictionless)
+    k = W.shape[1]
+    cone, first, width = ray_block_arrays(k)
+    n, zero = np.zeros((k, 2)), np.zeros(k)
+    if cert.kind == "farkas":
+        y = np.asarray(cert.y if cert.y is not None else [], dtype=float)
+        return (not cert.tight and not cert.null_space and y.shape == (3,) and bool(np.isfinite(y).all())
+                and verify_farkas_general(W, E, cone, first, width, n, zero, zero, y, np.zeros(k, dtype=bool), 0.0))
+    x = np.asarray(cert.values if cert.values is not None else [], dtype=float)
+    basis = np.asarray(cert.basis if cert.basis is not None else [], dtype=np.int64)
+    if x.shape != (k,) or not np.isfinite(x).all() or basis.shape != (3,) or len(set(basis.tolist())) != 3 \
+            or not ((basis >= 0) & (basis < k)).all():
+        return False
+    if not verify_interior_general(W, E, cone, first, width, n, zero, zero, x, basis, tol.residual):
+        return False
+    return margin is None or margin_matches(margin, [Block("ray", (j,), contact=j) for j in range(k)], x)
 
 
 def verify_span(vectors, certificate: Certificate, *, status: str | None = None,
@@ -265,6 +317,23 @@ def margin_tolerance(t: float) -> float:
     """How far a claimed margin may lie from the margin ``t`` that a certificate's values
     certify: ``1e-9 + 1e-6 |t|``."""
     return 1e-9 + 1e-6 * abs(t)
+
+
+def margin_matches(claimed: float, blocks, x) -> bool:
+    """Whether a claimed margin is the margin that values ``x`` certify over ``blocks``
+    (:func:`margin_of`) to within half :func:`margin_tolerance`: the rule of the rigorous float
+    proofs, which do not correct the values first as the exact checker does, so that a claim
+    near the edge goes to the exact checker.
+
+    Examples
+    --------
+    >>> from qualgrasp.certify.core.problem import Block
+    >>> blocks = [Block("ray", (0,)), Block("ray", (1,))]
+    >>> margin_matches(0.25, blocks, [1.0, 3.0]), margin_matches(0.3, blocks, [1.0, 3.0])
+    (True, False)
+    """
+    t = margin_of(blocks, x)
+    return abs(claimed - t) <= 0.5 * margin_tolerance(t)
 
 
 def _verify_interior(Cx, blocks, cert: Certificate, margin, tol: Tolerances,

@@ -19,6 +19,7 @@ from . import exact as ex
 from .. import models as registry
 from ..errors import ArgumentError
 from .._kernels.linalg import ETA
+from .._kernels.planar import planar_generators
 from .grasp import Grasp
 from .validation import param_names
 
@@ -35,6 +36,7 @@ __all__ = [
     "grasp_arrays",
     "variants_of",
     "force_column_errors",
+    "planar_generator_arrays",
     "planar_generator_rank",
     "planar_pair_normal",
 ]
@@ -200,6 +202,30 @@ def generator_columns(P, N, mu, models, center, length, *, frictionless: bool = 
             Pk = np.where((offset != 0)[:, None], Pk + (conv(offset) * width[..., owner])[..., None] * T, Pk)
     W = wrench(Pk, F, np.asarray(center)[..., None, :], np.asarray(length)[..., None])
     return np.swapaxes(W, -1, -2), owner
+
+
+def planar_generator_arrays(grasp: Grasp, *, frictionless: bool = False):
+    """Generator wrenches ``W`` (3, k) of a planar grasp, bounds ``E`` on their distance to the
+    exact values (:func:`qualgrasp.certify._kernels.planar.planar_generators`: the floats of
+    :func:`qualgrasp.certify.core.problem.grasp_system`), and the owner contact of each (sorted).
+    ``frictionless=True`` gives those of its form-closure problem (each model's frictionless
+    counterpart, :func:`generator_layout`).
+
+    Examples
+    --------
+    >>> from qualgrasp.certify import Contact, Grasp
+    >>> g = Grasp((Contact((1, 0), (-1, 0), "point", 0.5), Contact((-1, 0), (1, 0), "point", 0.5)))
+    >>> W, E, owner = planar_generator_arrays(g)
+    >>> W.shape, owner.tolist(), planar_generator_arrays(g, frictionless=True)[0].shape
+    ((3, 4), [0, 0, 1, 1], (3, 2))
+    """
+    P, N, mu, params, c, L = grasp_arrays(grasp)
+    models = tuple(ct.model for ct in grasp.contacts)
+    owner, offset, friction = generator_layout(models, variants_of(grasp), 2, frictionless=frictionless)
+    W = np.empty((3, len(owner)))
+    E = np.empty((3, len(owner)))
+    planar_generators(P, N, mu, registry.offset_lengths(models, params), c, float(L), owner, offset, friction, W, E)
+    return W, E, owner
 
 
 def planar_generator_rank(P, N, mu, width, owner, offset, friction, cols=None) -> int:

@@ -98,10 +98,11 @@ from ..core.arguments import count_in, number_in, require
 from ..errors import ArgumentError
 from ..core.closure import Verdict, force_closure
 from .evidence import EPS_TOL, Evidence, EvidenceColumns, stated_lo, surface_minimum
-from .gws import (ConicSupport, oriented_surface, planar_generator_arrays, planar_support_choices,
+from .gws import (ConicSupport, oriented_surface, planar_support_choices,
                   hull_rows, sum_rows, surface_faces)
 from ..core.grasp import Grasp
 from ..core.problem import System, grasp_system
+from ..core.wrench import planar_generator_arrays
 from ..solvers.clarabel_direct import settings
 
 __all__ = ["Norm", "NORMS", "Epsilon", "epsilon", "epsilons", "planar_epsilon", "planar_epsilons",
@@ -317,7 +318,7 @@ def planar_epsilons(W, E, owner, m: int, *, deadline: float | None = None, exact
     ----------
     W, E : ndarray, shape (3, k)
         Generator wrenches and bounds on their distance to the exact ones
-        (:func:`planar_generator_arrays`).
+        (:func:`~qualgrasp.certify.core.wrench.planar_generator_arrays`).
     owner : ndarray of int, shape (k,)
         Contact of each generator (sorted).
     m : int

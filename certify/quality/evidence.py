@@ -77,7 +77,8 @@ from .._kernels.surface import cycle_code, face_bounds, face_bounds_laplace, lei
 from ..core.certificates import Check
 from ..core.grasp import Grasp
 from ..core.problem import grasp_system
-from .gws import ConicSupport, planar_generator_arrays, planar_support_vertices, sum_rows, surface_faces
+from ..core.wrench import planar_generator_arrays
+from .gws import ConicSupport, planar_support_vertices, sum_rows, surface_faces
 
 __all__ = ["EPS_TOL", "KINDS", "Evidence", "EvidenceColumns", "cycle_check", "exact_face", "surface_minimum",
            "stated_lo",

@@ -6,7 +6,8 @@ Computing the bounds (:mod:`qualgrasp.certify.quality.bounds`) and proving them
 (:mod:`qualgrasp.certify.quality.evidence`) build the vertices of an inscribed polytope with the
 same functions, so that a vertex the evidence names is the vertex that was computed:
 
-* planar grasps: the generator wrenches with their error bounds (:func:`planar_generator_arrays`),
+* planar grasps: the generator wrenches with their error bounds
+  (:func:`~qualgrasp.certify.core.wrench.planar_generator_arrays`),
   the support point along a direction (:func:`planar_support_choice`, the first generator of each
   contact with the largest ``v . g``) and sums of generators (:func:`sum_rows`);
 * spatial grasps with exact cones: the support forces of every contact (:class:`ConicSupport`),
@@ -25,21 +26,19 @@ from typing import Sequence
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
-from .. import models as registry
 from .._kernels.conic import SHRINK, support_points
 from .._kernels.evidence import support_choices, vertex_sums
 from .._kernels.hull import hull_facets, hull_faces, hulls_faces
 from .._kernels.jit import kernel_array
-from .._kernels.planar import planar_generators
 from .._kernels.surface import orient_cycle
 from ..core import cones
 from ..core.grasp import Grasp
 from ..core.problem import grasp_system
-from ..core.wrench import force_column_errors, generator_layout, grasp_arrays, to_exact, variants_of
+from ..core.wrench import force_column_errors, grasp_arrays, to_exact
 
 __all__ = ["SHRINK", "surface_faces", "surfaces_faces", "oriented_surface", "hull_rows", "orient_faces",
            "generalised_cross", "face_distances",
-           "planar_generator_arrays", "sum_errors", "planar_support_choice", "planar_support_choices",
+           "sum_errors", "planar_support_choice", "planar_support_choices",
            "planar_support_vertices",
            "sum_rows", "sqrt_bounds", "vertex_scale", "ConicSupport"]
 
@@ -193,19 +192,6 @@ def face_distances(points: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 
 # --- planar generators and support points -------------------------------------------------------
-
-def planar_generator_arrays(grasp: Grasp):
-    """Generator wrenches ``W`` (3, k) of a planar grasp, bounds ``E`` on their distance to the
-    exact values (:func:`qualgrasp.certify._kernels.planar.planar_generators`: the floats of
-    :func:`qualgrasp.certify.core.problem.grasp_system`), and the owner contact of each (sorted)."""
-    P, N, mu, params, c, L = grasp_arrays(grasp)
-    models = tuple(ct.model for ct in grasp.contacts)
-    owner, offset, friction = generator_layout(models, variants_of(grasp), 2)
-    W = np.empty((3, len(owner)))
-    E = np.empty((3, len(owner)))
-    planar_generators(P, N, mu, registry.offset_lengths(models, params), c, float(L), owner, offset, friction, W, E)
-    return W, E, owner
-
 
 def sum_errors(E: np.ndarray, mag: np.ndarray, terms: int) -> np.ndarray:
     """Error bound of a float sum of ``terms`` points whose own errors add up to ``E`` and whose

@@ -19,7 +19,9 @@ which happens exactly when ``W' y = -1`` is solvable: that ``y`` separates stric
 
 from __future__ import annotations
 
-from itertools import combinations
+from functools import lru_cache
+from itertools import chain, combinations
+from math import comb
 
 import numpy as np
 
@@ -33,9 +35,19 @@ __all__ = ["FEAS", "bases", "enumerate_lp", "solve_enumeration", "EnumerationSol
 FEAS = 1e-12
 
 
+@lru_cache(maxsize=64)
 def bases(k: int, d: int) -> np.ndarray:
-    """All ``d``-subsets of ``range(k)`` as an int array (nS, d)."""
-    return np.array(list(combinations(range(k), d)), dtype=np.int64).reshape(-1, d)
+    """All ``d``-subsets of ``range(k)`` as an int array (nS, d), in the order of
+    :func:`itertools.combinations`. Kept per size: a grasp-by-grasp run asks for the same
+    thousands of bases for every grasp (the kernels only read them; do not write to it).
+
+    Examples
+    --------
+    >>> bases(4, 3).tolist()
+    [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]]
+    """
+    flat = chain.from_iterable(combinations(range(k), d))
+    return np.fromiter(flat, dtype=np.int64, count=comb(k, d) * d).reshape(-1, d)
 
 
 def enumerate_lp(W: np.ndarray):
