@@ -47,6 +47,7 @@ from ..certify import models
 from ..certify.batch import Options, certify_table, random_grasp_table, random_grasps
 from ..certify.core import Grasp, force_closure, form_closure, grasp_to_dict, verify
 from ..certify.core.problem import grasp_system
+from ..certify.core.certificates import FLOAT_PROOF_CONTACTS
 from ..certify.files import grasps_table
 from ..certify.files.columns import grasp_columns
 from ..certify.quality.bounds import check_norm, epsilon, epsilon_of_points, epsilons
@@ -416,9 +417,10 @@ def run_contacts_bench(contacts=CONTACTS, seed: int = 0, time_limit: float | Non
     rows = []
     for dim in (2, 3):
         extra = {"spread": 0.3} if dim == 3 else {}
-        warm = next(g for g in random_grasps(seed, 50, dim=dim, n_contacts=4, **extra)
-                    if force_closure(g).status == "closure")
-        epsilons(warm, verdict=certify_grasp(warm, quality=False).force)
+        for n_warm in (4, FLOAT_PROOF_CONTACTS):  # the kernels of both routes of verify too
+            warm = next(g for g in random_grasps(seed, 50, dim=dim, n_contacts=n_warm, **extra)
+                        if force_closure(g).status == "closure")
+            epsilons(warm, verdict=certify_grasp(warm, quality=False).force)
         for m in contacts:
             g = next((g for g in random_grasps(seed, 50, dim=dim, n_contacts=m, **extra)
                       if force_closure(g).status == "closure"), None)
