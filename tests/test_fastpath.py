@@ -1,6 +1,7 @@
 """The columnar fast path gives, row for row, what the per-grasp path gives."""
 
-
+import numpy as np
+import pyarrow as pa
 import pytest
 
 from qualgrasp.certify import Contact, Grasp, force_closure, verify
@@ -268,3 +269,41 @@ def test_spatial_grasps_mixing_frictionless_and_friction_contacts_verify():
         g = grasp_from_dict(d)
         v = force_closure(g)
         assert verify(g, v.certificate, status=v.status), (r["id"], v)
+
+
+def _arc_grasps(seed: int, count: int, m: int, model: str = "point") -> list:
+    """Grasps of ``m`` contacts on an arc of a blob 60 to 220 degrees wide: the narrow arcs are
+    not in closure (strict Farkas directions), the wide ones are."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for i in range(count):
+        a = rng.uniform(0, np.radians(rng.uniform(60, 220)), size=m)
+        u = np.stack([np.cos(a), np.sin(a)], axis=1)
+        p = u * rng.uniform(0.7, 1.3, size=(m, 1))
+        n = -u + 0.3 * rng.normal(size=(m, 2))
+        mu = rng.uniform(0.1, 0.6, size=m)
+        extra = {"width": 0.1} if model == "pad" else {}
+        out.append(Grasp(tuple(Contact(p[j], n[j], model, mu=mu[j], **extra) for j in range(m)), id=f"arc{seed}-{i}"))
+    return out
+
+
+@pytest.mark.parametrize("quality", [False, True])
+def test_planar_rows_beyond_enumeration_equal_per_grasp_rows(quality):
+    """Planar groups whose force-closure LP has more than 4,096 bases (over 30 generators: 16
+    point contacts, 9 pads) take the batch barrier method with certificates proved in floats,
+    form closure the enumeration: the per-grasp rows exactly, and hardly any row left to the
+    per-grasp route (before, every such row went there)."""
+    grasps = (random_grasps(1, 40, dim=2, n_contacts=16) + random_grasps(2, 30, dim=2, n_contacts=20)
+              + random_grasps(3, 30, dim=2, n_contacts=9, model="pad") + _arc_grasps(6, 40, 16)
+              + _arc_grasps(7, 30, 24) + _arc_grasps(8, 30, 9, "pad"))
+    table = pa.concat_tables([grasps_table([grasp_to_dict(g) for g in grasps]),
+                              random_grasp_table(4, 30, dim=2, n_contacts=16, degenerate="antipodal-disc")])
+    fast, ref, slow = columnar_and_per_grasp(table, Options(quality=quality))
+    assert len(fast) == len(ref) == table.num_rows
+    for a, b in zip(fast, ref):
+        assert a == b, (a["id"], {k: (a[k], b[k]) for k in a if a[k] != b[k]})
+    assert len(slow) < 0.05 * table.num_rows, len(slow)
+    statuses = {(r["n_contacts"], r["status"], r["form_status"]) for r in fast}
+    assert {(16, "closure", "closure"), (16, "closure", "no_closure"), (16, "no_closure", "no_closure"),
+            (24, "no_closure", "no_closure"), (9, "closure", "closure"), (9, "no_closure", "no_closure"),
+            (16, "closure", "degenerate")} <= statuses

@@ -7,7 +7,10 @@ grouped by contact pattern (dimension, contact count, each contact's model and v
 
 * planar groups go through :func:`qualgrasp.certify._kernels.planar.planar_batch`: the LP (the
   same kernel the per-grasp path calls), the certificate and its rigorous re-check in floating
-  point with error bounds; with quality, the exact planar epsilon and its evidence of every
+  point with error bounds; a force-closure LP with too many bases to enumerate (over 30
+  generators: 16 point contacts or more) by the compiled dual barrier method for the whole group,
+  as the per-grasp fast route solves it, its clear verdicts proved in floats (:func:`_planar_barrier`);
+  with quality, the exact planar epsilon and its evidence of every
   closure row by :func:`qualgrasp.certify.quality.bounds.planar_epsilon_columns`, compiled for the
   whole group and row for row what the per-grasp path's
   :func:`~qualgrasp.certify.quality.bounds.planar_epsilons` gives (rows its float checks cannot
@@ -47,7 +50,7 @@ from .._kernels.jit import kernel_array
 from .._kernels.linalg import U as U_ROUND, projection_bound, world_values
 from .._kernels.planar import pair_null_rows, planar_batch, thin_screen
 from .._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
-from ..core.certificates import Tolerances, verify
+from ..core.certificates import Tolerances, margin_matches, verify
 from ..core.closure import decide, farkas_from_arrays
 from ..errors import SolverError
 from ..files.columns import GraspColumns, grasp_columns
@@ -70,12 +73,14 @@ from ..core.wrench import (force_column_errors, force_columns, generator_columns
 __all__ = ["certify_table", "PlanarScreen", "planar_screen"]
 
 
-def _planar_kernel(P, N, mu, width, c, L, models, variants, tol: Tolerances, quality: bool):
+def _planar_kernel(P, N, mu, width, c, L, models, variants, tol: Tolerances, quality: bool, *,
+                   form_only: bool = False):
     """:func:`qualgrasp.certify._kernels.planar.planar_batch` on grasps sharing the contact models
     and variants: force and form closure (verdict codes, margins, weights, bases, directions)
-    and epsilons."""
-    owner, offset, friction = generator_layout(models, variants, 2)
+    and epsilons. ``form_only``: form closure on both sides (for a group whose force-closure LP
+    has too many bases to enumerate)."""
     owner_f, offset_f, friction_f = generator_layout(models, variants, 2, frictionless=True)
+    owner, offset, friction = (owner_f, offset_f, friction_f) if form_only else generator_layout(models, variants, 2)
     same = (np.array_equal(owner, owner_f) and np.array_equal(offset, offset_f)
             and np.array_equal(friction, friction_f))  # frictionless contacts only: form is force
     return planar_batch(
@@ -178,21 +183,29 @@ def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances
     """Certify the planar grasps ``rows`` (one contact pattern) with :func:`planar_batch`;
     return the settled rows and their result columns."""
     models, variants = cols.models_of(rows[0]), cols.variants_of(rows[0])
-    sizes = [len(generator_layout(models, variants, 2, frictionless=f)[0]) for f in (False, True)]
-    if not all(FastSolver.enumerates(k, 3) for k in sizes):
-        # the per-grasp fast route solves these by the barrier method: both routes give its rows
+    force_layout = generator_layout(models, variants, 2)
+    enumerated = FastSolver.enumerates(len(force_layout[0]), 3)
+    if not FastSolver.enumerates(len(generator_layout(models, variants, 2, frictionless=True)[0]), 3):
+        # the per-grasp fast route solves both by the barrier method: both routes give its rows
         return np.zeros(len(rows), dtype=bool), {}
     P, N, params = cols.contacts(rows)
     # the kernels' arrays once, for _planar_kernel and _planar_thin's per-row kernel calls alike
     P, N, mu, width = kernel_array(P[:, :, :2]), kernel_array(N[:, :, :2]), params["mu"], registry.offset_lengths(models, params)
     c, L = cols.center[rows, :2], cols.length[rows]
     (code, t, lam, basis, y, code_f, t_f, lam_f, basis_f, y_f, _) = _planar_kernel(
-        P, N, mu, width, c, L, models, variants, tol, False)
+        P, N, mu, width, c, L, models, variants, tol, False, form_only=not enumerated)
     out = {"force": (code, t, lam, basis, y), "form": (code_f, t_f, lam_f, basis_f, y_f)}
     verified = {}
-    for side, frictionless in (("force", False), ("form", True)):
+    sides = (("force", False), ("form", True))
+    if not enumerated:  # force closure as the per-grasp fast route solves it: the barrier method
+        W, E = generator_rows(P, N, kernel_array(mu), kernel_array(width), kernel_array(c), kernel_array(L),
+                              *force_layout)
+        out["force"], out["tight"] = _planar_barrier(W, E, tol), {}
+        verified["force"] = np.ones(len(rows), dtype=bool)
+        sides = (("form", True),)
+    for side, frictionless in sides:
         layout = generator_layout(models, variants, 2, frictionless=frictionless)
-        if side == "form" and all(np.array_equal(a, b) for a, b in zip(layout, generator_layout(models, variants, 2))):
+        if side == "form" and all(np.array_equal(a, b) for a, b in zip(layout, force_layout)):
             out["form"], out["form_tight"] = out["force"], out["tight"]  # frictionless: form is force
             break
         out[side], out["tight" if side == "force" else "form_tight"], verified[side] = _planar_thin(
@@ -204,6 +217,39 @@ def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances
         out["eps"] = _planar_quality(cols, rows, (code == 1) & settled, P, N, mu, width, c, L, models,
                                      variants, options)
     return settled, out
+
+
+def _planar_barrier(W, E, tol: Tolerances):
+    """Force closure of planar grasps whose LP has too many bases to enumerate, as the per-grasp
+    fast route decides it (:class:`qualgrasp.certify.solvers.FastSolver` hands such LPs to the
+    compiled dual barrier method, :func:`qualgrasp.certify.core.closure.decide` states the
+    verdict): the barrier method for the whole batch, and the clear verdicts proved columnar
+    (:func:`~qualgrasp.certify._kernels.recheck.certify_rows`: an interior certificate whose
+    margin matches, :func:`~qualgrasp.certify.core.certificates.margin_matches`, or a strict
+    Farkas direction). Rows numerically thin, near the boundary or not proved this way keep code
+    0, for the per-grasp route. ``W``, ``E``: generator columns (B, 3, k) and their error
+    bounds. Returns ``(code, t, lam, basis, y)``."""
+    B, d, k = W.shape
+    status, t, y, xn, _ = barrier_batch(np.ascontiguousarray(np.swapaxes(W, 1, 2)), np.zeros((B, k, 1, d)),
+                                        np.zeros(k, dtype=np.int64), np.ones((B, k)), EXIT_BELOW, GAP_TOL,
+                                        MAX_NEWTON)
+    sv = np.linalg.svd(W, compute_uv=False)
+    thin = ~(sv[:, -1] > max(1e-6, 2 * tol.rank) * sv[:, 0])  # conservative: decide's test is sharper
+    near = (status == 2) | (np.abs(t) < BARRIER_NEAR_ZERO)  # what FastSolver hands to clarabel
+    closure = ~thin & ~near & (status == 0) & (t >= tol.margin)
+    farkas = ~thin & ~near & (t < tol.margin)
+    values = xn + 0.0  # the identity value map's values (ClosureProblem.values): -0 stated as +0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        yn = np.nan_to_num(y / np.sqrt(np.sum(y * y, axis=1, keepdims=True)))
+    cone, first, width = ray_block_arrays(k)
+    zeros = np.zeros((B, k))
+    code, basis = certify_rows(W, E, cone, first, width, np.zeros((B, k, 2)), zeros, zeros, values, yn,
+                               closure, farkas, np.abs(W).max(axis=(1, 2)), tol.residual)
+    blocks = [Block("ray", (j,), contact=j) for j in range(k)]
+    for i in np.flatnonzero(code == 1):  # the margin stated must be the one verify certifies
+        if not margin_matches(float(t[i]), blocks, values[i]):
+            code[i] = 0
+    return code, np.where(code == 1, t, 0.0), values, basis, yn
 
 
 THIN_CODES = {2: "strict Farkas", 3: "null space", 4: "Farkas with tight generators", 5: "degenerate (rank)"}
