@@ -678,6 +678,69 @@ def test_compiled_support_refinement_hands_over_where_its_hull_declines(monkeypa
     assert mid >= 3
 
 
+def _support_batch():
+    """Generator arrays ``(W, E, owner, m)`` of planar rows with ``support`` evidence (more than
+    4,096 sums, at most 24 generators): grasps in closure of 8 to 12 point contacts and of 6 pads,
+    and generators of 8 contacts nearly in a plane, where the compiled hull declines part-way."""
+    groups = []
+    for seed, kwargs in ((1, dict(n_contacts=8)), (2, dict(n_contacts=10)), (3, dict(n_contacts=12)),
+                         (4, dict(n_contacts=6, model="pad"))):
+        arrays = [planar_generator_arrays(g) for g in _closure(random_grasps(seed, 40, dim=2, **kwargs))]
+        groups.append((np.stack([a[0] for a in arrays]), np.stack([a[1] for a in arrays]), arrays[0][2],
+                       int(kwargs["n_contacts"])))
+    rng = np.random.default_rng(5)
+    owner = np.repeat(np.arange(8), 3).astype(np.int64)
+    W = rng.normal(size=(60, 3, 24))
+    W[:, 2] *= np.where(rng.random((60, 24)) < 0.8, 1e-12, 1.0)
+    groups.append((W, np.abs(W) * 2.0**-52, owner, 8))
+    return groups
+
+
+def _same_columns(a, b):
+    for name in ("kind", "direction", "ref", "ref_start", "points", "points_start", "faces", "faces_start"):
+        x, y = getattr(a, name), getattr(b, name)
+        assert x.shape == y.shape and np.array_equal(_float_bits(x), _float_bits(y)), name
+
+
+@pytest.mark.parametrize("time_limit", [None, 10.0, "rounds", 1e-9])
+def test_batched_support_refinement_is_the_row_by_row_one(monkeypatch, time_limit):
+    """Planar rows with ``support`` evidence refined in one compiled call give the values, limits
+    and evidence of the row-by-row route bit for bit: without a time limit, with the default one,
+    with rows whose rounds are spent before the refinement ends (the rounds between two looks at
+    the clock cut to 1: those rows start again row by row), with hulls that decline part-way, and
+    under a limit too short for the batch (every row by row)."""
+    from qualgrasp.certify.core.wrench import to_exact
+
+    spent = time_limit == "rounds"
+    if spent:
+        monkeypatch.setattr(quality_module, "_ROUNDS", 1)
+        time_limit = 10.0
+    each, batch = [], []
+    real_each, real_batch = quality_module._support_rows_each, quality_module.support_refine_rows
+    monkeypatch.setattr(quality_module, "_support_rows_each", lambda *a: each.append(len(a[4])) or real_each(*a))
+    monkeypatch.setattr(quality_module, "support_refine_rows", lambda *a: batch.append(len(a[0])) or real_batch(*a))
+    batched = rows = 0
+    for W, E, owner, m in _support_batch():
+        exact = lambda b, W=W: to_exact(W[b])  # noqa: E731 (the floats as exact generators)
+        got = quality_module.planar_epsilon_columns(W, E, owner, m, time_limit=time_limit, exact=exact)
+        handed, called = sum(each), sum(batch)
+        each.clear()
+        batch.clear()
+        with monkeypatch.context() as patch:
+            patch.setattr(quality_module, "_support_rows", real_each)
+            ref = quality_module.planar_epsilon_columns(W, E, owner, m, time_limit=time_limit, exact=exact)
+        assert np.array_equal(_float_bits(got[0]), _float_bits(ref[0])) and np.array_equal(got[1], ref[1])
+        _same_columns(got[2], ref[2])
+        _same_columns(got[3], ref[3])
+        assert (got[3].kind == "support").any()
+        batched += called - (handed if called else 0)
+        rows += called or handed
+    if time_limit == 1e-9:
+        assert batched == 0
+    else:  # the rounds cut to 1: some rows refined in the batch, most started again row by row
+        assert batched > 10 and (rows - batched > 100 if spent else batched > 100), (batched, rows)
+
+
 def test_planar_support_evidence_of_earlier_builds_is_rechecked(monkeypatch):
     """Builds before 2026-11-28 broke a tie of the support choice by the values ``v @ W`` as the
     BLAS library rounds them; the checker re-checks their evidence with those choices where the

@@ -23,7 +23,7 @@ from .planar import planar_generators
 from .surface import cycle_code, face_bounds
 
 __all__ = ["generator_rows", "minkowski_sums", "surface_rows", "support_choices", "vertex_sums", "support_refine",
-           "REFINED", "ROUNDS_SPENT", "NOT_HERE"]
+           "support_refine_rows", "REFINED", "ROUNDS_SPENT", "NOT_HERE"]
 
 #: What :func:`support_refine` ends with: the refinement is over, ...
 REFINED = 0
@@ -258,6 +258,51 @@ def support_refine(W, E, owner, m, u, cut, limit, add, dirs, picks, n, rounds):
         for q in range(before, n):
             _pick_sum(W, E, picks[q], V[q], EV[q])
         done += 1
+
+
+@kernel
+def support_refine_rows(W, E, owner, m, U, cuts, limit, add, cap, rounds):
+    """:func:`support_refine` of every row of a batch ``W``, ``E`` (B, 3, k), one call each from
+    its start, row ``b`` along ``U[b]`` down to ``cuts[b]``; ``cap`` and ``rounds`` as for
+    :func:`support_refine`. Returns per row its state (:data:`REFINED`, :data:`ROUNDS_SPENT` or
+    :data:`NOT_HERE`) and, rows one after another, the directions kept, their
+    choices, the vertices and their error bounds (row ``b`` owning
+    ``[vstart[b], vstart[b + 1])`` of each), and the faces of their last hull (``fstart``
+    likewise; none for :data:`NOT_HERE`): ``state, D, R, V, EV, vstart, F, fstart``."""
+    B = W.shape[0]
+    state = np.empty(B, dtype=np.int64)
+    vstart = np.zeros(B + 1, dtype=np.int64)
+    fstart = np.zeros(B + 1, dtype=np.int64)
+    dirs, picks = np.empty((cap, 3)), np.empty((cap, m), dtype=np.int64)
+    D, R = np.empty((16 * B + cap, 3)), np.empty((16 * B + cap, m), dtype=np.int64)
+    V, EV = np.empty((16 * B + cap, 3)), np.empty((16 * B + cap, 3))
+    F = np.empty((32 * B + 2 * cap, 3), dtype=np.int64)
+    for b in range(B):
+        n, st, faces, v, ev = support_refine(W[b], E[b], owner, m, U[b], cuts[b], limit, add, dirs, picks, 0, rounds)
+        state[b] = st
+        a, f = vstart[b], fstart[b]
+        if a + n > D.shape[0]:  # room for twice as many
+            D, R, V, EV = _grown(D, a, 2 * (a + n)), _grown(R, a, 2 * (a + n)), _grown(V, a, 2 * (a + n)), \
+                _grown(EV, a, 2 * (a + n))
+        if f + faces.shape[0] > F.shape[0]:
+            F = _grown(F, f, 2 * (f + faces.shape[0]))
+        D[a:a + n] = dirs[:n]
+        R[a:a + n] = picks[:n]
+        V[a:a + n] = v
+        EV[a:a + n] = ev
+        F[f:f + faces.shape[0]] = faces
+        vstart[b + 1] = a + n
+        fstart[b + 1] = f + faces.shape[0]
+    nv, nf = vstart[B], fstart[B]
+    return state, D[:nv].copy(), R[:nv].copy(), V[:nv].copy(), EV[:nv].copy(), vstart, F[:nf].copy(), fstart
+
+
+@kernel
+def _grown(a, used, size):
+    """A copy of ``a`` (n, c) with ``size`` rows, its first ``used`` rows kept."""
+    out = np.empty((size, a.shape[1]), dtype=a.dtype)
+    out[:used] = a[:used]
+    return out
 
 
 @kernel

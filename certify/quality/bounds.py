@@ -89,7 +89,7 @@ from scipy.spatial import ConvexHull, QhullError
 
 from .._kernels.epsilon import hull_minima, linf_sweep, planar_edges, planar_epsilon_one, support_rows
 from .._kernels.epsilon import planar_epsilon as epsilon_kernel
-from .._kernels.evidence import NOT_HERE, REFINED, minkowski_sums, support_refine, surface_rows
+from .._kernels.evidence import NOT_HERE, REFINED, minkowski_sums, support_refine, support_refine_rows, surface_rows
 from .._kernels.hull import face_planes, grow_start, hull_grow, live_facets, used_vertices, weakest_plane
 from .._kernels.jit import await_compiled, compiled_here, kernel_array, mark_compiled, precompile
 from .._kernels.sets import EPSILON_SETS, KERNEL_SETS
@@ -139,6 +139,10 @@ _SWEEP_BATCH = 64
 _ADD = 2
 #: Rounds of the compiled planar support refinement between two looks at the clock.
 _ROUNDS = 16
+#: Shortest time limit (seconds) under which planar rows' first refinement calls run in one batch
+#: (:func:`_support_rows`): the row-by-row route looks at the clock before a row's first call and
+#: then only after it, and a limit this long cannot have passed by then.
+_ONE_CALL = 0.01
 
 
 @dataclass(frozen=True)
@@ -593,11 +597,54 @@ def _linf_rows(W, E, owner, m, rows, slow, vals, limited, time_limit, exact):
 
 
 def _support_rows(W, E, owner, m, todo, eps, arg, vals, limited, time_limit, exact):
-    """The L-infinity part of :func:`planar_epsilon_columns` beyond :data:`SUMS_MAX` sums: each
-    row's ``support`` surface refined on its own (:func:`_support_surface`, which gives its
-    hull's faces), then the float checks of all rows at once; a surface those cannot settle is
-    proved as :func:`_planar_support` proves it. Fills ``vals`` and ``limited`` and
-    returns the evidence as one block of :meth:`EvidenceColumns.assemble`."""
+    """The L-infinity part of :func:`planar_epsilon_columns` beyond :data:`SUMS_MAX` sums: the
+    rows' ``support`` surfaces refined in one compiled call
+    (:func:`~qualgrasp.certify._kernels.evidence.support_refine_rows`: each row as
+    :func:`_support_surface` refines it, up to the :data:`_ROUNDS` rounds it runs before it first
+    looks at the clock, all of them without a time limit), their float checks and evidence made
+    in columns. The rows that call does not finish (their hull declined, or their rounds are
+    spent) go through :func:`_support_rows_each`, which starts them again under their own
+    deadline; so does every row under a time limit below :data:`_ONE_CALL`, which may pass before
+    the first call ends. Fills ``vals`` and ``limited`` and returns the evidence as blocks of
+    :meth:`EvidenceColumns.assemble`."""
+    if (time_limit is not None and time_limit < _ONE_CALL) or not len(todo):
+        return _support_rows_each(W, E, owner, m, todo, eps, arg, vals, limited, time_limit, exact)
+    U = np.ascontiguousarray(np.asarray(arg, dtype=float).reshape(len(todo), 3))
+    cap = max(7, _PLANAR_DIRECTIONS + 2 * _ADD)
+    state, D, R, V, EV, vstart, F, fstart = support_refine_rows(
+        np.ascontiguousarray(W[todo]), np.ascontiguousarray(E[todo]), owner, m, U, eps * (1 - EPS_TOL / 16),
+        _PLANAR_DIRECTIONS, _ADD, cap, _PLANAR_DIRECTIONS if time_limit is None else _ROUNDS)
+    here = state == REFINED
+    decided, d2_lo, d2_hi = _flat_checks(V, EV, vstart, F, fstart)
+    lo = np.full(len(todo), np.nan)
+    ok = here & decided
+    lo[ok] = _lowers(eps[ok], d2_lo[ok], d2_hi[ok])
+    for q in np.flatnonzero(here & ~decided):  # exact arithmetic needed: as the per-grasp route
+        b, (a, z), (f, g) = todo[q], vstart[q:q + 2], fstart[q:q + 2]
+        gens = _exact_once(None if exact is None else (lambda b=b: exact(b)))
+        found = _lower(float(eps[q]), _prove(V[a:z], EV[a:z], F[f:g], _support_vertex(R[a:z], gens)))
+        lo[q] = np.nan if found is None else found
+    rows = todo[here]
+    l1_lo, e = vals[rows, 0], eps[here]
+    support = lo[here] >= l1_lo  # False where nothing was proved (NaN)
+    vals[rows, 2] = np.where(support, lo[here], np.minimum(l1_lo, e))
+    vals[rows, 3] = e
+    stated = np.zeros(len(todo), dtype=bool)
+    stated[here] = support
+    n = np.diff(vstart)
+    points = D[np.repeat(stated, n)].ravel()  # the directions of each row with support evidence
+    blocks = [(rows, np.where(support, "support", "l1"), U[here], {"points": (3 * n[here] * support, points)})]
+    if not here.all():
+        blocks += _support_rows_each(W, E, owner, m, todo[~here], eps[~here], U[~here], vals, limited, None, exact)
+    return blocks
+
+
+def _support_rows_each(W, E, owner, m, todo, eps, arg, vals, limited, time_limit, exact):
+    """:func:`_support_rows` row by row: each row's ``support`` surface refined on its own
+    (:func:`_support_surface`, which gives its hull's faces, under its own deadline), then the
+    float checks of all rows at once; a surface those cannot settle is proved as
+    :func:`_planar_support` proves it. Fills ``vals`` and ``limited`` and returns the evidence
+    as one block of :meth:`EvidenceColumns.assemble`."""
     refined = []
     for b, e, u in zip(todo, eps, arg):
         deadline = None if time_limit is None else time.perf_counter() + time_limit
