@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from .conic import support_points
 from .epsilon import hull_minima, linf_sweep, planar_edges, planar_epsilon_one, support_rows
-from .evidence import minkowski_sums, support_choices, support_refine, vertex_sums
+from .evidence import minkowski_sums, support_choices, support_refine, support_refine_rows, vertex_sums
 from .hull import face_planes, hull_faces, hull_grow, hulls_faces, live_facets, used_vertices, weakest_plane
 from .jit import B1, BOOL, F1, F2, F3, FLOAT, I1, I2, INT
 from .planar import planar_generators
@@ -34,7 +34,7 @@ _SURFACE_KERNELS = (
     (face_bounds_laplace, (F2, F2, I2, I2, F1)), _CYCLE,
     (hull_grow, (F2, I2, F2, F1, B1, INT, F1, INT)), (weakest_plane, (F2, F1, B1, INT)), (live_facets, (I2, B1, INT)),
     _ORIENT)
-#: The same for planar grasps, in four sets: these, ...
+#: The same for planar grasps, in five sets: these, ...
 _PLANAR_KERNELS = _CHECK_KERNELS + (
     (planar_generators, (F2, F2, F1, F1, F1, FLOAT, I1, F1, F1, F2, F2)),
     (planar_epsilon_one, (F2, I1, INT, BOOL)),
@@ -69,9 +69,13 @@ _LARGE_KERNELS = (
     (support_refine, (F2, F2, I1, INT, F1, FLOAT, INT, INT, F2, I2, INT, INT)),
     _ORIENT,
 )
+#: ... and the columnar route's for those grasps: the ``support`` refinement of many rows at once.
+_LARGE_COLUMN_KERNELS = (
+    (support_refine_rows, (F3, F3, I1, INT, F2, F1, INT, INT, INT, INT)),
+)
 #: Those kernel sets by name (:func:`~qualgrasp.certify.warmup.compile_ahead`; :mod:`qualgrasp.certify._kernels.jit`).
 KERNEL_SETS = {"quality-planar": _PLANAR_KERNELS, "quality-hulls": _HULL_KERNELS,
                "quality-planar-columns": _COLUMN_KERNELS, "quality-planar-large": _LARGE_KERNELS,
-               "quality-spatial": _SURFACE_KERNELS}
+               "quality-planar-large-columns": _LARGE_COLUMN_KERNELS, "quality-spatial": _SURFACE_KERNELS}
 #: The sets the epsilons of each dimension need.
 EPSILON_SETS = {2: ("quality-planar", "quality-hulls"), 3: ("quality-spatial",)}

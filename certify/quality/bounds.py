@@ -219,12 +219,14 @@ def _expired(deadline: float | None) -> bool:
 
 def _after_compiling(deadline: float | None, dim: int, large: bool = False, columns: bool = False) -> float | None:
     """Compile (or load) the kernel sets of ``dim`` (:data:`KERNEL_SETS`; for planar grasps with
-    ``large`` the large set too, with ``columns`` the columnar route's), first waiting for another
+    ``large`` the large set too, with ``columns`` the columnar route's, with both the columnar
+    route's for large grasps), first waiting for another
     process compiling a set (:func:`~qualgrasp.certify.warmup.compile_ahead`), and return
     ``deadline`` pushed back by the time that took: a time limit counts computation, never
     compilation, so that a cold compile cache cannot change a result."""
     names = EPSILON_SETS[dim] + (("quality-planar-large",) if large and dim == 2 else ()) + (
-        ("quality-planar-columns",) if columns and dim == 2 else ())
+        ("quality-planar-columns",) if columns and dim == 2 else ()) + (
+        ("quality-planar-large-columns",) if large and columns and dim == 2 else ())
     if all(compiled_here(KERNEL_SETS[name]) for name in names):  # every call after a process's first
         return deadline
     start = time.perf_counter()
