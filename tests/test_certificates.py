@@ -6,7 +6,7 @@ import functools
 import numpy as np
 import pytest
 
-from qualgrasp.certify import Certificate, certify_grasp, force_closure, form_closure, verify
+from qualgrasp.certify import Certificate, Contact, Grasp, certify_grasp, force_closure, form_closure, verify
 from qualgrasp.experiments.bench import KINDS
 from qualgrasp.certify.batch import random_grasps, textbook_grasps
 
@@ -177,3 +177,106 @@ def test_float_proofs_of_large_planar_grasps_agree_with_the_exact_route():
                     proved += fast
     assert checked > 500 and genuine > 50
     assert proved >= 0.9 * genuine, (proved, genuine)
+
+
+def _off_equilibrium(W, values, basis, shift):
+    """Interior values over generators ``W`` moved along the null space of ``W`` until their
+    least weight is on ``basis[0]``, then moved off equilibrium on that column by ``shift`` times
+    their sum: the exact checker's correction moves that weight back."""
+    k = W.shape[1]
+    rest = [j for j in range(k) if j not in basis]
+    for s in range(len(rest)):
+        zn = np.zeros(len(rest))
+        zn[s] = 1.0
+        zb = np.linalg.solve(W[:, basis], -W[:, rest] @ zn)
+        if zb[0] < 0:
+            break
+    z = np.zeros(k)
+    z[list(basis)], z[rest] = zb, zn
+    x = np.asarray(values, dtype=float)
+    x = x + 0.3 * x[basis[0]] / -zb[0] * z
+    x[basis[0]] += shift * np.abs(x).sum()
+    return x
+
+
+def test_float_proofs_bound_the_margin_after_the_exact_correction():
+    # The exact checker corrects the values before it compares the stated margin with theirs; the
+    # float route must allow for that correction (bounded by the float kernels), or it accepts a
+    # margin the exact route refuses. Eight contacts around a circle; an equilibrium whose least
+    # weight is on a basis column, moved off equilibrium along that column so that the correction
+    # moves the least weight back (_off_equilibrium), and the margin of the moved values stated.
+    from qualgrasp.certify.core import certificates
+    from qualgrasp.certify.core.certificates import margin_of
+    from qualgrasp.certify.core.problem import Block
+    from qualgrasp.certify.core.wrench import planar_generator_arrays
+
+    a = np.linspace(0, 2 * np.pi, 8, endpoint=False)
+    g = Grasp(tuple(Contact((np.cos(t), np.sin(t)), (-np.cos(t), -np.sin(t)), "point", mu=0.5) for t in a))
+    v = force_closure(g)
+    W, _, _ = planar_generator_arrays(g)
+    blocks = [Block("ray", (j,), contact=j) for j in range(W.shape[1])]
+    refused = 0
+    for shift in (1e-9, 3e-8, 5e-8, 8e-8, 1.2e-7):
+        moved = _off_equilibrium(W, v.certificate.values, v.certificate.basis, shift)
+        cert = dataclasses.replace(v.certificate, values=tuple(moved))
+        for exact_margin in (False, True):
+            claims = dict(status="closure", margin=margin_of(blocks, moved), exact_margin=exact_margin)
+            exact = bool(_exact_only(g, cert, False, **claims))
+            assert exact or not certificates._proved_in_floats(g, cert, "closure", claims["margin"], False,
+                                                               certificates.Tolerances())
+            assert bool(verify(g, cert, **claims)) == exact
+            refused += not exact
+    assert refused >= 2  # the moves beyond the tolerance are refused (by both routes)
+
+
+def test_float_proofs_refuse_certificates_of_the_wrong_types():
+    # Certificates built in code rather than read from JSON: strings, a fractional basis index,
+    # complex values, tight or null_space of None. The exact route refuses them; the float route
+    # must not accept them (numpy would convert or truncate them), nor raise.
+    a = np.linspace(0, 2 * np.pi, 8, endpoint=False)
+    g = Grasp(tuple(Contact((np.cos(t), np.sin(t)), (-np.cos(t), -np.sin(t)), "point", mu=0.5) for t in a))
+    closure = force_closure(g)
+    c = closure.certificate
+    shifted = Grasp(tuple(Contact((np.cos(t) + 3, np.sin(t)), (1.0, 0.2 * np.sin(t)), "point", mu=0.1) for t in a))
+    farkas = force_closure(shifted).certificate
+    assert c.kind == "interior" and farkas.kind == "farkas" and not farkas.tight
+    for bad, status in ((dataclasses.replace(c, values=tuple(str(v) for v in c.values)), "closure"),
+                        (dataclasses.replace(c, basis=(c.basis[0] + 0.5,) + tuple(c.basis[1:])), "closure"),
+                        (dataclasses.replace(c, basis=tuple(str(j) for j in c.basis)), "closure"),
+                        (dataclasses.replace(c, values=tuple(complex(v) for v in c.values)), "closure"),
+                        (dataclasses.replace(farkas, y=tuple(str(v) for v in farkas.y)), "no_closure"),
+                        (dataclasses.replace(farkas, null_space=None), "no_closure"),
+                        (dataclasses.replace(farkas, tight=None), "no_closure")):
+        assert not verify(shifted if status == "no_closure" else g, bad, status=status)
+    assert verify(g, c, status="closure", margin=closure.margin) and verify(shifted, farkas, status="no_closure")
+
+
+def test_bulk_recheck_bounds_the_margin_after_the_exact_correction(tmp_path):
+    # ``qualgrasp verify`` proves most rows in bulk with the float kernels: a stated margin must
+    # hold for the values the exact checker corrects the certificate to, as in verify (above).
+    from qualgrasp.certify.batch import certify_file, verify_file
+    from qualgrasp.certify.core.certificates import margin_of
+    from qualgrasp.certify.core.problem import Block
+    from qualgrasp.certify.core.wrench import planar_generator_arrays
+    from qualgrasp.certify.files import table_to_rows, write_grasps
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    a = np.linspace(0, 2 * np.pi, 8, endpoint=False)  # normals tilted both ways: form closure too
+    g = Grasp(tuple(Contact((np.cos(t), np.sin(t)), (-np.cos(t) - 0.3 * (-1) ** i * np.sin(t),
+                                                     -np.sin(t) + 0.3 * (-1) ** i * np.cos(t)), "point", mu=0.5)
+                    for i, t in enumerate(a)), id="g")
+    grasps, results, tampered = tmp_path / "g.parquet", tmp_path / "r.parquet", tmp_path / "t.parquet"
+    write_grasps(grasps, [g] * 80)  # enough rows for the bulk proofs
+    certify_file(grasps, results, quality=False)
+    rows = table_to_rows(pq.read_table(results))
+    W, _, _ = planar_generator_arrays(g)
+    cert = rows[0]["certificate"]["force"]
+    blocks = [Block("ray", (j,), contact=j) for j in range(W.shape[1])]
+    x = _off_equilibrium(W, cert["values"], cert["basis"], 8e-8)
+    rows[5]["certificate"]["force"]["values"] = x.tolist()
+    rows[5]["margin"] = margin_of(blocks, x)
+    pq.write_table(pa.Table.from_pylist(rows, schema=pq.read_table(results).schema), tampered)  # bulk-proved
+    assert not verify_file(results, grasps).failures
+    failures = verify_file(tampered, grasps).failures
+    assert len(failures) == 1 and "margin" in str(failures[0]), failures

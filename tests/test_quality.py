@@ -702,39 +702,61 @@ def _same_columns(a, b):
         assert x.shape == y.shape and np.array_equal(_float_bits(x), _float_bits(y)), name
 
 
-@pytest.mark.parametrize("time_limit", [None, 10.0, "rounds", 1e-9])
+class _SlowClock:
+    """A clock that moves 6 ms each time it is read (as ``time`` for the refinement's module)."""
+
+    def __init__(self):
+        self.now = 0.0
+
+    def perf_counter(self):
+        self.now += 0.006
+        return self.now
+
+
+@pytest.mark.parametrize("time_limit", [None, 10.0, "rounds", "clock", 1e-9])
 def test_batched_support_refinement_is_the_row_by_row_one(monkeypatch, time_limit):
     """Planar rows with ``support`` evidence refined in one compiled call give the values, limits
     and evidence of the row-by-row route bit for bit: without a time limit, with the default one,
     with rows whose rounds are spent before the refinement ends (the rounds between two looks at
-    the clock cut to 1: those rows start again row by row), with hulls that decline part-way, and
-    under a limit too short for the batch (every row by row)."""
+    the clock cut to 1: those rows start again row by row), with hulls that decline part-way
+    under a limit that a slow clock lets pass (those rows go on row by row under their own
+    deadline), and under a limit too short for the batch (every row by row)."""
     from qualgrasp.certify.core.wrench import to_exact
 
     spent = time_limit == "rounds"
+    clock = time_limit == "clock"
     if spent:
         monkeypatch.setattr(quality_module, "_ROUNDS", 1)
         time_limit = 10.0
+    if clock:
+        time_limit = 0.011
     each, batch = [], []
     real_each, real_batch = quality_module._support_rows_each, quality_module.support_refine_rows
     monkeypatch.setattr(quality_module, "_support_rows_each", lambda *a: each.append(len(a[4])) or real_each(*a))
     monkeypatch.setattr(quality_module, "support_refine_rows", lambda *a: batch.append(len(a[0])) or real_batch(*a))
-    batched = rows = 0
+    batched = rows = limited = 0
     for W, E, owner, m in _support_batch():
         exact = lambda b, W=W: to_exact(W[b])  # noqa: E731 (the floats as exact generators)
-        got = quality_module.planar_epsilon_columns(W, E, owner, m, time_limit=time_limit, exact=exact)
+        with monkeypatch.context() as patch:
+            if clock:
+                patch.setattr(quality_module, "time", _SlowClock())
+            got = quality_module.planar_epsilon_columns(W, E, owner, m, time_limit=time_limit, exact=exact)
         handed, called = sum(each), sum(batch)
         each.clear()
         batch.clear()
         with monkeypatch.context() as patch:
             patch.setattr(quality_module, "_support_rows", real_each)
+            if clock:
+                patch.setattr(quality_module, "time", _SlowClock())
             ref = quality_module.planar_epsilon_columns(W, E, owner, m, time_limit=time_limit, exact=exact)
+        limited += int(got[1].sum())
         assert np.array_equal(_float_bits(got[0]), _float_bits(ref[0])) and np.array_equal(got[1], ref[1])
         _same_columns(got[2], ref[2])
         _same_columns(got[3], ref[3])
         assert (got[3].kind == "support").any()
         batched += called - (handed if called else 0)
         rows += called or handed
+    assert (limited > 0) == (clock or time_limit == 1e-9), limited  # only these limits can pass
     if time_limit == 1e-9:
         assert batched == 0
     else:  # the rounds cut to 1: some rows refined in the batch, most started again row by row

@@ -26,7 +26,8 @@ import pyarrow as pa
 from .. import models as registry
 from .._kernels.jit import kernel_array
 from .._kernels.planar import planar_generators
-from .._kernels.recheck import null_rows, verify_farkas_general, verify_interior_general
+from .._kernels.recheck import (correction_bound, null_rows, residual_bound, verify_farkas_general,
+                               verify_interior_general)
 from ..core.certificates import Tolerances, margin_matches
 from ..files.columns import GraspColumns
 from ..core.cones import CONES
@@ -139,7 +140,7 @@ def _group_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, tol: Tole
         for i in np.flatnonzero(interior):
             if verify_interior_general(C[i], E[i], cone, first, width, nb[i], mub[i], gb[i], values[i],
                                        basis[i], tol.residual) and \
-                    _margin_ok(mg[i], cone, first, width, nb[i], mub[i], gb[i], values[i]):
+                    _margin_ok(mg[i], C[i], E[i], cone, first, width, nb[i], mub[i], gb[i], values[i], basis[i]):
                 good[i] = True
         for i in np.flatnonzero(farkas):
             good[i] = verify_farkas_general(C[i], E[i], cone, first, width, nb[i], mub[i], gb[i], y[i],
@@ -195,11 +196,12 @@ def _eps_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, status: np.
     return ok
 
 
-def _margin_ok(claimed: float, cone, first, width, n, mu, g, x) -> bool:
-    """:func:`margin_matches` of the blocks given as arrays."""
+def _margin_ok(claimed: float, C, E, cone, first, width, n, mu, g, x, basis) -> bool:
+    """:func:`margin_matches` of the blocks given as arrays, for the values the exact checker
+    would correct ``x`` to (the correction bounded by the float kernels)."""
     blocks = [Block(CONES[cone[b]], tuple(range(first[b], first[b] + width[b])), tuple(n[b]), mu[b], g[b], b)
               for b in range(len(cone))]
-    return margin_matches(claimed, blocks, x)
+    return margin_matches(claimed, blocks, x, correction_bound(C, E, basis, residual_bound(C, E, x)[0]))
 
 
 def _claims(cols: GraspColumns, results: pa.Table, lines) -> np.ndarray:

@@ -49,7 +49,8 @@ from .._kernels.evidence import generator_rows
 from .._kernels.jit import kernel_array
 from .._kernels.linalg import U as U_ROUND, projection_bound, world_values
 from .._kernels.planar import pair_null_rows, planar_batch, thin_screen
-from .._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
+from .._kernels.recheck import (certify_rows, correction_bound, null_rows, residual_bound, verify_farkas_general,
+                               verify_interior_general)
 from ..core.certificates import Tolerances, margin_matches, verify
 from ..core.closure import decide, farkas_from_arrays
 from ..errors import SolverError
@@ -247,7 +248,8 @@ def _planar_barrier(W, E, tol: Tolerances):
                                closure, farkas, np.abs(W).max(axis=(1, 2)), tol.residual)
     blocks = [Block("ray", (j,), contact=j) for j in range(k)]
     for i in np.flatnonzero(code == 1):  # the margin stated must be the one verify certifies
-        if not margin_matches(float(t[i]), blocks, values[i]):
+        delta = correction_bound(W[i], E[i], basis[i], residual_bound(W[i], E[i], values[i])[0])
+        if not margin_matches(float(t[i]), blocks, values[i], delta):
             code[i] = 0
     return code, np.where(code == 1, t, 0.0), values, basis, yn
 

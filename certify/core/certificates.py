@@ -41,7 +41,7 @@ import numpy as np
 from . import cones
 from . import exact as ex
 from .._kernels.cones import polar_values as kernel_polar_values
-from .._kernels.recheck import verify_farkas_general, verify_interior_general
+from .._kernels.recheck import correction_bound, residual_bound, verify_farkas_general, verify_interior_general
 from ..errors import CertificateError
 from .arguments import number_in, require
 from .grasp import Grasp
@@ -269,17 +269,32 @@ def _proved_in_floats(grasp: Grasp, cert: Certificate, status, margin, frictionl
     cone, first, width = ray_block_arrays(k)
     n, zero = np.zeros((k, 2)), np.zeros(k)
     if cert.kind == "farkas":
-        y = np.asarray(cert.y if cert.y is not None else [], dtype=float)
-        return (not cert.tight and not cert.null_space and y.shape == (3,) and bool(np.isfinite(y).all())
-                and verify_farkas_general(W, E, cone, first, width, n, zero, zero, y, np.zeros(k, dtype=bool), 0.0))
-    x = np.asarray(cert.values if cert.values is not None else [], dtype=float)
-    basis = np.asarray(cert.basis if cert.basis is not None else [], dtype=np.int64)
-    if x.shape != (k,) or not np.isfinite(x).all() or basis.shape != (3,) or len(set(basis.tolist())) != 3 \
-            or not ((basis >= 0) & (basis < k)).all():
+        if not (_numbers(cert.y, 3, _REALS) and isinstance(cert.tight, (tuple, list)) and not cert.tight
+                and isinstance(cert.null_space, (bool, np.bool_)) and not cert.null_space):
+            return False
+        y = np.array(cert.y, dtype=float)
+        return bool(np.isfinite(y).all()) and verify_farkas_general(W, E, cone, first, width, n, zero, zero, y,
+                                                                    np.zeros(k, dtype=bool), 0.0)
+    if not (_numbers(cert.values, k, _REALS) and _numbers(cert.basis, 3, _INTEGERS)):
+        return False
+    x, basis = np.array(cert.values, dtype=float), np.array(cert.basis, dtype=np.int64)
+    if not np.isfinite(x).all() or len(set(basis.tolist())) != 3 or not ((basis >= 0) & (basis < k)).all():
         return False
     if not verify_interior_general(W, E, cone, first, width, n, zero, zero, x, basis, tol.residual):
         return False
-    return margin is None or margin_matches(margin, [Block("ray", (j,), contact=j) for j in range(k)], x)
+    delta = correction_bound(W, E, basis, residual_bound(W, E, x)[0])  # how far the exact checker corrects
+    return margin is None or margin_matches(margin, [Block("ray", (j,), contact=j) for j in range(k)], x, delta)
+
+
+_REALS = (int, float, np.integer, np.floating)
+_INTEGERS = (int, np.integer)
+
+
+def _numbers(values, n: int, kinds) -> bool:
+    """Whether ``values`` is a sequence of ``n`` numbers of the types ``kinds`` (booleans not
+    counted as numbers): what the float route takes; anything else goes to the exact route."""
+    return (isinstance(values, (tuple, list)) and len(values) == n
+            and all(isinstance(v, kinds) and not isinstance(v, (bool, np.bool_)) for v in values))
 
 
 def verify_span(vectors, certificate: Certificate, *, status: str | None = None,
@@ -319,11 +334,12 @@ def margin_tolerance(t: float) -> float:
     return 1e-9 + 1e-6 * abs(t)
 
 
-def margin_matches(claimed: float, blocks, x) -> bool:
-    """Whether a claimed margin is the margin that values ``x`` certify over ``blocks``
-    (:func:`margin_of`) to within half :func:`margin_tolerance`: the rule of the rigorous float
-    proofs, which do not correct the values first as the exact checker does, so that a claim
-    near the edge goes to the exact checker.
+def margin_matches(claimed: float, blocks, x, delta: float = 0.0) -> bool:
+    """Whether a claimed margin is the margin certified by every values within ``delta`` of ``x``
+    (in each entry: the exact checker's corrected values, ``delta`` the float kernels' bound on
+    the correction) to within half :func:`margin_tolerance`: the rule of the rigorous float
+    proofs, which do not correct the values as the exact checker does. A claim near the edge goes
+    to the exact checker.
 
     Examples
     --------
@@ -331,9 +347,39 @@ def margin_matches(claimed: float, blocks, x) -> bool:
     >>> blocks = [Block("ray", (0,)), Block("ray", (1,))]
     >>> margin_matches(0.25, blocks, [1.0, 3.0]), margin_matches(0.3, blocks, [1.0, 3.0])
     (True, False)
+    >>> margin_matches(0.25, blocks, [1.0, 3.0], delta=1e-6)  # the correction may move it by 2e-7
+    False
     """
     t = margin_of(blocks, x)
-    return abs(claimed - t) <= 0.5 * margin_tolerance(t)
+    return abs(claimed - t) + 2 * _margin_shift(blocks, x, delta) <= 0.5 * margin_tolerance(t)
+
+
+def _margin_shift(blocks, x, delta: float) -> float:
+    """Bound on how far :func:`margin_of` moves when every entry of ``x`` moves by at most
+    ``delta``: a ray's slack and normal force move by ``delta``; a Lorentz block's slack by
+    ``(1 + mu) |df| + |n| |dm| / g`` (``|df| <= sqrt(dim) delta``, as the float kernels bound it)
+    and its normal force by ``|df|``; the margin (least slack over total normal force) by at most
+    ``(S + |t| F) / (T - F)`` for slack moves ``S``, normal-force moves ``F`` and total ``T``."""
+    if delta == 0.0:
+        return 0.0
+    if not math.isfinite(delta):
+        return math.inf
+    moves, total, force = [], 0.0, 0.0
+    for b in blocks:
+        if b.cone == "ray":
+            moves.append(delta)
+            force += delta
+        else:
+            dim, rn = len(b.n), math.sqrt(sum(float(v) ** 2 for v in b.n))
+            df = math.sqrt(dim) * delta
+            moments = len(b.cols) - dim  # columns of torsional moments: none without a moment length
+            moves.append((1 + float(b.mu)) * df + (moments * rn * delta / float(b.g) if moments else 0.0))
+            force += df
+        total += slack(b, [x[j] for j in b.cols])[1]
+    t = margin_of(blocks, x)
+    if not total - force > 0 or not math.isfinite(t):
+        return math.inf
+    return (max(moves, default=0.0) + abs(t) * force) / (total - force) * (1 + 1e-9)
 
 
 def _verify_interior(Cx, blocks, cert: Certificate, margin, tol: Tolerances,

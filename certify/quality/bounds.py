@@ -637,7 +637,8 @@ def _support_rows(W, E, owner, m, todo, eps, arg, vals, limited, time_limit, exa
     points = D[np.repeat(stated, n)].ravel()  # the directions of each row with support evidence
     blocks = [(rows, np.where(support, "support", "l1"), U[here], {"points": (3 * n[here] * support, points)})]
     if not here.all():
-        blocks += _support_rows_each(W, E, owner, m, todo[~here], eps[~here], U[~here], vals, limited, None, exact)
+        blocks += _support_rows_each(W, E, owner, m, todo[~here], eps[~here], U[~here], vals, limited, time_limit,
+                                     exact)
     return blocks
 
 
