@@ -30,7 +30,7 @@ from .._kernels.recheck import (correction_bound, null_rows, residual_bound, ver
                                verify_interior_general)
 from ..core.certificates import Tolerances, margin_matches
 from ..files.columns import GraspColumns
-from ..core.cones import CONES
+from ..core.cones import CONES, RAY
 from ..quality.evidence import EPS_COLUMNS, Evidence, verify_bounds
 from ..core.problem import Block, conic_block_arrays, ray_block_arrays
 from ..report import GEOMETRY_TOL
@@ -199,8 +199,9 @@ def _eps_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, status: np.
 def _margin_ok(claimed: float, C, E, cone, first, width, n, mu, g, x, basis) -> bool:
     """:func:`margin_matches` of the blocks given as arrays, for the values the exact checker
     would correct ``x`` to (the correction bounded by the float kernels)."""
-    blocks = [Block(CONES[cone[b]], tuple(range(first[b], first[b] + width[b])), tuple(n[b]), mu[b], g[b], b)
-              for b in range(len(cone))]
+    blocks = [Block("ray", (int(first[b]),), contact=b) if cone[b] == RAY else
+              Block(CONES[cone[b]], tuple(range(first[b], first[b] + width[b])), tuple(n[b]), mu[b], g[b], b)
+              for b in range(len(cone))]  # a ray's normal, friction and moment length count for nothing
     return margin_matches(claimed, blocks, x, correction_bound(C, E, basis, residual_bound(C, E, x)[0]))
 
 

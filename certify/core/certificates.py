@@ -171,7 +171,11 @@ def polar_values(C, blocks, y) -> np.ndarray:
 
 def margin_of(blocks, x) -> float:
     """Min-weight margin certified by values ``x``: smallest slack over total normal force."""
-    pairs = [slack(b, [x[j] for j in b.cols]) for b in blocks]
+    return _margin([slack(b, [x[j] for j in b.cols]) for b in blocks])
+
+
+def _margin(pairs) -> float:
+    """:func:`margin_of` from each block's ``(slack, normal force)``."""
     total = sum(fn for _, fn in pairs)
     return min(s for s, _ in pairs) / total if total > 0 else -math.inf
 
@@ -350,36 +354,36 @@ def margin_matches(claimed: float, blocks, x, delta: float = 0.0) -> bool:
     >>> margin_matches(0.25, blocks, [1.0, 3.0], delta=1e-6)  # the correction may move it by 2e-7
     False
     """
-    t = margin_of(blocks, x)
-    return abs(claimed - t) + 2 * _margin_shift(blocks, x, delta) <= 0.5 * margin_tolerance(t)
+    pairs = [slack(b, [x[j] for j in b.cols]) for b in blocks]
+    t = _margin(pairs)
+    return abs(claimed - t) + 2 * _margin_shift(blocks, pairs, t, delta) <= 0.5 * margin_tolerance(t)
 
 
-def _margin_shift(blocks, x, delta: float) -> float:
+def _margin_shift(blocks, pairs, t: float, delta: float) -> float:
     """Bound on how far :func:`margin_of` moves when every entry of ``x`` moves by at most
     ``delta``: a ray's slack and normal force move by ``delta``; a Lorentz block's slack by
     ``(1 + mu) |df| + |n| |dm| / g`` (``|df| <= sqrt(dim) delta``, as the float kernels bound it)
     and its normal force by ``|df|``; the margin (least slack over total normal force) by at most
-    ``(S + |t| F) / (T - F)`` for slack moves ``S``, normal-force moves ``F`` and total ``T``."""
+    ``(S + |t| F) / (T - F)`` for slack moves ``S``, normal-force moves ``F`` and total ``T``
+    (``pairs``: each block's ``(slack, normal force)`` at ``x``, ``t`` their margin)."""
     if delta == 0.0:
         return 0.0
-    if not math.isfinite(delta):
+    if not math.isfinite(delta) or not math.isfinite(t):
         return math.inf
-    moves, total, force = [], 0.0, 0.0
+    most, force = 0.0, 0.0
     for b in blocks:
         if b.cone == "ray":
-            moves.append(delta)
-            force += delta
-        else:
-            dim, rn = len(b.n), math.sqrt(sum(float(v) ** 2 for v in b.n))
-            df = math.sqrt(dim) * delta
-            moments = len(b.cols) - dim  # columns of torsional moments: none without a moment length
-            moves.append((1 + float(b.mu)) * df + (moments * rn * delta / float(b.g) if moments else 0.0))
-            force += df
-        total += slack(b, [x[j] for j in b.cols])[1]
-    t = margin_of(blocks, x)
-    if not total - force > 0 or not math.isfinite(t):
+            most, force = max(most, delta), force + delta
+            continue
+        dim, rn = len(b.n), math.sqrt(sum(float(v) ** 2 for v in b.n))
+        df = math.sqrt(dim) * delta
+        moments = len(b.cols) - dim  # columns of torsional moments: none without a moment length
+        most = max(most, (1 + float(b.mu)) * df + (moments * rn * delta / float(b.g) if moments else 0.0))
+        force += df
+    total = sum(fn for _, fn in pairs)
+    if not total - force > 0:
         return math.inf
-    return (max(moves, default=0.0) + abs(t) * force) / (total - force) * (1 + 1e-9)
+    return (most + abs(t) * force) / (total - force) * (1 + 1e-9)
 
 
 def _verify_interior(Cx, blocks, cert: Certificate, margin, tol: Tolerances,
