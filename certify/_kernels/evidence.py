@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .hull import face_planes, hull_faces
+from .hull import face_planes, hull_faces_work, hull_work
 from .jit import kernel
 from .linalg import ETA, gamma
 from .order import stable_argsort
@@ -231,9 +231,10 @@ def support_refine(W, E, owner, m, u, cut, limit, add, dirs, picks, n, rounds):
     for q in range(n):
         _pick_sum(W, E, picks[q], V[q], EV[q])
     done = 0
+    work = hull_work(dirs.shape[0])  # one set of work arrays for every round's hull
     while True:
         P = V[:n].copy()
-        faces = hull_faces(P)
+        faces = hull_faces_work(P, work)
         if faces.shape[0] == 0:
             return n, NOT_HERE, faces, V[:n], EV[:n]
         normal, dist = face_planes(P, faces)

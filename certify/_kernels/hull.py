@@ -22,8 +22,8 @@ import numpy as np
 from .jit import kernel
 from .order import stable_argsort
 
-__all__ = ["PLANE_TOL", "hull_faces", "hull_work", "hulls_faces", "face_planes", "used_vertices", "hull_planes",
-           "planes_start", "planes_insert", "live_planes", "weakest_plane", "hull_grow", "grow_start", "live_facets",
+__all__ = ["PLANE_TOL", "hull_faces", "hull_faces_work", "hull_work", "hulls_faces", "face_planes", "used_vertices",
+           "hull_planes", "planes_start", "planes_insert", "live_planes", "weakest_plane", "hull_grow", "grow_start", "live_facets",
            "hull_facets"]
 
 #: Relative distance below which a point counts as on a face's plane (times the set's largest
@@ -125,6 +125,13 @@ def hull_faces(P):
     cone from the point to their horizon. A new face of (near) zero area declines the set.
     """
     return _hull(P, hull_work(P.shape[0]))
+
+
+@kernel
+def hull_faces_work(P, work):
+    """:func:`hull_faces` of ``P`` in the work arrays of :func:`hull_work` (made for at least as
+    many points): a caller building many hulls allocates them once. The same faces."""
+    return _hull(P, work)
 
 
 @kernel
