@@ -359,7 +359,7 @@ def thin_screen(W, E, Y, T, margin, rel, P, N, width, owner, no_friction, no_off
     * with generators without friction edges (``no_friction``; ``owner`` their contacts),
       ``at_most_two``: rank at most 2 proved (:func:`_at_most_two`); without pad offsets as
       well (``no_offset``), ``full``: rank 3 of the exact generators proved in floats
-      (:func:`_full_rank`).
+      (:func:`_full_rank`), sought only where rank at most 2 is not proved (which excludes it).
     """
     B, d, k = W.shape
     ok = np.zeros(B, dtype=np.bool_)
@@ -380,8 +380,10 @@ def thin_screen(W, E, Y, T, margin, rel, P, N, width, owner, no_friction, no_off
             tight[b, :] = tt
             if ok[b] and not tt.any():
                 proved[b] = verify_farkas_general(W[b], E[b], rays, first, ones, n0, z, z, yf[b], tt, 0.0)
-        if no_friction and no_offset:
-            full[b] = _full_rank(P[b], N[b], owner)
-        if no_friction and not full[b]:
+        # rank at most 2 first: its proof is linear in the generators, and rules out rank 3,
+        # whose search over minors is cubic (every minor of collinear contacts is zero)
+        if no_friction:
             parallel[b] = _at_most_two(P[b], N[b], width[b], owner, no_offset)
+        if no_friction and no_offset and not parallel[b]:
+            full[b] = _full_rank(P[b], N[b], owner)
     return ok, yf, tight, proved, full, parallel
