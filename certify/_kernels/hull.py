@@ -23,8 +23,8 @@ from .jit import kernel
 from .order import stable_argsort
 
 __all__ = ["PLANE_TOL", "hull_faces", "hull_faces_work", "hull_work", "hulls_faces", "face_planes", "used_vertices",
-           "hull_planes", "planes_start", "planes_insert", "live_planes", "weakest_plane", "hull_grow", "grow_start", "live_facets",
-           "hull_facets"]
+           "hull_planes", "planes_start", "planes_insert", "live_planes", "weakest_plane", "hull_grow", "grow_start",
+           "live_facets", "hull_facets"]
 
 #: Relative distance below which a point counts as on a face's plane (times the set's largest
 #: absolute coordinate).
@@ -124,20 +124,13 @@ def hull_faces(P):
     sees the faces whose planes it lies more than the tolerance beyond, which are replaced by the
     cone from the point to their horizon. A new face of (near) zero area declines the set.
     """
-    return _hull(P, hull_work(P.shape[0]))
-
-
-@kernel
-def hull_faces_work(P, work):
-    """:func:`hull_faces` of ``P`` in the work arrays of :func:`hull_work` (made for at least as
-    many points): a caller building many hulls allocates them once. The same faces."""
-    return _hull(P, work)
+    return hull_faces_work(P, hull_work(P.shape[0]))
 
 
 @kernel
 def hull_work(n):
-    """The work arrays of :func:`_hull` for sets of up to ``n`` points (a batch of hulls
-    allocates them once)."""
+    """The work arrays of :func:`hull_faces_work` for sets of up to ``n`` points (a caller
+    building many hulls allocates them once)."""
     cap = 8 * n + 16
     return (np.empty((cap, 3), dtype=np.int64), np.empty((cap, 4)), np.empty(cap), np.zeros(cap, dtype=np.bool_),
             np.empty(cap, dtype=np.int64), np.empty(cap, dtype=np.int64), np.empty((3 * cap, 2), dtype=np.int64),
@@ -145,9 +138,9 @@ def hull_work(n):
 
 
 @kernel
-def _hull(P, work):
-    """:func:`hull_faces` of ``P`` in the work arrays of :func:`hull_work` (for at least as many
-    points)."""
+def hull_faces_work(P, work):
+    """:func:`hull_faces` of ``P`` in the work arrays of :func:`hull_work` (made for at least as
+    many points): the same faces."""
     face, plane, size, alive, live, visible, edges, nxt, far, order, taken = work
     n = P.shape[0]
     tol = _tolerance(P)
@@ -301,11 +294,11 @@ def hulls_faces(V, vstart):
     work = hull_work(most)
     for s in range(S):
         n = vstart[s + 1] - vstart[s]
-        P = np.empty((n, 3))  # a copy in C order: the one specialisation of _hull
+        P = np.empty((n, 3))  # a copy in C order: the one specialisation of hull_faces_work
         for i in range(n):
             for r in range(3):
                 P[i, r] = V[vstart[s] + i, r]
-        f = _hull(P, work)
+        f = hull_faces_work(P, work)
         end = fstart[s] + f.shape[0]
         if end > faces.shape[0]:  # room for twice as many
             grown = np.empty((2 * end, 3), dtype=np.int64)

@@ -26,13 +26,11 @@ import pyarrow as pa
 from .. import models as registry
 from .._kernels.jit import kernel_array
 from .._kernels.planar import planar_generators
-from .._kernels.recheck import (correction_bound, null_rows, residual_bound, verify_farkas_general,
-                               verify_interior_general)
-from ..core.certificates import Tolerances, margin_matches
+from .._kernels.recheck import null_rows, verify_farkas_general, verify_interior_general
+from ..core.certificates import Tolerances, margin_proved
 from ..files.columns import GraspColumns
-from ..core.cones import CONES, RAY
 from ..quality.evidence import EPS_COLUMNS, Evidence, verify_bounds
-from ..core.problem import Block, conic_block_arrays, ray_block_arrays
+from ..core.problem import conic_block_arrays, ray_block_arrays
 from ..report import GEOMETRY_TOL
 from ..files.results import RESULT_SCHEMA
 from ..core.wrench import force_column_errors, force_columns, generator_columns, generator_layout
@@ -140,7 +138,7 @@ def _group_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, tol: Tole
         for i in np.flatnonzero(interior):
             if verify_interior_general(C[i], E[i], cone, first, width, nb[i], mub[i], gb[i], values[i],
                                        basis[i], tol.residual) and \
-                    _margin_ok(mg[i], C[i], E[i], cone, first, width, nb[i], mub[i], gb[i], values[i], basis[i]):
+                    margin_proved(mg[i], C[i], E[i], (cone, first, width, nb[i], mub[i], gb[i]), values[i], basis[i]):
                 good[i] = True
         for i in np.flatnonzero(farkas):
             good[i] = verify_farkas_general(C[i], E[i], cone, first, width, nb[i], mub[i], gb[i], y[i],
@@ -194,15 +192,6 @@ def _eps_proofs(cols: GraspColumns, rows: np.ndarray, res: pa.Table, status: np.
             except (ValueError, TypeError, IndexError, ZeroDivisionError, OverflowError):
                 ok[j] = False
     return ok
-
-
-def _margin_ok(claimed: float, C, E, cone, first, width, n, mu, g, x, basis) -> bool:
-    """:func:`margin_matches` of the blocks given as arrays, for the values the exact checker
-    would correct ``x`` to (the correction bounded by the float kernels)."""
-    blocks = [Block("ray", (int(first[b]),), contact=b) if cone[b] == RAY else
-              Block(CONES[cone[b]], tuple(range(first[b], first[b] + width[b])), tuple(n[b]), mu[b], g[b], b)
-              for b in range(len(cone))]  # a ray's normal, friction and moment length count for nothing
-    return margin_matches(claimed, blocks, x, correction_bound(C, E, basis, residual_bound(C, E, x)[0]))
 
 
 def _claims(cols: GraspColumns, results: pa.Table, lines) -> np.ndarray:

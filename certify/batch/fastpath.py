@@ -49,9 +49,8 @@ from .._kernels.evidence import generator_rows
 from .._kernels.jit import kernel_array
 from .._kernels.linalg import U as U_ROUND, projection_bound, world_values
 from .._kernels.planar import pair_null_rows, planar_batch, thin_screen
-from .._kernels.recheck import (certify_rows, correction_bound, null_rows, residual_bound, verify_farkas_general,
-                               verify_interior_general)
-from ..core.certificates import Tolerances, margin_matches, verify
+from .._kernels.recheck import certify_rows, null_rows, verify_farkas_general, verify_interior_general
+from ..core.certificates import Tolerances, margin_proved, verify
 from ..core.closure import decide, farkas_from_arrays
 from ..errors import SolverError
 from ..files.columns import GraspColumns, grasp_columns
@@ -226,7 +225,7 @@ def _planar_barrier(W, E, tol: Tolerances):
     compiled dual barrier method, :func:`qualgrasp.certify.core.closure.decide` states the
     verdict): the barrier method for the whole batch, and the clear verdicts proved columnar
     (:func:`~qualgrasp.certify._kernels.recheck.certify_rows`: an interior certificate whose
-    margin matches, :func:`~qualgrasp.certify.core.certificates.margin_matches`, or a strict
+    margin matches, :func:`~qualgrasp.certify.core.certificates.margin_proved`, or a strict
     Farkas direction). Rows numerically thin, near the boundary or not proved this way keep code
     0, for the per-grasp route. ``W``, ``E``: generator columns (B, 3, k) and their error
     bounds. Returns ``(code, t, lam, basis, y)``."""
@@ -246,10 +245,9 @@ def _planar_barrier(W, E, tol: Tolerances):
     zeros = np.zeros((B, k))
     code, basis = certify_rows(W, E, cone, first, width, np.zeros((B, k, 2)), zeros, zeros, values, yn,
                                closure, farkas, np.abs(W).max(axis=(1, 2)), tol.residual)
-    blocks = [Block("ray", (j,), contact=j) for j in range(k)]
+    arrays = (cone, first, width, np.zeros((k, 2)), np.zeros(k), np.zeros(k))
     for i in np.flatnonzero(code == 1):  # the margin stated must be the one verify certifies
-        delta = correction_bound(W[i], E[i], basis[i], residual_bound(W[i], E[i], values[i])[0])
-        if not margin_matches(float(t[i]), blocks, values[i], delta):
+        if not margin_proved(float(t[i]), W[i], E[i], arrays, values[i], basis[i]):
             code[i] = 0
     return code, np.where(code == 1, t, 0.0), values, basis, yn
 

@@ -45,7 +45,7 @@ from .._kernels.recheck import correction_bound, residual_bound, verify_farkas_g
 from ..errors import CertificateError
 from .arguments import number_in, require
 from .grasp import Grasp
-from .problem import Block, block_arrays, grasp_system, ray_block_arrays, span_system, span_vectors
+from .problem import Block, array_blocks, block_arrays, grasp_system, ray_block_arrays, span_system, span_vectors
 from .wrench import planar_generator_arrays, to_exact
 
 __all__ = [
@@ -57,6 +57,7 @@ __all__ = [
     "verify_system",
     "margin_tolerance",
     "margin_matches",
+    "margin_proved",
     "FLOAT_PROOF_CONTACTS",
 ]
 
@@ -258,7 +259,7 @@ def _proved_in_floats(grasp: Grasp, cert: Certificate, status, margin, frictionl
     :func:`~qualgrasp.certify._kernels.recheck.verify_farkas_general`: error bounds instead of
     rationals) prove what :func:`verify` checks, for a planar grasp of at least
     :data:`FLOAT_PROOF_CONTACTS` contacts whose models' float cone weights are exact: an
-    interior certificate whose claimed margin matches (:func:`margin_matches`), or a strict
+    interior certificate whose claimed margin matches (:func:`margin_proved`), or a strict
     Farkas one (no tight block). False decides nothing: the exact route then checks, and gives
     the reason of a failure."""
     if grasp.dim != 2 or cert.layout != "generators" or cert.kind not in ("interior", "farkas"):
@@ -286,8 +287,7 @@ def _proved_in_floats(grasp: Grasp, cert: Certificate, status, margin, frictionl
         return False
     if not verify_interior_general(W, E, cone, first, width, n, zero, zero, x, basis, tol.residual):
         return False
-    delta = correction_bound(W, E, basis, residual_bound(W, E, x)[0])  # how far the exact checker corrects
-    return margin is None or margin_matches(margin, [Block("ray", (j,), contact=j) for j in range(k)], x, delta)
+    return margin is None or margin_proved(margin, W, E, (cone, first, width, n, zero, zero), x, basis)
 
 
 _REALS = (int, float, np.integer, np.floating)
@@ -357,6 +357,15 @@ def margin_matches(claimed: float, blocks, x, delta: float = 0.0) -> bool:
     pairs = [slack(b, [x[j] for j in b.cols]) for b in blocks]
     t = _margin(pairs)
     return abs(claimed - t) + 2 * _margin_shift(blocks, pairs, t, delta) <= 0.5 * margin_tolerance(t)
+
+
+def margin_proved(claimed: float, C, E, arrays, x, basis) -> bool:
+    """:func:`margin_matches` of a certificate proved by the float kernels: its values ``x`` over
+    columns ``C`` (error bounds ``E``) with ``basis``, its blocks as :func:`block_arrays` gives
+    them (``arrays``), the correction the exact checker would make bounded by
+    :func:`~qualgrasp.certify._kernels.recheck.correction_bound`."""
+    delta = correction_bound(C, E, basis, residual_bound(C, E, x)[0])
+    return margin_matches(claimed, array_blocks(*arrays), x, delta)
 
 
 def _margin_shift(blocks, pairs, t: float, delta: float) -> float:

@@ -31,11 +31,11 @@ from .. import models as registry
 from ..errors import ArgumentError, GraspError
 from .._kernels.conic import lorentz_system
 from .._kernels.linalg import world_values
-from .cones import cone_code
+from .cones import CONES, RAY, cone_code
 from .wrench import (contact_frame, force_columns, generator_columns, grasp_arrays, tangent,
                      to_exact, variants_of, wrench)
 
-__all__ = ["Block", "block_arrays", "ray_block_arrays", "conic_block_arrays", "System", "ClosureProblem",
+__all__ = ["Block", "block_arrays", "array_blocks", "ray_block_arrays", "conic_block_arrays", "System", "ClosureProblem",
            "grasp_problem", "span_problem", "grasp_system", "span_system", "span_vectors", "is_polyhedral",
            "DENSE_COLUMNS", "LorentzLayout", "lorentz_layout", "ray_problem"]
 
@@ -64,6 +64,21 @@ def block_arrays(blocks: Sequence[Block], dim: int):
     mu = np.array([float(b.mu) for b in blocks])
     g = np.array([float(b.g) for b in blocks])
     return cone, first, width, n, mu, g
+
+
+def array_blocks(cone, first, width, n, mu, g) -> list[Block]:
+    """The cone blocks of :func:`block_arrays`' arrays, each the ``contact`` of its index; a ray
+    without the normal, friction and moment length that count for nothing on it.
+
+    Examples
+    --------
+    >>> blocks = array_blocks(*block_arrays([Block("ray", (0,)), Block("lorentz", (1, 2), (1.0, 0.0), 0.5)], 2))
+    >>> [(b.cone, b.cols, float(b.mu)) for b in blocks]
+    [('ray', (0,), 0.0), ('lorentz', (1, 2), 0.5)]
+    """
+    return [Block("ray", (int(first[b]),), contact=b) if cone[b] == RAY else
+            Block(CONES[cone[b]], tuple(range(first[b], first[b] + width[b])), tuple(n[b]), mu[b], g[b], b)
+            for b in range(len(cone))]
 
 
 def ray_block_arrays(k: int):

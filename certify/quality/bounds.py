@@ -623,8 +623,7 @@ def _support_rows(W, E, owner, m, todo, eps, arg, vals, limited, time_limit, exa
     lo[ok] = _lowers(eps[ok], d2_lo[ok], d2_hi[ok])
     for q in np.flatnonzero(here & ~decided):  # exact arithmetic needed: as the per-grasp route
         b, (a, z), (f, g) = todo[q], vstart[q:q + 2], fstart[q:q + 2]
-        gens = _exact_once(None if exact is None else (lambda b=b: exact(b)))
-        found = _lower(float(eps[q]), _prove(V[a:z], EV[a:z], F[f:g], _support_vertex(R[a:z], gens)))
+        found = _lower(float(eps[q]), _support_bounds(V[a:z], EV[a:z], F[f:g], R[a:z], _row_gens(exact, b)))
         lo[q] = np.nan if found is None else found
     rows = todo[here]
     l1_lo, e = vals[rows, 0], eps[here]
@@ -663,8 +662,7 @@ def _support_rows_each(W, E, owner, m, todo, eps, arg, vals, limited, time_limit
             dirs, V, EV, R, faces = surface
             bounds = proved.get(q)
             if bounds is None:  # exact arithmetic needed: as the per-grasp route
-                gens = _exact_once(None if exact is None else (lambda b=b: exact(b)))
-                bounds = _prove(V, EV, faces, _support_vertex(R, gens))
+                bounds = _support_bounds(V, EV, faces, R, _row_gens(exact, b))
             lo = _lower(float(e), bounds)
             found = None if lo is None else (lo, dirs)
         vals[b, 2], vals[b, 3], _, ev, limited[b] = _support_result(float(e), u, vals[b, 0], found, cut)
@@ -713,19 +711,24 @@ def _planar_support(W, E, owner, m, eps, u, deadline, gens):
     if surface is None:
         return None, limited
     dirs, V, EV, R, faces = surface
-    lo = _lower(eps, _prove(V, EV, faces, _support_vertex(R, gens)))
+    lo = _lower(eps, _support_bounds(V, EV, faces, R, gens))
     return (None if lo is None else (lo, dirs)), limited
 
 
-def _support_vertex(R, gens):
-    """Exact coordinates of the vertex ``i`` of ``support`` evidence with the generator choices
-    ``R``, for :func:`_prove`."""
+def _support_bounds(V, EV, faces, R, gens):
+    """:func:`_prove` of a ``support`` surface: vertices ``V`` (error bounds ``EV``), their
+    generator choices ``R`` (the exact vertices, from ``gens()``, where needed) and hull faces."""
 
     def vertex(i):
         C = gens()
         return [sum((C[r, j] for j in R[i] if j >= 0), 0) for r in range(3)]
 
-    return vertex
+    return _prove(V, EV, faces, vertex)
+
+
+def _row_gens(exact, b: int):
+    """:func:`_exact_once` of row ``b``'s exact generators (``exact(b)``; none without ``exact``)."""
+    return _exact_once(None if exact is None else (lambda: exact(b)))
 
 
 def _support_surface(W, E, owner, m, eps, u, deadline):
