@@ -13,7 +13,10 @@ grasps (a prefix of them for the slow routes):
 * **exact verify**: the rational-arithmetic checker on the per-grasp certificates.
 
 The table gives microseconds per grasp, grasps per second and each route's time per grasp as a
-multiple of the batch path's. The **degenerate planar** rows time the batch path, without and with
+multiple of the batch path's. The **with quality** rows time the batch path with quality (the
+offline job's default: closure, both epsilons and their evidence) on planar grasps of 3 and 10
+point contacts, against the same grasps without quality and the per-grasp route with quality.
+The **degenerate planar** rows time the batch path, without and with
 quality, on a degenerate planar set (``qualgrasp sample --degenerate mixed``: normals through one
 point, repeated or collinear contacts) and on a generic set of the same size, model and contact
 count, in the same run; their ratio is the degenerate set's time per grasp as a multiple of the
@@ -55,9 +58,9 @@ from ..certify.report import certify_grasp
 from ..certify.solvers import make_solver
 from .dexnet import dexnet_inputs
 
-__all__ = ["KINDS", "DEGENERATE_KIND", "BenchRow", "run_bench", "print_bench", "SINGLE_KIND", "SINGLE_ROUND",
-           "SingleRow", "run_single_bench", "print_single_bench", "CONTACTS", "ContactsRow", "epsilon_linearised",
-           "run_contacts_bench", "print_contacts_bench"]
+__all__ = ["KINDS", "BATCH_QUALITY_KINDS", "DEGENERATE_KIND", "BenchRow", "run_bench", "print_bench", "SINGLE_KIND",
+           "SINGLE_ROUND", "SingleRow", "run_single_bench", "print_single_bench", "CONTACTS", "ContactsRow",
+           "epsilon_linearised", "run_contacts_bench", "print_contacts_bench"]
 
 #: name -> keyword arguments of :func:`qualgrasp.certify.batch.samples.random_grasp`
 #: (sizes chosen so that both verdicts are frequent: 17 % to 40 % of the grasps are in closure)
@@ -67,6 +70,14 @@ KINDS = {
     "spatial frictionless, 10 contacts": dict(dim=3, n_contacts=10, model="frictionless"),
     "spatial point, 3 contacts": dict(dim=3, n_contacts=3, model="point", spread=0.3),
     "spatial soft, 2 contacts": dict(dim=3, n_contacts=2, model="soft", spread=0.15),
+}
+
+
+#: The planar kinds also timed with quality (the offline job's default), one process: the batch
+#: path against itself without quality and against the per-grasp route with quality.
+BATCH_QUALITY_KINDS = {
+    "planar point, 3 contacts": dict(dim=2, n_contacts=3, model="point"),
+    "planar point, 10 contacts": dict(dim=2, n_contacts=10, model="point"),
 }
 
 
@@ -115,6 +126,26 @@ def _batch_seconds(grasps, quality: bool = False, table=None) -> float:
     start = time.perf_counter()
     certify_table(table, lines, options, slow=slow)
     return time.perf_counter() - start
+
+
+def _quality_rows(n: int, seed: int, reference_n: int) -> list[BenchRow]:
+    """The rows of :data:`BATCH_QUALITY_KINDS`: per kind, the batch path with quality (closure, both
+    epsilons and their evidence) on ``n`` grasps, the same grasps without quality, and the
+    per-grasp route with quality on the first ``reference_n``; ratios to the first."""
+    rows = []
+    for kind, kwargs in BATCH_QUALITY_KINDS.items():
+        grasps = random_grasps(seed, n, **kwargs)
+        table = grasps_table([grasp_to_dict(g) for g in grasps])
+        base = _batch_seconds(grasps, True, table)
+        plain = _batch_seconds(grasps, False, table)
+        few = grasps[:max(reference_n, 1)]
+        certify_grasp(few[0], quality=True)  # load its kernels outside the timing
+        per = _time(lambda g: certify_grasp(g, quality=True), few)
+        label = f"{kind}, with quality"
+        rows += [BenchRow(label, "qualgrasp batch, closure and both epsilons with evidence", n, base, 1.0),
+                 BenchRow(label, "qualgrasp batch, closure only", n, plain, plain / base),
+                 BenchRow(label, "per-grasp route with quality", len(few), per, (per / len(few)) / (base / n))]
+    return rows
 
 
 def _degenerate_rows(n: int, seed: int, reference_n: int) -> list[BenchRow]:
@@ -173,6 +204,9 @@ def run_bench(n: int = 20000, seed: int = 0, reference_n: int = 300,
             for route, count, seconds in routes:
                 rows.append(BenchRow(kind, route, count, seconds, (seconds / count) / t_batch))
             bar.remove_task(task)
+        task = bar.add_task("planar with quality", total=None)
+        rows += _quality_rows(n, seed, reference_n)
+        bar.remove_task(task)
         task = bar.add_task("degenerate planar", total=None)
         rows += _degenerate_rows(n, seed, reference_n)
         bar.remove_task(task)
