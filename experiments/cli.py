@@ -13,6 +13,7 @@ from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
+from ..certify.batch.engine import tune_allocator
 from ..certify.cli.options import OptionError, count_in, fail, output_folder
 from ..certify.errors import CertifyError
 from . import figures
@@ -240,7 +241,9 @@ def bench_command(
     """Time every certification route on the same random grasps, with ratios to the batch path.
 
     Routes: the batch path, the per-grasp fast route, clarabel, linprog, cvxpy with Parameters
-    and cvxpy rebuilt per grasp; prints grasps per second and each route's ratio.
+    and cvxpy rebuilt per grasp; prints grasps per second and each route's ratio. Also the batch
+    path with quality (planar, 3 and 10 point contacts) and on a degenerate planar set. All in
+    one process whose memory allocator is set as the workers of qualgrasp certify set theirs.
 
     With --quality: epsilon bound gaps and time per grasp, and the error of the 8-edge cone
     linearisation other toolkits use, on --n random grasps in closure per kind.
@@ -294,4 +297,5 @@ def bench_command(
     elif quality:
         print_quality_bench(run_quality_bench(n=n, seed=seed))
     else:
+        tune_allocator()  # the batch rows time a worker's path: in a process tuned as workers are
         print_bench(run_bench(n=n, seed=seed, reference_n=reference_n))
