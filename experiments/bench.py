@@ -21,8 +21,8 @@ quality, on a degenerate planar set (``qualgrasp sample --degenerate mixed``: no
 point, repeated or collinear contacts) and on a generic set of the same size, model and contact
 count, in the same run; their ratio is the degenerate set's time per grasp as a multiple of the
 generic set's. Speeds are single-process; ``qualgrasp certify --workers N`` runs N
-such processes, and ``qualgrasp bench`` sets its memory allocator as they do
-(:func:`qualgrasp.certify.batch.engine.tune_allocator`).
+such processes, and ``qualgrasp bench`` times this table in a process whose memory allocator
+is set as theirs (:func:`qualgrasp.certify.batch.engine.tune_allocator`).
 
 ``qualgrasp bench --single`` times one spatial grasp per call, as a planning loop calls the API:
 :func:`~qualgrasp.certify.core.closure.force_closure` (exact cones, with its certificate) and
