@@ -221,32 +221,44 @@ def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances
 
 def _planar_barrier(W, E, tol: Tolerances):
     """Force closure of planar grasps whose LP has too many bases to enumerate, as the per-grasp
-    fast route decides it (:class:`qualgrasp.certify.solvers.FastSolver` hands such LPs to the
-    compiled dual barrier method, :func:`qualgrasp.certify.core.closure.decide` states the
-    verdict): the barrier method for the whole batch, and the clear verdicts proved columnar
-    (:func:`~qualgrasp.certify._kernels.recheck.certify_rows`: an interior certificate whose
-    margin matches, :func:`~qualgrasp.certify.core.certificates.margin_proved`, or a strict
-    Farkas direction). Rows numerically thin, near the boundary or not proved this way keep code
-    0, for the per-grasp route. ``W``, ``E``: generator columns (B, 3, k) and their error
-    bounds. Returns ``(code, t, lam, basis, y)``."""
+    fast route decides it: :func:`_barrier_rays` on the generator columns ``W`` (B, 3, k) and
+    their error bounds ``E``, an interior certificate kept only where its margin is proved
+    (:func:`~qualgrasp.certify.core.certificates.margin_proved`). Returns ``(code, t, lam, basis,
+    y)``."""
+    k = W.shape[2]
+    return _barrier_rays(W, E, np.zeros((len(W), k, 2)), max(1e-6, 2 * tol.rank), tol, margins=True)
+
+
+def _barrier_rays(W, E, normals, thin_rel: float, tol: Tolerances, *, closure: bool = True, margins: bool = False):
+    """Closure programmes of generator rays ``W`` (B, d, k) (error bounds ``E``) whose LPs the
+    per-grasp fast route hands to the compiled dual barrier method
+    (:class:`qualgrasp.certify.solvers.FastSolver`), solved by that method for the whole batch;
+    its clear verdicts proved columnar (:func:`~qualgrasp.certify._kernels.recheck.certify_rows`,
+    ``normals`` (B, k, .) its rays' normals): an interior certificate (unless ``closure`` is
+    False; with ``margins``, only where its stated margin is proved as well, by
+    :func:`~qualgrasp.certify.core.certificates.margin_proved`) or a strict Farkas direction.
+    Rows numerically thin (least singular value not above ``thin_rel`` times the largest:
+    conservative, the per-grasp rank test is sharper), near the boundary (what FastSolver hands
+    to clarabel) or not proved this way keep code 0, for the per-grasp route. Returns ``(code,
+    t, lam, basis, y)``."""
     B, d, k = W.shape
     status, t, y, xn, _ = barrier_batch(np.ascontiguousarray(np.swapaxes(W, 1, 2)), np.zeros((B, k, 1, d)),
                                         np.zeros(k, dtype=np.int64), np.ones((B, k)), EXIT_BELOW, GAP_TOL,
                                         MAX_NEWTON)
     sv = np.linalg.svd(W, compute_uv=False)
-    thin = ~(sv[:, -1] > max(1e-6, 2 * tol.rank) * sv[:, 0])  # conservative: decide's test is sharper
+    thin = ~(sv[:, -1] > thin_rel * sv[:, 0])
     near = (status == 2) | (np.abs(t) < BARRIER_NEAR_ZERO)  # what FastSolver hands to clarabel
-    closure = ~thin & ~near & (status == 0) & (t >= tol.margin)
+    interior = ~thin & ~near & (status == 0) & (t >= tol.margin) & closure
     farkas = ~thin & ~near & (t < tol.margin)
     values = xn + 0.0  # the identity value map's values (ClosureProblem.values): -0 stated as +0
     with np.errstate(invalid="ignore", divide="ignore"):
         yn = np.nan_to_num(y / np.sqrt(np.sum(y * y, axis=1, keepdims=True)))
     cone, first, width = ray_block_arrays(k)
     zeros = np.zeros((B, k))
-    code, basis = certify_rows(W, E, cone, first, width, np.zeros((B, k, 2)), zeros, zeros, values, yn,
-                               closure, farkas, np.abs(W).max(axis=(1, 2)), tol.residual)
-    arrays = (cone, first, width, np.zeros((k, 2)), np.zeros(k), np.zeros(k))
-    for i in np.flatnonzero(code == 1):  # the margin stated must be the one verify certifies
+    code, basis = certify_rows(W, E, cone, first, width, np.ascontiguousarray(normals), zeros, zeros, values, yn,
+                               interior, farkas, np.abs(W).max(axis=(1, 2)), tol.residual)
+    arrays = (cone, first, width, np.zeros((k, normals.shape[2])), np.zeros(k), np.zeros(k))
+    for i in np.flatnonzero(code == 1) if margins else ():  # the margin stated must be the one verify certifies
         if not margin_proved(float(t[i]), W[i], E[i], arrays, values[i], basis[i]):
             code[i] = 0
     return code, np.where(code == 1, t, 0.0), values, basis, yn
@@ -549,21 +561,8 @@ def _polyhedral(P, N, c, L, options, tol: Tolerances):
     E = force_column_errors(P, N, models, c, L)
     if FastSolver.enumerates(m, 2 * d):
         return _polyhedral_rows(P, N, c, L, W, E, options, tol)
-    status, t, y, xn, _ = barrier_batch(np.ascontiguousarray(np.swapaxes(W, 1, 2)),
-                                        np.zeros((B, m, 1, 2 * d)), np.zeros(m, dtype=np.int64),
-                                        np.ones((B, m)), EXIT_BELOW, GAP_TOL, MAX_NEWTON)
-    sv = np.linalg.svd(W, compute_uv=False)
-    thin = sv[:, -1] <= 1e-6 * sv[:, 0]  # conservative: the per-grasp rank test is sharper
-    near = (status == 2) | (np.abs(t) < BARRIER_NEAR_ZERO)  # what FastSolver hands to clarabel
-    closure = ~thin & ~near & (status == 0) & (t >= tol.margin) & (not options.quality)
-    farkas = ~thin & ~near & (t < tol.margin)
-    values = world_values(np.ascontiguousarray(np.broadcast_to(np.eye(m), (B, m, m))), xn)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        yn = np.nan_to_num(y / np.sqrt(np.sum(y * y, axis=1, keepdims=True)))
-    cone, first, width = ray_block_arrays(m)
-    code, basis = certify_rows(W, E, cone, first, width, np.ascontiguousarray(N), zeros, zeros,
-                               values, yn, closure, farkas, np.abs(W).max(axis=(1, 2)), tol.residual)
-    out = [code, np.where(code == 1, t, 0.0), values, basis, yn]
+    out = list(_barrier_rays(W, E, N, 1e-6, tol, closure=not options.quality))
+    code = out[0]
     tight = {}
     rest = np.flatnonzero(code == 0)
     if len(rest):
