@@ -12,7 +12,7 @@ from hypothesis.extra.numpy import arrays
 
 from qualgrasp.certify._kernels.cones import farkas_direction
 from qualgrasp.certify._kernels.epsilon import planar_epsilon_one
-from qualgrasp.certify._kernels.order import radix_argsort, stable_argsort
+from qualgrasp.certify._kernels.order import radix_argsort, stable_argsort, stable_smallest
 
 
 @settings(max_examples=200, deadline=None)
@@ -20,6 +20,13 @@ from qualgrasp.certify._kernels.order import radix_argsort, stable_argsort
        | arrays(np.int64, st.integers(0, 70), elements=st.integers(-3, 3)))
 def test_stable_argsort_is_numpys_stable_argsort(keys):
     assert stable_argsort(keys).tolist() == np.argsort(keys, kind="stable").tolist()
+
+
+@settings(max_examples=200, deadline=None)
+@given(arrays(np.float64, st.integers(0, 70), elements=st.sampled_from([-1.5, -0.0, 0.0, 0.25, 2.0, 7.0])),
+       st.integers(0, 8))
+def test_stable_smallest_is_the_start_of_numpys_stable_argsort(keys, c):
+    assert stable_smallest(keys, c).tolist() == np.argsort(keys, kind="stable")[:c].tolist()
 
 
 @settings(max_examples=100, deadline=None)

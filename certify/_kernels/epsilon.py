@@ -68,62 +68,63 @@ def planar_edges(Wb, owner):
 def planar_epsilon_one(Wb, owner, m, linf):
     """Epsilon and direction of one planar grasp (see :func:`planar_epsilon`)."""
     k = Wb.shape[1]
-    if linf:
-        E = planar_edges(Wb, owner)
-        n = E.shape[0]
-    else:
-        # facets of conv(0 and the generators): the grasp is in closure, so the origin is
-        # interior and no facet passes through it; triples of generators suffice
-        n = k
-        E = np.empty((n, 3))
-        for a in range(k):
-            E[a, 0], E[a, 1], E[a, 2] = Wb[0, a], Wb[1, a], Wb[2, a]
+    # L-infinity: normals of pairs of edges. L1: facets of conv(0 and the generators); the grasp
+    # is in closure, so the origin is interior and no facet passes through it: normals of
+    # triples of generators suffice
+    E = planar_edges(Wb, owner) if linf else np.ascontiguousarray(Wb.T)
+    n = E.shape[0]
     scale = 0.0
     for a in range(n):
         scale = max(scale, abs(E[a, 0]) + abs(E[a, 1]) + abs(E[a, 2]))
     tiny = 1e-12 * max(1.0, scale * scale)
     work = np.empty((2, m))
     arg = np.zeros(3)
-    best = np.inf
     grouped = True  # each contact's generators together, in contact order (as generator_layout lays them)
     for j in range(1, k):
         grouped = grouped and owner[j - 1] <= owner[j]
-    for a in range(n):
+    if linf:
+        return _pair_normals(Wb, owner, work, linf, grouped, E, tiny, np.inf, arg), arg
+    best = np.inf
+    D = np.empty((n, 3))
+    for a in range(n):  # the triples (a, c, q), c < q after a: the pairs of their differences from a
         for c in range(a + 1, n):
-            if linf:  # normal of a pair of edges
-                best = _candidate(Wb, owner, work, linf, E[a, 0], E[a, 1], E[a, 2],
-                                  E[c, 0], E[c, 1], E[c, 2], tiny, best, arg, grouped)
-                continue
-            for q in range(c + 1, n):  # normal of a triple of points
-                best = _candidate(Wb, owner, work, linf,
-                                  E[c, 0] - E[a, 0], E[c, 1] - E[a, 1], E[c, 2] - E[a, 2],
-                                  E[q, 0] - E[a, 0], E[q, 1] - E[a, 1], E[q, 2] - E[a, 2],
-                                  tiny, best, arg, grouped)
+            D[c - a - 1, 0] = E[c, 0] - E[a, 0]
+            D[c - a - 1, 1] = E[c, 1] - E[a, 1]
+            D[c - a - 1, 2] = E[c, 2] - E[a, 2]
+        best = _pair_normals(Wb, owner, work, linf, grouped, D[:n - a - 1], tiny, best, arg)
     return best, arg
 
 
 @kernel
-def _candidate(Wb, owner, work, linf, x0, x1, x2, y0, y1, y2, tiny, best, arg, grouped):
-    """Evaluate the support function at both unit normals ``+-(x cross y)``, ``+`` first; return
-    the least value so far (``arg`` holds its direction). ``work`` is (2, contacts); ``grouped``:
-    ``owner`` is sorted (:func:`_support_both_below` may then stop early)."""
-    u0 = x1 * y2 - x2 * y1
-    u1 = x2 * y0 - x0 * y2
-    u2 = x0 * y1 - x1 * y0
-    nu = np.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
-    if nu <= tiny:
-        return best
-    u0, u1, u2 = u0 / nu, u1 / nu, u2 / nu
-    if grouped:
-        plus, minus = _support_both_below(Wb, owner, u0, u1, u2, linf, best)
-    else:
-        plus, minus = _support_both(Wb, owner, work[0], work[1], u0, u1, u2, linf)
-    if plus < best:
-        best = plus
-        arg[0], arg[1], arg[2] = u0, u1, u2
-    if minus < best:
-        best = minus
-        arg[0], arg[1], arg[2] = -u0, -u1, -u2
+def _pair_normals(Wb, owner, work, linf, grouped, D, tiny, best, arg):
+    """Evaluate the support function at both unit normals ``+-(x cross y)``, ``+`` first, of
+    each pair ``x = D[a]``, ``y = D[c]`` (``a < c``, in that order) whose cross product is longer
+    than ``tiny``; return the least value, below ``best``, or ``best`` (``arg`` then holds its
+    direction). ``work`` is (2, contacts); ``grouped``: ``owner`` is sorted
+    (:func:`_support_both_below` may then stop early). The loop is written out here, not called
+    per pair: a call per pair costs a third more time."""
+    n = D.shape[0]
+    for a in range(n):
+        x0, x1, x2 = D[a, 0], D[a, 1], D[a, 2]
+        for c in range(a + 1, n):
+            y0, y1, y2 = D[c, 0], D[c, 1], D[c, 2]
+            u0 = x1 * y2 - x2 * y1
+            u1 = x2 * y0 - x0 * y2
+            u2 = x0 * y1 - x1 * y0
+            nu = np.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+            if nu <= tiny:
+                continue
+            u0, u1, u2 = u0 / nu, u1 / nu, u2 / nu
+            if grouped:
+                plus, minus = _support_both_below(Wb, owner, u0, u1, u2, linf, best)
+            else:
+                plus, minus = _support_both(Wb, owner, work[0], work[1], u0, u1, u2, linf)
+            if plus < best:
+                best = plus
+                arg[0], arg[1], arg[2] = u0, u1, u2
+            if minus < best:
+                best = minus
+                arg[0], arg[1], arg[2] = -u0, -u1, -u2
     return best
 
 

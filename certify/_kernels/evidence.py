@@ -18,7 +18,7 @@ import numpy as np
 from .hull import face_planes, hull_faces_work, hull_work
 from .jit import kernel
 from .linalg import ETA, gamma
-from .order import stable_argsort
+from .order import stable_smallest
 from .planar import planar_generators
 from .surface import cycle_code, face_bounds
 
@@ -150,43 +150,52 @@ def support_choices(W, owner, m, dirs):
     sure = np.ones(n, dtype=np.bool_)
     vals = np.empty(k)
     errs = np.empty(k)
+    best = np.empty(m, dtype=np.int64)
     g = 2.0 * gamma(4)
     for q in range(n):
         v0, v1, v2 = dirs[q, 0], dirs[q, 1], dirs[q, 2]
+        _choose(W, owner, v0, v1, v2, vals, best, R[q])
         for j in range(k):
-            a, b, c = v0 * W[0, j], v1 * W[1, j], v2 * W[2, j]
-            vals[j] = a + b + c
-            errs[j] = g * (abs(a) + abs(b) + abs(c)) + 8 * ETA
+            errs[j] = g * (abs(v0 * W[0, j]) + abs(v1 * W[1, j]) + abs(v2 * W[2, j])) + 8 * ETA
         j0 = 0
-        while j0 < k:
-            i = owner[j0]
-            j1 = j0
-            best = j0
+        while j0 < k and sure[q]:
+            i, j1 = owner[j0], j0
             while j1 < k and owner[j1] == i:
-                if vals[j1] > vals[best]:
-                    best = j1
                 j1 += 1
-            top = vals[best] - errs[best]  # below every value the best can take
-            clear = True
-            nan = False
+            top = vals[best[i]] - errs[best[i]]  # below every value the best can take
+            clear = top > 0.0
             high = -np.inf  # above every value of the contact
             for j in range(j0, j1):
-                nan = nan or vals[j] != vals[j]
+                if vals[j] != vals[j]:  # as numpy's maximum: a NaN is the largest value, not positive
+                    clear, high = False, np.inf
+                    break
                 high = max(high, vals[j] + errs[j])
-                if j != best and not vals[j] + errs[j] < top:
+                if j != best[i] and not vals[j] + errs[j] < top:
                     clear = False
-            if nan:  # as numpy's maximum: a NaN is the largest value, which is not positive
-                R[q, i] = -1
-                sure[q] = False
-            elif high < 0.0:
-                R[q, i] = -1  # every value of the contact is negative
-            elif clear and top > 0.0:
-                R[q, i] = best
-            else:
-                R[q, i] = best if vals[best] > 0.0 else -1
-                sure[q] = False
+            sure[q] = clear or high < 0.0  # every value of the contact is negative: the origin
             j0 = j1
     return R, sure
+
+
+@kernel
+def _choose(W, owner, v0, v1, v2, vals, best, Rv):
+    """The choices of :func:`support_choices` along one direction ``v`` into ``Rv`` (m,; contacts
+    without generators are left as they are), the values ``v . g`` into ``vals`` (k,) and each
+    contact's first generator with the largest value into ``best`` (m,)."""
+    k = W.shape[1]
+    for j in range(k):
+        vals[j] = v0 * W[0, j] + v1 * W[1, j] + v2 * W[2, j]
+    j0 = 0
+    while j0 < k:
+        i, j1, b, nan = owner[j0], j0, j0, False
+        while j1 < k and owner[j1] == i:
+            nan = nan or vals[j1] != vals[j1]
+            if vals[j1] > vals[b]:
+                b = j1
+            j1 += 1
+        best[i] = b
+        Rv[i] = b if vals[b] > 0.0 and not nan else -1
+        j0 = j1
 
 
 @kernel
@@ -247,10 +256,9 @@ def support_refine(W, E, owner, m, u, cut, limit, add, dirs, picks, n, rounds):
             return n, REFINED, faces, V[:n], EV[:n]
         if done == rounds:
             return n, ROUNDS_SPENT, faces, V[:n], EV[:n]
-        order = stable_argsort(dist)
-        c = min(2 * add, order.shape[0])
-        cand = np.empty((c, 3))
-        for j in range(c):
+        order = stable_smallest(dist, 2 * add)  # no NaN: declined above
+        cand = np.empty((order.shape[0], 3))
+        for j in range(order.shape[0]):
             cand[j] = normal[order[j]]
         before = n
         n = _fresh(W, owner, m, cand, dirs, picks, n)
@@ -275,9 +283,11 @@ def support_refine_rows(W, E, owner, m, U, cuts, limit, add, cap, rounds):
     vstart = np.zeros(B + 1, dtype=np.int64)
     fstart = np.zeros(B + 1, dtype=np.int64)
     dirs, picks = np.empty((cap, 3)), np.empty((cap, m), dtype=np.int64)
-    D, R = np.empty((16 * B + cap, 3)), np.empty((16 * B + cap, m), dtype=np.int64)
-    V, EV = np.empty((16 * B + cap, 3)), np.empty((16 * B + cap, 3))
-    F = np.empty((32 * B + 2 * cap, 3), dtype=np.int64)
+    # room for 32 directions a row (10 contacts use about 21), doubled when a row would not fit;
+    # pages no row writes are never touched, and the results are views, not copies
+    D, R = np.empty((32 * B + cap, 3)), np.empty((32 * B + cap, m), dtype=np.int64)
+    V, EV = np.empty((32 * B + cap, 3)), np.empty((32 * B + cap, 3))
+    F = np.empty((64 * B + 2 * cap, 3), dtype=np.int64)
     for b in range(B):
         n, st, faces, v, ev = support_refine(W[b], E[b], owner, m, U[b], cuts[b], limit, add, dirs, picks, 0, rounds)
         state[b] = st
@@ -295,7 +305,7 @@ def support_refine_rows(W, E, owner, m, U, cuts, limit, add, cap, rounds):
         vstart[b + 1] = a + n
         fstart[b + 1] = f + faces.shape[0]
     nv, nf = vstart[B], fstart[B]
-    return state, D[:nv].copy(), R[:nv].copy(), V[:nv].copy(), EV[:nv].copy(), vstart, F[:nf].copy(), fstart
+    return state, D[:nv], R[:nv], V[:nv], EV[:nv], vstart, F[:nf], fstart
 
 
 @kernel
@@ -310,8 +320,10 @@ def _grown(a, used, size):
 def _fresh(W, owner, m, cand, dirs, picks, n):
     """Append to ``dirs`` and ``picks`` (``n`` kept) each row of ``cand`` whose choice is not
     among those kept, in order; the new ``n``."""
-    R = support_choices(W, owner, m, cand)[0]
+    R = np.full((cand.shape[0], m), -1, dtype=np.int64)
+    vals, best = np.empty(W.shape[1]), np.empty(m, dtype=np.int64)
     for j in range(cand.shape[0]):
+        _choose(W, owner, cand[j, 0], cand[j, 1], cand[j, 2], vals, best, R[j])
         new = True
         for q in range(n):
             same = True

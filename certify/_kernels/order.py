@@ -4,7 +4,7 @@ numba compiles its own ``np.argsort`` (an introsort) anew for every array type, 
 each on a first run; this bottom-up merge sort compiles in a fraction of that and is stable (ties
 keep their index order), so the kernels' results do not depend on the sorting algorithm's way with
 ties. :func:`radix_argsort` gives the same order for large arrays of non-negative integer keys
-in linear time.
+in linear time, and :func:`stable_smallest` its first few indices without sorting the rest.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import numpy as np
 
 from .jit import kernel
 
-__all__ = ["stable_argsort", "radix_argsort"]
+__all__ = ["stable_argsort", "stable_smallest", "radix_argsort"]
 
 
 @kernel
@@ -47,6 +47,28 @@ def stable_argsort(keys):
         order, work = work, order
         width *= 2
     return order
+
+
+@kernel
+def stable_smallest(keys, c):
+    """The first ``min(c, n)`` indices of :func:`stable_argsort` of the 1-D array ``keys`` (n,)
+    without NaN, in ``O(n c)``: each key is inserted after the kept ones it does not precede, so
+    ties keep their index order."""
+    out = np.empty(max(0, min(c, keys.shape[0])), dtype=np.int64)
+    kept = 0
+    for f in range(keys.shape[0] if out.shape[0] else 0):
+        x = keys[f]
+        if kept == out.shape[0]:
+            if not x < keys[out[kept - 1]]:
+                continue
+            kept -= 1  # the last kept key makes room
+        j = kept
+        while j > 0 and x < keys[out[j - 1]]:
+            out[j] = out[j - 1]
+            j -= 1
+        out[j] = f
+        kept += 1
+    return out
 
 
 #: Bits of the key sorted per pass of :func:`radix_argsort`.
