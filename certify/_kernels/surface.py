@@ -117,7 +117,7 @@ def face_bounds_laplace(V, EV, faces, perms, psign):
     return ok, lo, hi
 
 
-@kernel
+@kernel(inline=True)
 def _edges(V, EV, faces, f, D, ED):
     """Into ``D`` and ``ED``: the edges ``v_q - v_1`` of face ``f`` and bounds on their distance to
     the exact ones (the vertices' own and the subtraction's rounding); returns ``v_1``'s index."""
@@ -162,7 +162,7 @@ def _pair_table(perms, psign):
             and perms[1, 0] == 1 and perms[1, 1] == 0 and psign[0] == 1.0 and psign[1] == -1.0)
 
 
-@kernel
+@kernel(inline=True)
 def _normal3(D, ED, g, n, en):
     """:func:`_leibniz_normal` of a face in 3-D with the table of :func:`leibniz_tables` of 2,
     written out: the same operations in the same order (each sum from ``0.0``, each product from
@@ -182,7 +182,7 @@ def _normal3(D, ED, g, n, en):
         en[r] = (pe - pa) + g * pe
 
 
-@kernel
+@kernel(inline=True)
 def _distance_bounds(V, EV, i0, n, en):
     """From the normal ``n`` (within ``en``) of a face through ``v_1 = V[i0]``: whether
     ``det = n . v_1`` is proved positive, and bounds of ``det^2 / |n|^2``."""
