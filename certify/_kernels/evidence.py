@@ -77,7 +77,7 @@ def minkowski_sums(W, E, owner, m):
     return pts, err, choice
 
 
-@kernel
+@kernel(inline=True)
 def _pick_sum(W, E, picks, v, ev):
     """Into ``v`` and ``ev`` (3,): the sum of the columns of ``W`` (3, k) that ``picks`` (m,;
     -1 picks none) names, added in order from zero, and the bound on its error: the sum of
