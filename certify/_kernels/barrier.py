@@ -12,7 +12,7 @@ from .linalg import cholesky_solve
 __all__ = ["socp_dual_barrier", "barrier_batch"]
 
 
-@kernel
+@kernel(inline=True)
 def _barrier_terms(y, Pm, T, rk, kappa, K, q, u, psi, Ty):
     """Affine parts ``u_b = z(y) - p_b . y``, ``T_b y`` and ``psi_b`` (``u^2 - kappa^2 |T y|^2``
     for cones, ``u`` for rays) at ``y``; False when ``y`` is not strictly feasible."""
@@ -233,7 +233,7 @@ def _equilibrate(Pm, T, rk, kappa, xn, xt):
     return t
 
 
-@kernel
+@kernel(inline=True)
 def _phi(y, tau, q, K, u, psi, rk):
     z = 1.0
     for i in range(y.shape[0]):
