@@ -113,3 +113,15 @@ def test_planar_epsilon_enumeration_is_its_definition_bit_for_bit(sizes, data, l
     want, want_arg = _epsilon_by_definition(W, owner, len(sizes), linf)
     assert float(eps).hex() == want.hex()
     assert [x.hex() for x in arg.tolist()] == [float(x).hex() for x in want_arg]
+
+
+def test_per_item_kernels_are_compiled_into_their_callers():
+    # kernel(inline=True): numba compiles these into each caller's loop (the face checks of
+    # face_bounds, the sums of the evidence, the barrier's Newton steps); the callers stay calls
+    from qualgrasp.certify._kernels import barrier, evidence, surface
+
+    inline = [surface._edges, surface._normal3, surface._distance_bounds, evidence._pick_sum,
+              barrier._barrier_terms, barrier._phi]
+    assert all(k.targetoptions.get("inline") == "always" for k in inline)
+    assert all(k.targetoptions.get("inline", "never") == "never"
+               for k in (surface.face_bounds, evidence.minkowski_sums, barrier.socp_dual_barrier))
