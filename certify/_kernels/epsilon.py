@@ -101,20 +101,15 @@ def _pair_normals(Wb, owner, work, linf, grouped, D, tiny, best, arg):
     each pair ``x = D[a]``, ``y = D[c]`` (``a < c``, in that order) whose cross product is longer
     than ``tiny``; return the least value, below ``best``, or ``best`` (``arg`` then holds its
     direction). ``work`` is (2, contacts); ``grouped``: ``owner`` is sorted
-    (:func:`_support_both_below` may then stop early). The loop is written out here, not called
-    per pair: a call per pair costs a third more time."""
+    (:func:`_support_both_below` may then stop early). One loop over all pairs, with the normal
+    compiled into it (:func:`_unit_cross`): a call per pair costs a third more time."""
     n = D.shape[0]
     for a in range(n):
         x0, x1, x2 = D[a, 0], D[a, 1], D[a, 2]
         for c in range(a + 1, n):
-            y0, y1, y2 = D[c, 0], D[c, 1], D[c, 2]
-            u0 = x1 * y2 - x2 * y1
-            u1 = x2 * y0 - x0 * y2
-            u2 = x0 * y1 - x1 * y0
-            nu = np.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
-            if nu <= tiny:
+            ok, u0, u1, u2 = _unit_cross(x0, x1, x2, D[c, 0], D[c, 1], D[c, 2], tiny)
+            if not ok:
                 continue
-            u0, u1, u2 = u0 / nu, u1 / nu, u2 / nu
             if grouped:
                 plus, minus = _support_both_below(Wb, owner, u0, u1, u2, linf, best)
             else:
@@ -126,6 +121,19 @@ def _pair_normals(Wb, owner, work, linf, grouped, D, tiny, best, arg):
                 best = minus
                 arg[0], arg[1], arg[2] = -u0, -u1, -u2
     return best
+
+
+@kernel(inline=True)
+def _unit_cross(x0, x1, x2, y0, y1, y2, tiny):
+    """``(True, x cross y / |x cross y|)``, or ``(False, 0, 0, 0)`` when ``|x cross y| <= tiny``:
+    a candidate facet normal of two edges."""
+    u0 = x1 * y2 - x2 * y1
+    u1 = x2 * y0 - x0 * y2
+    u2 = x0 * y1 - x1 * y0
+    nu = np.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+    if nu <= tiny:
+        return False, 0.0, 0.0, 0.0
+    return True, u0 / nu, u1 / nu, u2 / nu
 
 
 @kernel
@@ -386,14 +394,9 @@ def linf_sweep(Wb, owner, m, E, first, last, top_val, top_u):
             val = SA * c + SB * s_
             if not val < top_val[top_val.shape[0] - 1]:
                 continue
-            y0, y1, y2 = ev_e[q, 0], ev_e[q, 1], ev_e[q, 2]
-            u0 = e1 * y2 - e2 * y1
-            u1 = e2 * y0 - e0 * y2
-            u2 = e0 * y1 - e1 * y0
-            nu = np.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
-            if nu <= tiny:
+            ok, u0, u1, u2 = _unit_cross(e0, e1, e2, ev_e[q, 0], ev_e[q, 1], ev_e[q, 2], tiny)
+            if not ok:
                 continue
-            u0, u1, u2 = u0 / nu, u1 / nu, u2 / nu
             w0, w1, w2 = c * a0 + s_ * b0, c * a1 + s_ * b1, c * a2 + s_ * b2
             if u0 * w0 + u1 * w1 + u2 * w2 < 0.0:
                 u0, u1, u2 = -u0, -u1, -u2
