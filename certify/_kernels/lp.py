@@ -133,8 +133,10 @@ def lp_enumerate(W, combos, feas):
 @kernel
 def lp_planar_one(Wb, combos, feas, dual_below, C, D, buf, lam, y):
     """:func:`lp_planar` for one generator matrix ``Wb`` (3, k); fills ``lam`` and ``y`` and
-    returns ``(t, has_y)``. ``C``, ``D``, ``buf`` are work arrays (k, k, 3), (k, k) and
-    (k + 2 nS,). The dual bases are scanned only when ``t < dual_below``."""
+    returns ``(t, has_y)``. ``combos`` must be every 3-subset of ``range(k)`` in the order of
+    :func:`itertools.combinations` (:func:`qualgrasp.certify.solvers.enumeration.bases`: the
+    primal scan runs over them as nested loops). ``C``, ``D``, ``buf`` are work arrays
+    (k, k, 3), (k, k) and (k + 2 nS,). The dual bases are scanned only when ``t < dual_below``."""
     k = Wb.shape[1]
     nS = combos.shape[0]
     w10, w11, w12, wmax = 0.0, 0.0, 0.0, 0.0
@@ -160,27 +162,33 @@ def lp_planar_one(Wb, combos, feas, dual_below, C, D, buf, lam, y):
     best_t = -np.inf
     for j in range(k):
         lam[j] = np.nan
-    for si in range(nS):
-        i, j, l = combos[si, 0], combos[si, 1], combos[si, 2]
-        # basis (i, j, l): Cramer's rule, singular relative to the Hadamard bound of its 4x4 matrix
-        det = Wb[0, i] * C[j, l, 0] + Wb[1, i] * C[j, l, 1] + Wb[2, i] * C[j, l, 2]
-        den = k * det - (D[j, l] - D[i, l] + D[i, j])
-        if abs(den) <= 1e-13 * np.sqrt(norms[i] * norms[j] * norms[l] * n0):
-            dens[si] = 0.0
-            continue
-        t = det / den
-        dens[si], ts[si] = den, t
-        s0 = -D[j, l] / den
-        s1 = D[i, l] / den
-        s2 = -D[i, j] / den
-        lim = -feas * (1.0 + abs(t))
-        if s0 >= lim and s1 >= lim and s2 >= lim and t > best_t:
-            best_t = t
-            for c in range(k):
-                lam[c] = t
-            lam[i] += s0
-            lam[j] += s1
-            lam[l] += s2
+    si = 0  # the bases (i, j, l) in the order of combos, nested: what stays fixed is read once
+    for i in range(k):
+        wi0, wi1, wi2 = Wb[0, i], Wb[1, i], Wb[2, i]
+        for j in range(i + 1, k):
+            dij, nij = D[i, j], norms[i] * norms[j]
+            for l in range(j + 1, k):
+                # Cramer's rule, singular relative to the Hadamard bound of its 4x4 matrix
+                det = wi0 * C[j, l, 0] + wi1 * C[j, l, 1] + wi2 * C[j, l, 2]
+                den = k * det - (D[j, l] - D[i, l] + dij)
+                if abs(den) <= 1e-13 * np.sqrt(nij * norms[l] * n0):
+                    dens[si] = 0.0
+                    si += 1
+                    continue
+                t = det / den
+                dens[si], ts[si] = den, t
+                si += 1
+                s0 = -D[j, l] / den
+                s1 = D[i, l] / den
+                s2 = -dij / den
+                lim = -feas * (1.0 + abs(t))
+                if s0 >= lim and s1 >= lim and s2 >= lim and t > best_t:
+                    best_t = t
+                    for c in range(k):
+                        lam[c] = t
+                    lam[i] += s0
+                    lam[j] += s1
+                    lam[l] += s2
     has_y = False
     y[0], y[1], y[2] = 0.0, 0.0, 0.0
     if best_t >= dual_below:
