@@ -1,12 +1,14 @@
 """Compiled helpers against their numpy meaning: the stable argsorts the kernels share (merge and
-radix), the
+radix) and the start of one, the
 projection of a Farkas direction off its tight blocks, which must leave it orthogonal to every
 tight column however dependent those columns are, and the planar epsilon enumeration against its
-definition in plain Python floats."""
+definition in plain Python floats; the planar LP's refusal of bases it cannot scan, and which
+kernels are compiled into their callers."""
 
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings, strategies as st
 from hypothesis.extra.numpy import arrays
 
@@ -118,10 +120,23 @@ def test_planar_epsilon_enumeration_is_its_definition_bit_for_bit(sizes, data, l
 def test_per_item_kernels_are_compiled_into_their_callers():
     # kernel(inline=True): numba compiles these into each caller's loop (the face checks of
     # face_bounds, the sums of the evidence, the barrier's Newton steps); the callers stay calls
-    from qualgrasp.certify._kernels import barrier, evidence, surface
+    from qualgrasp.certify._kernels import barrier, epsilon, evidence, surface
 
     inline = [surface._edges, surface._normal3, surface._distance_bounds, evidence._pick_sum,
-              barrier._barrier_terms, barrier._phi]
+              barrier._barrier_terms, barrier._phi, epsilon._unit_cross]
     assert all(k.targetoptions.get("inline") == "always" for k in inline)
     assert all(k.targetoptions.get("inline", "never") == "never"
-               for k in (surface.face_bounds, evidence.minkowski_sums, barrier.socp_dual_barrier))
+               for k in (surface.face_bounds, evidence.minkowski_sums, barrier.socp_dual_barrier,
+                         epsilon.planar_epsilon_one))
+
+
+def test_the_planar_lp_refuses_bases_that_are_not_every_3_subset():
+    # its primal scan runs over the 3-subsets as nested loops and writes one entry per subset
+    from qualgrasp.certify._kernels.lp import lp_planar
+    from qualgrasp.certify.solvers.enumeration import bases
+
+    W = np.random.default_rng(0).normal(size=(2, 3, 5))
+    t = lp_planar(W, bases(5, 3), 1e-9)[0]
+    assert t.shape == (2,)
+    with pytest.raises(ValueError, match="bases"):
+        lp_planar(W, bases(5, 3)[:-1], 1e-9)

@@ -99,8 +99,8 @@ def planar_epsilon_one(Wb, owner, m, linf):
 def _pair_normals(Wb, owner, work, linf, grouped, D, tiny, best, arg):
     """Evaluate the support function at both unit normals ``+-(x cross y)``, ``+`` first, of
     each pair ``x = D[a]``, ``y = D[c]`` (``a < c``, in that order) whose cross product is longer
-    than ``tiny``; return the least value, below ``best``, or ``best`` (``arg`` then holds its
-    direction). ``work`` is (2, contacts); ``grouped``: ``owner`` is sorted
+    than ``tiny``; return the least of ``best`` and their values (``arg`` is set to the
+    direction of each value below the least so far). ``work`` is (2, contacts); ``grouped``: ``owner`` is sorted
     (:func:`_support_both_below` may then stop early). One loop over all pairs, with the normal
     compiled into it (:func:`_unit_cross`): a call per pair costs a third more time."""
     n = D.shape[0]

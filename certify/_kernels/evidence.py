@@ -166,7 +166,7 @@ def support_choices(W, owner, m, dirs):
             clear = top > 0.0
             high = -np.inf  # above every value of the contact
             for j in range(j0, j1):
-                if vals[j] != vals[j]:  # as numpy's maximum: a NaN is the largest value, not positive
+                if vals[j] != vals[j]:  # a contact with a NaN value (its choice the origin) is never sure
                     clear, high = False, np.inf
                     break
                 high = max(high, vals[j] + errs[j])
@@ -180,8 +180,10 @@ def support_choices(W, owner, m, dirs):
 @kernel
 def _choose(W, owner, v0, v1, v2, vals, best, Rv):
     """The choices of :func:`support_choices` along one direction ``v`` into ``Rv`` (m,; contacts
-    without generators are left as they are), the values ``v . g`` into ``vals`` (k,) and each
-    contact's first generator with the largest value into ``best`` (m,)."""
+    without generators are left as they are; -1 for a contact with a NaN value: as numpy's
+    maximum, a NaN is the largest value, which is not positive), the values ``v . g`` into
+    ``vals`` (k,) and each contact's first generator with the largest value into ``best`` (m,).
+    ``owner`` must be sorted (each contact's generators together)."""
     k = W.shape[1]
     for j in range(k):
         vals[j] = v0 * W[0, j] + v1 * W[1, j] + v2 * W[2, j]
@@ -283,8 +285,8 @@ def support_refine_rows(W, E, owner, m, U, cuts, limit, add, cap, rounds):
     vstart = np.zeros(B + 1, dtype=np.int64)
     fstart = np.zeros(B + 1, dtype=np.int64)
     dirs, picks = np.empty((cap, 3)), np.empty((cap, m), dtype=np.int64)
-    # room for 32 directions a row (10 contacts use about 21), doubled when a row would not fit;
-    # pages no row writes are never touched, and the results are views, not copies
+    # room for 32 directions a row (10 contacts use about 21), grown to twice the rows used when a
+    # row would not fit; the results are views, not copies
     D, R = np.empty((32 * B + cap, 3)), np.empty((32 * B + cap, m), dtype=np.int64)
     V, EV = np.empty((32 * B + cap, 3)), np.empty((32 * B + cap, 3))
     F = np.empty((64 * B + 2 * cap, 3), dtype=np.int64)

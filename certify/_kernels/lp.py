@@ -139,6 +139,8 @@ def lp_planar_one(Wb, combos, feas, dual_below, C, D, buf, lam, y):
     (k, k, 3), (k, k) and (k + 2 nS,). The dual bases are scanned only when ``t < dual_below``."""
     k = Wb.shape[1]
     nS = combos.shape[0]
+    if nS != k * (k - 1) * (k - 2) // 6:  # the scan below writes one entry of buf per 3-subset
+        raise ValueError("combos must be bases(k, 3): every 3-subset of the generators")
     w10, w11, w12, wmax = 0.0, 0.0, 0.0, 0.0
     norms = buf[:k]
     dens = buf[k:k + nS]
@@ -249,7 +251,8 @@ def lp_planar(W, combos, feas, dual_below=np.inf):
     ``s = -(D_jl, -D_il, D_ij) / (k det - g)``, and the dual ``y = (c_jl + c_li + c_ij) /
     (k det - g)`` with ``c_ab = w_a x w_b`` and ``z = t``. Cross products are computed once per
     pair, so a basis costs a few dozen flops. The dual bases (needed only for a verdict against
-    closure) are scanned only where ``t* < dual_below``.
+    closure) are scanned only where ``t* < dual_below``. ``combos`` must be
+    :func:`qualgrasp.certify.solvers.enumeration.bases` of ``(k, 3)`` (see :func:`lp_planar_one`).
     """
     B, d, k = W.shape
     t_out = np.full(B, -np.inf)
