@@ -156,4 +156,3 @@ def test_the_bench_times_every_set_warm(monkeypatch):
     monkeypatch.setattr(bench, "certify_table", recorded)
     assert bench._batch_seconds(grasps, False, table) > 0
     assert calls == [(40, 40), (40, 40)]
-

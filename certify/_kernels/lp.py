@@ -170,16 +170,15 @@ def lp_planar_one(Wb, combos, feas, dual_below, C, D, buf, lam, y):
         for j in range(i + 1, k):
             dij, nij = D[i, j], norms[i] * norms[j]
             for l in range(j + 1, k):
+                s, si = si, si + 1
                 # Cramer's rule, singular relative to the Hadamard bound of its 4x4 matrix
                 det = wi0 * C[j, l, 0] + wi1 * C[j, l, 1] + wi2 * C[j, l, 2]
                 den = k * det - (D[j, l] - D[i, l] + dij)
                 if abs(den) <= 1e-13 * np.sqrt(nij * norms[l] * n0):
-                    dens[si] = 0.0
-                    si += 1
+                    dens[s] = 0.0
                     continue
                 t = det / den
-                dens[si], ts[si] = den, t
-                si += 1
+                dens[s], ts[s] = den, t
                 s0 = -D[j, l] / den
                 s1 = D[i, l] / den
                 s2 = -dij / den
