@@ -20,7 +20,9 @@ The **degenerate planar** rows time the batch path, without and with
 quality, on a degenerate planar set (``qualgrasp sample --degenerate mixed``: normals through one
 point, repeated or collinear contacts) and on a generic set of the same size, model and contact
 count, in the same run; their ratio is the degenerate set's time per grasp as a multiple of the
-generic set's. Speeds are single-process; ``qualgrasp certify --workers N`` runs N
+generic set's. The batch path, and the per-grasp routes of the quality and degenerate rows, are
+timed on a second pass over their grasps: the first loads every kernel and solver they reach, as a
+worker's first chunk does. Speeds are single-process; ``qualgrasp certify --workers N`` runs N
 such processes, and ``qualgrasp bench`` times this table in a process whose memory allocator
 is set as theirs (:func:`qualgrasp.certify.batch.engine.tune_allocator`).
 
@@ -109,6 +111,14 @@ def _time(fn, items, progress=None) -> float:
     return time.perf_counter() - start
 
 
+def _warm_seconds(fn, items) -> float:
+    """Seconds of ``fn`` over ``items``, timed on a second pass, as :func:`_batch_seconds` times
+    the batch path: the first, untimed, loads every kernel and solver the items reach (on a
+    degenerate set, routes that its first grasp does not)."""
+    _time(fn, items)
+    return _time(fn, items)
+
+
 def _batch_seconds(grasps, quality: bool = False, table=None) -> float:
     """Seconds of the columnar batch path on ``grasps`` (their ``table``, built outside the
     timing when not given), timed on a second pass: the first, untimed, loads or compiles every
@@ -140,8 +150,7 @@ def _quality_rows(n: int, seed: int, reference_n: int) -> list[BenchRow]:
         base = _batch_seconds(grasps, True, table)
         plain = _batch_seconds(grasps, False, table)
         few = grasps[:max(reference_n, 1)]
-        certify_grasp(few[0], quality=True)  # load its kernels outside the timing
-        per = _time(lambda g: certify_grasp(g, quality=True), few)
+        per = _warm_seconds(lambda g: certify_grasp(g, quality=True), few)
         label = f"{kind}, with quality"
         rows += [BenchRow(label, "qualgrasp batch, closure and both epsilons with evidence", n, base, 1.0),
                  BenchRow(label, "qualgrasp batch, closure only", n, plain, plain / base),
@@ -168,7 +177,7 @@ def _degenerate_rows(n: int, seed: int, reference_n: int) -> list[BenchRow]:
                  BenchRow(label, f"qualgrasp batch, degenerate set, {what}", n, deg, deg / base)]
         if not quality:
             fast, few = make_solver("fast"), grasps["degenerate"][:max(reference_n, 1)]
-            seconds = _time(lambda g: certify_grasp(g, solver=fast, quality=False), few)
+            seconds = _warm_seconds(lambda g: certify_grasp(g, solver=fast, quality=False), few)
             rows.append(BenchRow(label, "per-grasp fast route (both certificates), degenerate set", len(few),
                                  seconds, (seconds / len(few)) / (base / n)))
     return rows
