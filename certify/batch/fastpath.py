@@ -57,7 +57,7 @@ from ..files.columns import GraspColumns, grasp_columns
 from ..core.cones import LORENTZ
 from ..core.grasp import Contact, Grasp
 from ..core.problem import (Block, ClosureProblem, System, conic_block_arrays, conic_columns, grasp_problem,
-                            grasp_system, ray_block_arrays, ray_problem)
+                            grasp_system, ray_block_arrays, ray_blocks, ray_problem)
 from ..quality.bounds import planar_epsilon_columns
 from ..solvers import BARRIER_NEAR_ZERO, FastSolver, make_solver
 from ..solvers.barrier import EXIT_BELOW, GAP_TOL, MAX_NEWTON
@@ -183,9 +183,10 @@ def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances
     """Certify the planar grasps ``rows`` (one contact pattern) with :func:`planar_batch`;
     return the settled rows and their result columns."""
     models, variants = cols.models_of(rows[0]), cols.variants_of(rows[0])
-    force_layout = generator_layout(models, variants, 2)
+    layouts = {fl: generator_layout(models, variants, 2, frictionless=fl) for fl in (False, True)}
+    force_layout = layouts[False]
     enumerated = FastSolver.enumerates(len(force_layout[0]), 3)
-    if not FastSolver.enumerates(len(generator_layout(models, variants, 2, frictionless=True)[0]), 3):
+    if not FastSolver.enumerates(len(layouts[True][0]), 3):
         # the per-grasp fast route solves both by the barrier method: both routes give its rows
         return np.zeros(len(rows), dtype=bool), {}
     P, N, params = cols.contacts(rows)
@@ -204,7 +205,7 @@ def _planar_group(cols: GraspColumns, rows: np.ndarray, options, tol: Tolerances
         verified["force"] = np.ones(len(rows), dtype=bool)
         sides = (("form", True),)
     for side, frictionless in sides:
-        layout = generator_layout(models, variants, 2, frictionless=frictionless)
+        layout = layouts[frictionless]
         if side == "form" and all(np.array_equal(a, b) for a, b in zip(layout, force_layout)):
             out["form"], out["form_tight"] = out["force"], out["tight"]  # frictionless: form is force
             break
@@ -253,11 +254,10 @@ def _barrier_rays(W, E, normals, thin_rel: float, tol: Tolerances, *, closure: b
     values = xn + 0.0  # the identity value map's values (ClosureProblem.values): -0 stated as +0
     with np.errstate(invalid="ignore", divide="ignore"):
         yn = np.nan_to_num(y / np.sqrt(np.sum(y * y, axis=1, keepdims=True)))
-    cone, first, width = ray_block_arrays(k)
+    arrays = ray_blocks(k, normals.shape[2])
     zeros = np.zeros((B, k))
-    code, basis = certify_rows(W, E, cone, first, width, np.ascontiguousarray(normals), zeros, zeros, values, yn,
+    code, basis = certify_rows(W, E, *arrays[:3], np.ascontiguousarray(normals), zeros, zeros, values, yn,
                                interior, farkas, np.abs(W).max(axis=(1, 2)), tol.residual)
-    arrays = (cone, first, width, np.zeros((k, normals.shape[2])), np.zeros(k), np.zeros(k))
     for i in np.flatnonzero(code == 1) if margins else ():  # the margin stated must be the one verify certifies
         if not margin_proved(float(t[i]), W[i], E[i], arrays, values[i], basis[i]):
             code[i] = 0
@@ -325,8 +325,7 @@ def _planar_thin(P, N, mu, width, c, L, layout, verdict, tol: Tolerances):
     # every generator tight, exact rank 3: nothing is left once projected, the rank decides
     refused = has_y & ok & tight.all(axis=1) & full
     code[at[refused]] = 5
-    cone, first, ones = ray_block_arrays(k)
-    arrays = (cone, first, ones, np.zeros((k, 2)), np.zeros(k), np.zeros(k))
+    arrays = ray_blocks(k, 2)
     solver = make_solver("fast")
     # rank at most 2 (parallel normals, two distinct contacts): the all-tight direction, or the last singular vector
     # when the dual direction gives no certificate, decided in one compiled pass

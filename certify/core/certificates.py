@@ -45,7 +45,7 @@ from .._kernels.recheck import correction_bound, residual_bound, verify_farkas_g
 from ..errors import CertificateError
 from .arguments import number_in, require
 from .grasp import Grasp
-from .problem import Block, array_blocks, block_arrays, grasp_system, ray_block_arrays, span_system, span_vectors
+from .problem import Block, array_blocks, block_arrays, grasp_system, ray_blocks, span_system, span_vectors
 from .wrench import planar_generator_arrays, to_exact
 
 __all__ = [
@@ -271,23 +271,22 @@ def _proved_in_floats(grasp: Grasp, cert: Certificate, status, margin, frictionl
         return False
     W, E, _ = planar_generator_arrays(grasp, frictionless=frictionless)
     k = W.shape[1]
-    cone, first, width = ray_block_arrays(k)
-    n, zero = np.zeros((k, 2)), np.zeros(k)
+    arrays = ray_blocks(k, 2)
     if cert.kind == "farkas":
         if not (_numbers(cert.y, 3, _REALS) and isinstance(cert.tight, (tuple, list)) and not cert.tight
                 and isinstance(cert.null_space, (bool, np.bool_)) and not cert.null_space):
             return False
         y = np.array(cert.y, dtype=float)
-        return bool(np.isfinite(y).all()) and verify_farkas_general(W, E, cone, first, width, n, zero, zero, y,
-                                                                    np.zeros(k, dtype=bool), 0.0)
+        return bool(np.isfinite(y).all()) and verify_farkas_general(W, E, *arrays, y, np.zeros(k, dtype=bool),
+                                                                    0.0)
     if not (_numbers(cert.values, k, _REALS) and _numbers(cert.basis, 3, _INTEGERS)):
         return False
     x, basis = np.array(cert.values, dtype=float), np.array(cert.basis, dtype=np.int64)
     if not np.isfinite(x).all() or len(set(basis.tolist())) != 3 or not ((basis >= 0) & (basis < k)).all():
         return False
-    if not verify_interior_general(W, E, cone, first, width, n, zero, zero, x, basis, tol.residual):
+    if not verify_interior_general(W, E, *arrays, x, basis, tol.residual):
         return False
-    return margin is None or margin_proved(margin, W, E, (cone, first, width, n, zero, zero), x, basis)
+    return margin is None or margin_proved(margin, W, E, arrays, x, basis)
 
 
 _REALS = (int, float, np.integer, np.floating)

@@ -35,9 +35,9 @@ from .cones import CONES, RAY, cone_code
 from .wrench import (contact_frame, force_columns, generator_columns, grasp_arrays, tangent,
                      to_exact, variants_of, wrench)
 
-__all__ = ["Block", "block_arrays", "array_blocks", "ray_block_arrays", "conic_block_arrays", "System", "ClosureProblem",
-           "grasp_problem", "span_problem", "grasp_system", "span_system", "span_vectors", "is_polyhedral",
-           "DENSE_COLUMNS", "LorentzLayout", "lorentz_layout", "ray_problem"]
+__all__ = ["Block", "block_arrays", "array_blocks", "ray_block_arrays", "ray_blocks", "conic_block_arrays", "System",
+           "ClosureProblem", "grasp_problem", "span_problem", "grasp_system", "span_system", "span_vectors",
+           "is_polyhedral", "DENSE_COLUMNS", "LorentzLayout", "lorentz_layout", "ray_problem"]
 
 
 @dataclass(frozen=True)
@@ -84,6 +84,20 @@ def array_blocks(cone, first, width, n, mu, g) -> list[Block]:
 def ray_block_arrays(k: int):
     """``(cone, first, width)`` block arrays of ``k`` rays, one per column (generator columns)."""
     return np.zeros(k, dtype=np.int64), np.arange(k, dtype=np.int64), np.ones(k, dtype=np.int64)
+
+
+def ray_blocks(k: int, dim: int):
+    """All six block arrays ``(cone, first, width, n, mu, g)`` (:func:`block_arrays`' form) of
+    ``k`` rays in ``dim`` dimensions: :func:`ray_block_arrays`, and the zero normals, friction and
+    moment lengths that count for nothing on a ray.
+
+    Examples
+    --------
+    >>> cone, first, width, n, mu, g = ray_blocks(3, 2)
+    >>> first.tolist(), width.tolist(), n.shape, float(mu.sum() + g.sum())
+    ([0, 1, 2], [1, 1, 1], (3, 2), 0.0)
+    """
+    return (*ray_block_arrays(k), np.zeros((k, dim)), np.zeros(k), np.zeros(k))
 
 
 def conic_block_arrays(models: Sequence[str], N: np.ndarray, mu: np.ndarray, params, dim: int):
