@@ -14,7 +14,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from ..certify.batch.engine import tune_allocator
-from ..certify.cli.options import OptionError, count_in, fail, output_folder
+from ..certify.cli.options import MAX_WORKERS, OptionError, count_in, fail, output_folder
 from ..certify.errors import CertifyError
 from . import figures
 from .bench_jobs import print_jobs_bench, run_jobs_bench
@@ -136,7 +136,7 @@ def compare_command(
     try:
         count_in(silhouettes, "--silhouettes", 0, available - 1, what="(the bundled cell outlines)")
         count_in(wings, "--wings", 0, available_wings(), what="(the bundled wing outlines)")
-        count_in(workers, "--workers", 1, 256, what="processes")
+        count_in(workers, "--workers", 1, MAX_WORKERS, what="processes")
         if trials is not None:
             count_in(trials, "--trials", 1, 1000)
     except OptionError as err:

@@ -13,12 +13,36 @@ from ..core.grasp import Contact, Grasp
 from ..files.outputs import atomic_output
 from ..files.reader import contact_type, grasp_schema, is_parquet
 
-__all__ = ["RANGES", "DEGENERATE", "random_grasp", "random_grasps", "textbook_grasps", "random_grasp_table",
+__all__ = ["RANGES", "parameter_ranges", "DEGENERATE", "random_grasp", "random_grasps", "textbook_grasps", "random_grasp_table",
            "degenerate_geometry", "write_random_grasp_file"]
 
 
-#: Ranges of the uniform draws of each model parameter.
-RANGES = {"mu": (0.2, 1.0), "torsion": (0.05, 0.5), "width": (0.05, 0.6)}
+#: Ranges of the uniform draws of each model parameter (a patch's radius 1.5 times the torsion's,
+#: so that its torsional length ``2 radius / 3`` spans the soft finger's).
+RANGES = {"mu": (0.2, 1.0), "torsion": (0.05, 0.5), "width": (0.05, 0.6), "radius": (0.075, 0.75)}
+
+
+def parameter_ranges(model: str, **given: tuple[float, float]) -> dict[str, tuple[float, float]]:
+    """The ranges the parameters of ``model`` are drawn from: ``given`` (by parameter name), else
+    :data:`RANGES`.
+
+    Raises
+    ------
+    ValueError
+        Naming a parameter without a range (of a model registered outside the package).
+
+    Examples
+    --------
+    >>> parameter_ranges("patch", mu=(0.5, 0.5))
+    {'mu': (0.5, 0.5), 'radius': (0.075, 0.75)}
+    """
+    ranges = {**RANGES, **given}
+    names = [par.name for par in registry.get(model).params]
+    missing = [name for name in names if name not in ranges]
+    if missing:
+        raise ValueError(f"no range to draw the parameter{'s' * (len(missing) > 1)} {', '.join(missing)} "
+                         f"of model {model!r} from (known: {', '.join(RANGES)})")
+    return {name: ranges[name] for name in names}
 
 
 def random_grasp(rng: np.random.Generator, *, dim: int = 2, n_contacts: int = 3,
@@ -30,18 +54,17 @@ def random_grasp(rng: np.random.Generator, *, dim: int = 2, n_contacts: int = 3,
     Contact points lie at radius 0.7 to 1.3 in uniformly random directions; each inward normal is
     the direction to the origin plus Gaussian noise of size ``spread``, so that roughly half of
     the grasps are in closure for the default sizes. ``model`` is any registered contact model;
-    its parameters are drawn uniformly from the ranges ``mu``, ``torsion``, ``width`` (in the
-    model's parameter order, after the normal).
+    its parameters are drawn uniformly from the ranges ``mu``, ``torsion``, ``width``, others from
+    :data:`RANGES` (:func:`parameter_ranges`; in the model's parameter order, after the normal).
     """
-    ranges = {"mu": mu, "torsion": torsion, "width": width}
-    spec = registry.get(model)
+    ranges = parameter_ranges(model, mu=mu, torsion=torsion, width=width)
     contacts = []
     for _ in range(n_contacts):
         u = rng.normal(size=dim)
         u /= np.linalg.norm(u)
         p = u * rng.uniform(0.7, 1.3)
         n = -u + spread * rng.normal(size=dim)
-        params = {par.name: rng.uniform(*ranges[par.name]) for par in spec.params}
+        params = {name: rng.uniform(*bounds) for name, bounds in ranges.items()}
         contacts.append(Contact(p, n, model, **params))
     return Grasp(tuple(contacts))
 
@@ -226,10 +249,9 @@ def random_grasp_table(seed: int, count: int, *, dim: int = 2, n_contacts: int =
     total = count * m
     lists = lambda a: pa.ListArray.from_arrays(pa.array(np.arange(0, total * dim + 1, dim, dtype=np.int32)),
                                                pa.array(a.reshape(-1)))
-    ranges = {"mu": mu, "torsion": torsion, "width": width}
     fields = {"p": lists(p), "n": lists(n), "model": pa.array(np.full(total, model, dtype=object))}
-    for par in registry.get(model).params:
-        fields[par.name] = pa.array(rng.uniform(*ranges[par.name], size=total))
+    for name, bounds in parameter_ranges(model, mu=mu, torsion=torsion, width=width).items():
+        fields[name] = pa.array(rng.uniform(*bounds, size=total))
     contacts = pa.StructArray.from_arrays(
         [fields.get(f.name, pa.nulls(total, f.type)) for f in contact_type()], fields=list(contact_type()))
     per_row = pa.ListArray.from_arrays(pa.array(np.arange(0, total + 1, m, dtype=np.int32)), contacts)

@@ -22,10 +22,10 @@ from ..batch.engine import tune_allocator
 from ..batch.jobs import certify_file, verify_file
 from ..errors import CertifyError
 from ..regions.files import DEFAULT_BUDGET, certify_region_file, verify_region_file
-from ..batch.samples import DEGENERATE, write_random_grasp_file
+from ..batch.samples import DEGENERATE, parameter_ranges, write_random_grasp_file
 from ..files.reader import count_grasps
 from ..core.validation import MAX_CONTACTS
-from .options import fail, printable
+from .options import MAX_WORKERS, fail, printable
 
 __all__ = ["register"]
 
@@ -87,8 +87,10 @@ def certify_command(
         fail(f"--eps-gap must be a fraction between 0 and 1 (relative gap hi - lo <= gap * hi), got {eps_gap}")
     if eps_budget < 1:
         fail(f"--eps-budget must be at least 1 direction cell, got {eps_budget}")
-    if workers < 0:
-        fail(f"--workers must be 0 (all cores) or a number of processes, got {workers}")
+    if not 0 <= workers <= MAX_WORKERS:
+        fail(f"--workers must be 0 (all cores) or a number of processes up to {MAX_WORKERS}, got {workers}")
+    if not (eps_time >= 0 and math.isfinite(eps_time)):  # NaN fails both
+        fail(f"--eps-time must be a finite number of seconds >= 0 (0: no time limit), got {eps_time}")
     if chunk_size is not None and chunk_size < 1:
         fail(f"--chunk-size must be at least 1 grasp, got {chunk_size}")
     mesh_options = {k: v for k, v in dict(gripper=gripper, convention=convention, units=units, mu=mu, model=model,
@@ -150,8 +152,8 @@ def verify_command(
     """
     if (grasps is None) == (regions is None):
         fail("give exactly one of --grasps and --regions")
-    if workers < 0:
-        fail(f"--workers must be 0 (all cores) or a number of processes, got {workers}")
+    if not 0 <= workers <= MAX_WORKERS:
+        fail(f"--workers must be 0 (all cores) or a number of processes up to {MAX_WORKERS}, got {workers}")
     try:
         if regions is not None:
             summary = verify_region_file(results, regions)
@@ -219,12 +221,18 @@ def sample_command(
     through one point, repeated or collinear contacts), as round or square objects give."""
     if n < 0:
         fail(f"--n must be a number of grasps (>= 0), got {n}")
+    if seed < 0:
+        fail(f"--seed must be a non-negative integer, got {seed}")
     if dim not in (2, 3):
         fail(f"--dim must be 2 (planar) or 3 (spatial), got {dim}")
     if not 1 <= contacts <= MAX_CONTACTS:
         fail(f"--contacts must be between 1 and {MAX_CONTACTS}, got {contacts}")
     if model not in models.names():
         fail(f"--model must be one of {', '.join(models.names())}, got {model!r}")
+    try:
+        parameter_ranges(model)
+    except ValueError as err:
+        fail(f"--model {model}: {err}")
     if dim not in models.get(model).dims:
         fail(f"--model {model} exists in {' and '.join(map(str, models.get(model).dims))} dimensions only, "
               f"not with --dim {dim}")

@@ -65,16 +65,23 @@ def number_in(value: float, name: str, low: float, high: float, *, unit: str = "
     Traceback (most recent call last):
     ...
     qualgrasp.certify.errors.ArgumentError: rel_gap must be a finite number >= 0 and < 1, got nan
+
+    An infinite end is no bound, and the message does not state it:
+
+    >>> number_in(float("inf"), "eps_time", 0, math.inf, unit="seconds")
+    Traceback (most recent call last):
+    ...
+    qualgrasp.certify.errors.ArgumentError: eps_time must be a finite number >= 0 seconds, got inf
     """
     if isinstance(value, bool) or not isinstance(value, Real):
         raise TypeError(f"{name} must be a number, got {type(value).__name__}")
     ok = math.isfinite(value) and (value > low if low_open else value >= low) and (
         value < high if high_open else value <= high)
     if not ok:
-        lo = f"{'>' if low_open else '>='} {low:g}"
-        hi = f"{'<' if high_open else '<='} {high:g}"
-        unit = f" {unit}" if unit else ""
-        raise error(f"{name} must be a finite number {lo} and {hi}{unit}, got {value:g}")
+        bounds = [f"{'>' if low_open else '>='} {low:g}"] if math.isfinite(low) else []
+        bounds += [f"{'<' if high_open else '<='} {high:g}"] if math.isfinite(high) else []  # no "<= inf"
+        rule = "".join(f" {part}" for part in (" and ".join(bounds), unit) if part)
+        raise error(f"{name} must be a finite number{rule}, got {value:g}")
     return value
 
 

@@ -311,7 +311,8 @@ def check_contacts(data: ContactData) -> Checked:
                        f"numbers, got {raw(j, 'n', list(n[j, :plen[j]]))}")
     stored, norm = _unit_normals(np.where(np.isfinite(n), n, 0.0))
     fail(~(norm >= MIN_NORMAL),
-         lambda j: f"n: normal n is zero (length {norm[j]:.3g}); give the inward surface normal")
+         lambda j: f"n: normal n is zero or shorter than {MIN_NORMAL:g} (length {norm[j]:.3g}); "
+                   "give the inward surface normal")
 
     # model: the default rule, then known names existing in the contact's dimension
     model = data.model.copy()

@@ -129,9 +129,11 @@ def input_format(path: str | Path) -> str:
 
 
 def _not_lines(head: bytes, complete: bool) -> str | None:
-    """Why the start of a file is not JSON Lines, or None when it is: most of its complete lines
-    must be JSON objects, more than half of them (a file whose first line is longer than the
-    sample is judged by that line's start)."""
+    """Why the start of a file is not JSON Lines, or None when it is: at least half of its complete
+    non-blank lines must be JSON objects (a file whose first line is longer than the sample is
+    judged by that line's start). A file with more than half is JSON Lines whatever its other
+    lines hold; with fewer, it is not (a CSV file, a log); with exactly half, unless it holds NUL
+    bytes or its first line opens a JSON document spread over lines."""
     text = head[3:] if head.startswith(b"\xef\xbb\xbf") else head
     lines = text.replace(b"\r\n", b"\n").replace(b"\r", b"\n").split(b"\n")
     if not complete:
@@ -149,7 +151,10 @@ def _not_lines(head: bytes, complete: bool) -> str | None:
         return "one JSON document spread over many lines (a JSON array or pretty-printed JSON); write one grasp per line"
     if first.startswith(b"[") and b'"contacts"' in first:
         return "a JSON array of grasps; write one grasp per line"
-    return None  # JSON Lines with bad lines: each is an error row
+    if 2 * objects >= len(lines):
+        return None  # JSON Lines with bad lines: each is an error row
+    return (f"{objects} of its first {len(lines)} non-blank lines "
+            f"{'is a JSON object' if objects == 1 else 'are JSON objects'} (at least half must be)")
 
 
 def _check_parquet(path: Path) -> None:

@@ -14,7 +14,7 @@ from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from ...certify.cli.options import OptionError, count_in, output_folder
+from ...certify.cli.options import MAX_WORKERS, OptionError, count_in, output_folder
 from ..design import BUILTINS
 from ..silhouettes import available_silhouettes, available_wings
 from ..silhouettes import silhouettes as bundled
@@ -75,7 +75,7 @@ def validate_command(
     try:
         count_in(silhouettes, "--silhouettes", 0, available_silhouettes() - 1, what="(the bundled cell outlines)")
         count_in(wings, "--wings", 0, available_wings(), what="(the bundled wing outlines)")
-        count_in(workers, "--workers", 1, 256, what="processes")
+        count_in(workers, "--workers", 1, MAX_WORKERS, what="processes")
         output_folder(out, "--out", reads=[folder] if folder else [])
     except OptionError as err:
         _fail(str(err))

@@ -1,0 +1,143 @@
+"""What a hostile run against the command line found (2026-11-28), each now refused in one line
+with exit 2 before any work, or read as documented: a negative ``--seed``; a ``--workers`` count
+that would start a pool of thousands of processes; ``--eps-time`` negative or NaN (once read as
+"no time limit") or infinite (once refused with a rule that admitted it); ``sample --model patch``
+(once a ``KeyError``); a normal shorter than the least length (once called "zero" with its length
+beside it); a text file of which fewer than half the lines are JSON objects (once read as that
+many error rows)."""
+
+import json
+
+import pytest
+from typer.testing import CliRunner
+
+from qualgrasp.certify.batch.samples import RANGES, parameter_ranges, random_grasp_table
+from qualgrasp.certify.cli.options import MAX_WORKERS
+from qualgrasp.certify.core.arguments import number_in
+from qualgrasp.certify.core.validation import MIN_NORMAL
+from qualgrasp.certify.errors import ArgumentError
+from qualgrasp.certify.files import read_results
+from qualgrasp.cli import app
+
+runner = CliRunner()
+
+GRASP = {"id": "g", "contacts": [{"p": [0, 1], "n": [0, -1], "mu": 0.5}, {"p": [0, -1], "n": [0, 1], "mu": 0.5}]}
+
+
+@pytest.fixture
+def grasps(tmp_path):
+    path = tmp_path / "g.jsonl"
+    path.write_text(json.dumps(GRASP) + "\n")
+    return path
+
+
+def _refused(args, *words):
+    result = runner.invoke(app, [str(a) for a in args])
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output
+    assert result.exception is None or isinstance(result.exception, SystemExit)
+    line = result.output.strip()
+    assert len(line.splitlines()) == 1 and line.startswith("error: "), line
+    assert all(w in line for w in words), line
+    return line
+
+
+@pytest.mark.parametrize("value", ["-1", "-5"])
+def test_sample_refuses_a_negative_seed(tmp_path, value):
+    out = tmp_path / "s.jsonl"
+    _refused(["sample", out, "--n", "3", "--seed", value], "--seed", value)
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("command", ["certify", "verify"])
+def test_a_worker_count_beyond_the_limit_is_refused_before_any_process_starts(grasps, tmp_path, command):
+    workers = MAX_WORKERS + 1  # not more: were the check gone, this many processes would start
+    args = (["certify", grasps, "-o", tmp_path / "r.jsonl", "-q"] if command == "certify"
+            else ["verify", grasps, "--grasps", grasps])
+    _refused(args + ["--workers", workers], "--workers", str(MAX_WORKERS), str(workers))
+    assert not (tmp_path / "r.jsonl").exists() and not (tmp_path / "r.jsonl.parts").exists()
+
+
+@pytest.mark.parametrize("value", ["-1", "nan", "inf", "-inf"])
+def test_eps_time_must_be_a_finite_number_of_seconds(grasps, tmp_path, value):
+    out = tmp_path / "r.jsonl"
+    _refused(["certify", grasps, "-o", out, "-q", "--eps-time", value], "--eps-time", "0: no time limit")
+    assert not out.exists()
+
+
+def test_eps_time_zero_is_no_time_limit(grasps, tmp_path):
+    out = tmp_path / "r.jsonl"
+    result = runner.invoke(app, ["certify", str(grasps), "-o", str(out), "-q", "--eps-time", "0", "--workers", "1"])
+    assert result.exit_code == 0, result.output
+    row, = read_results(out)
+    assert row["status"] == "closure" and row["eps_limited"] is False
+
+
+def test_a_range_without_an_end_is_not_stated():
+    with pytest.raises(ArgumentError) as err:
+        number_in(float("inf"), "eps_time", 0, float("inf"), unit="seconds")
+    assert str(err.value) == "eps_time must be a finite number >= 0 seconds, got inf"
+    with pytest.raises(ArgumentError, match=r"^x must be a finite number, got nan$"):
+        number_in(float("nan"), "x", float("-inf"), float("inf"))
+
+
+@pytest.mark.parametrize("suffix", [".jsonl", ".parquet"])
+def test_sample_draws_every_built_in_models_parameters(tmp_path, suffix):
+    """``patch`` (a radius) was listed by ``sample --help`` and failed; every built-in model's
+    parameters have a range, and the set certifies."""
+    out = tmp_path / f"p{suffix}"
+    result = runner.invoke(app, ["sample", str(out), "--n", "50", "--dim", "3", "--model", "patch"])
+    assert result.exit_code == 0, result.output
+    res = tmp_path / "r.jsonl"
+    result = runner.invoke(app, ["certify", str(out), "-o", str(res), "-q", "--no-quality", "--workers", "1"])
+    assert result.exit_code == 0, result.output
+    rows = list(read_results(res))
+    assert len(rows) == 50 and {r["status"] for r in rows} <= {"closure", "no_closure"}
+    radius = random_grasp_table(0, 20, dim=3, model="patch").column("contacts").combine_chunks().flatten()
+    values = radius.field("radius").to_numpy()
+    assert ((values >= RANGES["radius"][0]) & (values <= RANGES["radius"][1])).all()
+
+
+def test_a_model_parameter_without_a_range_is_named(tmp_path, monkeypatch):
+    """A model whose parameter has no range (one registered outside the package, say) is refused
+    by name, by the function and by the command before any file is written."""
+    monkeypatch.delitem(RANGES, "radius")
+    with pytest.raises(ValueError, match="no range to draw the parameter radius of model 'patch'"):
+        parameter_ranges("patch")
+    out = tmp_path / "p.jsonl"
+    _refused(["sample", out, "--dim", "3", "--model", "patch"], "--model patch", "radius")
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("length, refused", [(0.5 * MIN_NORMAL, True), (2 * MIN_NORMAL, False)])
+def test_a_normal_shorter_than_the_least_length_is_refused_saying_so(tmp_path, length, refused):
+    grasp = json.loads(json.dumps(GRASP))
+    grasp["contacts"][0]["n"] = [0, -length]
+    src, out = tmp_path / "g.jsonl", tmp_path / "r.jsonl"
+    src.write_text(json.dumps(grasp) + "\n")
+    runner.invoke(app, ["certify", str(src), "-o", str(out), "-q", "--no-quality", "--workers", "1"])
+    row, = read_results(out)
+    if refused:
+        assert row["status"] == "error"
+        assert f"normal n is zero or shorter than {MIN_NORMAL:g} (length {length:.3g})" in row["error"]
+    else:
+        assert row["status"] == "closure"
+
+
+@pytest.mark.parametrize("text, words", [
+    ("a,b,c\n1,2,3\n4,5,6\n", "0 of its first 3 non-blank lines are JSON objects"),
+    (json.dumps(GRASP) + "\n" + "garbage\n" * 20, "1 of its first 21 non-blank lines is a JSON object"),
+])
+def test_a_text_file_of_too_few_json_objects_is_not_read_as_json_lines(tmp_path, text, words):
+    src, out = tmp_path / "table.csv", tmp_path / "r.jsonl"
+    src.write_text(text)
+    _refused(["certify", src, "-o", out, "-q"], "neither JSON Lines nor Parquet", words, "at least half")
+    assert not out.exists()
+
+
+def test_half_of_the_lines_json_objects_is_json_lines_with_error_rows(tmp_path):
+    src, out = tmp_path / "g.jsonl", tmp_path / "r.jsonl"
+    src.write_text(json.dumps(GRASP) + "\nnot json\n")
+    result = runner.invoke(app, ["certify", str(src), "-o", str(out), "-q", "--no-quality", "--workers", "1"])
+    assert result.exit_code == 1, result.output
+    assert [r["status"] for r in read_results(out)] == ["closure", "error"]
