@@ -13,8 +13,8 @@ from ..core.grasp import Contact, Grasp
 from ..files.outputs import atomic_output
 from ..files.reader import contact_type, grasp_schema, is_parquet
 
-__all__ = ["RANGES", "parameter_ranges", "DEGENERATE", "random_grasp", "random_grasps", "textbook_grasps", "random_grasp_table",
-           "degenerate_geometry", "write_random_grasp_file"]
+__all__ = ["RANGES", "parameter_ranges", "DEGENERATE", "random_grasp", "random_grasps", "textbook_grasps",
+           "random_grasp_table", "degenerate_geometry", "write_random_grasp_file"]
 
 
 #: Ranges of the uniform draws of each model parameter (a patch's radius 1.5 times the torsion's,

@@ -40,8 +40,8 @@ from ..core import arguments
 from ..errors import OptionError
 from ..files.outputs import check_name_length, check_output, file_kind, inside, same_file, writable_folder
 
-__all__ = ["OptionError", "FIGURE_SUFFIXES", "FOLDER_MARKER", "MAX_WORKERS", "output_file", "output_folder", "input_file", "number_in",
-           "count_in", "optional_number_in", "printable", "fail"]
+__all__ = ["OptionError", "FIGURE_SUFFIXES", "FOLDER_MARKER", "MAX_WORKERS", "output_file", "output_folder",
+           "input_file", "number_in", "count_in", "optional_number_in", "printable", "fail"]
 
 #: The most worker processes a command's ``--workers`` may ask for: a local pool starts them all
 #: at once, so a mistyped count would fill the machine with processes before any work.
