@@ -4,10 +4,12 @@ that would start a pool of thousands of processes; ``--eps-time`` negative or Na
 "no time limit") or infinite (once refused with a rule that admitted it); ``sample --model patch``
 (once a ``KeyError``); a normal shorter than the least length (once called "zero" with its length
 beside it); a text file of which fewer than half the lines are JSON objects (once read as that
-many error rows)."""
+many error rows); ``verify`` counting rows it could not pair with a grasp, and error rows it
+re-checks, wrongly."""
 
 import json
 
+import pyarrow.parquet as pq
 import pytest
 from typer.testing import CliRunner
 
@@ -141,3 +143,38 @@ def test_half_of_the_lines_json_objects_is_json_lines_with_error_rows(tmp_path):
     result = runner.invoke(app, ["certify", str(src), "-o", str(out), "-q", "--no-quality", "--workers", "1"])
     assert result.exit_code == 1, result.output
     assert [r["status"] for r in read_results(out)] == ["closure", "error"]
+
+
+def _verify(results, grasps):
+    result = runner.invoke(app, ["verify", str(results), "--grasps", str(grasps), "--workers", "1"])
+    return result.exit_code, result.output.strip().splitlines()
+
+
+def test_verify_states_which_rows_it_re_checked_against_their_grasps(tmp_path):
+    """A results file with an unreadable row group: its rows fail naming the reader's error and
+    are not counted as re-checked; error rows are re-checked (their error recomputed), not
+    skipped; a grasp file given as results re-checks nothing."""
+    src = tmp_path / "g.jsonl"
+    lines = [json.dumps({**GRASP, "id": f"g{i}"}) for i in range(60)] + ['{"id": "bad", "contacts": []}']
+    src.write_text("\n".join(lines) + "\n")
+    results = tmp_path / "r.parquet"
+    assert runner.invoke(app, ["certify", str(src), "-o", str(results), "-q", "--no-quality",
+                               "--workers", "1"]).exit_code == 1  # the bad line: an error row
+    code, out = _verify(results, src)
+    assert code == 0 and out[-1] == "60 certified rows and 1 error rows re-checked against their grasps, 0 failed"
+    table = pq.read_table(results)
+    pq.write_table(table, tmp_path / "rg.parquet", row_group_size=20, compression="none")
+    meta = pq.ParquetFile(tmp_path / "rg.parquet").metadata.row_group(1).column(table.schema.get_field_index("margin"))
+    data = bytearray((tmp_path / "rg.parquet").read_bytes())
+    start = meta.dictionary_page_offset or meta.data_page_offset
+    data[start:start + 40] = bytes(b ^ 0x5A for b in data[start:start + 40])
+    (tmp_path / "bad.parquet").write_bytes(bytes(data))
+    code, out = _verify(tmp_path / "bad.parquet", src)
+    assert code == 1
+    assert sum("unreadable Parquet data (row group 1)" in line for line in out) == 20
+    assert out[-1] == ("40 certified rows and 1 error rows re-checked against their grasps, 20 failed; 20 of the "
+                       "failed rows were re-checked against no grasp (unreadable, or stating no line of the grasp "
+                       "file); 20 of the 61 grasps have no results row (a subset: not a failure)")
+    code, out = _verify(src, src)
+    assert code == 1 and out[-1].startswith("0 certified rows and 0 error rows re-checked against their grasps, "
+                                            "61 failed; 61 of the failed rows")

@@ -23,7 +23,7 @@ from ..core.certificates import Tolerances
 from .chunk import STATUSES, Options, Quality, verify_chunk
 from .engine import RunSummary, chunk_size_for, run, tune_allocator
 from ..errors import CertifyError
-from ..files.reader import Chunk, chunk_values, count_grasps, input_format, is_parquet, iter_chunks
+from ..files.reader import READ_ERROR, Chunk, chunk_values, count_grasps, input_format, is_parquet, iter_chunks
 from ..core.validation import show
 from ..solvers import Method
 
@@ -51,13 +51,18 @@ def certify_file(grasps_path: str | Path, results_path: str | Path, *, method: M
 class Summary:
     """Counts of a verification run; ``failures`` lists ``(id, reason)`` of the rows that fail
     (the id the results row states, the reason naming its line); ``missing`` counts the grasps
-    that have no results row (a results file may hold a subset: not a failure)."""
+    that have no results row (a results file may hold a subset: not a failure); ``unpaired``
+    counts the rows that failed before any re-check, having no grasp to be re-checked against
+    (unreadable, stating no usable line, or a line that is no grasp of the file), and
+    ``unpaired_errors`` those of them stating status ``error``."""
 
     rows: int = 0
     statuses: dict[str, int] = field(default_factory=dict)
     failures: list[tuple[object, str]] = field(default_factory=list)
     missing: int = 0
     grasps: int = 0
+    unpaired: int = 0
+    unpaired_errors: int = 0
 
     @property
     def errors(self) -> int:
@@ -93,7 +98,17 @@ class _Block:
         return [self.rows[i] for i in idx]
 
     def lines(self) -> tuple[np.ndarray, dict[int, str]]:
-        """The grasp line each row states (-1 where none can be used) and, for those rows, why."""
+        """The grasp line each row states (-1 where none can be used) and, for those rows, why:
+        for a row of an unreadable Parquet row group, the reader's error."""
+        out, problems = self._stated_lines()
+        if isinstance(self.rows, pa.Table) and READ_ERROR in self.rows.column_names:
+            unreadable = self.rows.column(READ_ERROR).combine_chunks()
+            for k in np.flatnonzero(np.asarray(unreadable.is_valid(), dtype=bool)):
+                out[k] = -1
+                problems[int(k)] = f"results row {self.where[k]}: {unreadable[int(k)].as_py()}"
+        return out, problems
+
+    def _stated_lines(self) -> tuple[np.ndarray, dict[int, str]]:
         n = len(self)
         if isinstance(self.rows, pa.Table):
             if "line" not in self.rows.column_names:
@@ -207,7 +222,10 @@ class _Verifier:
 
     def fail(self, block: _Block, k: int, reason: str) -> None:
         """A results row that pairs with no grasp: counted, and a failure naming its own id."""
-        self.summary.count(block.status(k))
+        status = block.status(k)
+        self.summary.count(status)
+        self.summary.unpaired += 1
+        self.summary.unpaired_errors += status == "error"
         self.summary.failures.append((block.own_id(k), reason))
 
     def merge(self, result) -> None:

@@ -164,14 +164,27 @@ def verify_command(
         fail(str(err))
     for gid, reason in summary.failures:
         typer.echo(printable(f"{gid}\t{reason}"))
-    checked = summary.rows - summary.errors
-    missing = getattr(summary, "missing", 0)
-    console.print(f"{checked} certified rows re-checked, {summary.errors} error rows skipped, "
-                  f"{len(summary.failures)} failed"
-                  + (f"; {missing} of the {summary.grasps} grasps have no results row (a subset: not a failure)"
-                     if missing else ""), soft_wrap=True)
+    console.print(_verify_line(summary), soft_wrap=True)
     if summary.failures:
         raise typer.Exit(1)
+
+
+def _verify_line(summary) -> str:
+    """What a verification proved, in one line: the rows re-checked against their grasps
+    (certified rows and error rows), those that failed, the rows without a grasp to re-check
+    against (failed, not re-checked) and the grasps without a row (a subset: no failure)."""
+    unpaired = getattr(summary, "unpaired", 0)
+    rechecked = summary.rows - unpaired
+    errors = summary.errors - getattr(summary, "unpaired_errors", 0)
+    missing = getattr(summary, "missing", 0)
+    line = (f"{rechecked - errors} certified rows and {errors} error rows re-checked against their grasps, "
+            f"{len(summary.failures)} failed")
+    if unpaired:
+        line += (f"; {unpaired} of the failed rows were re-checked against no grasp (unreadable, or stating no "
+                 f"line of the grasp file)")
+    if missing:
+        line += f"; {missing} of the {summary.grasps} grasps have no results row (a subset: not a failure)"
+    return line
 
 
 def certify_regions_command(
