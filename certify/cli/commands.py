@@ -37,7 +37,8 @@ METHODS = ("fast", "reference")
 
 def certify_command(
     grasps: Path = typer.Argument(..., help="Grasp set: .jsonl (JSON Lines) or .parquet."),
-    output: Path = typer.Option(..., "-o", "--output", help="Results file: .jsonl or .parquet."),
+    output: Path = typer.Option(..., "-o", "--output",
+                                help="Results file: Parquet if named .parquet or .pq, else JSON Lines."),
     method: str = typer.Option("fast", help="'fast' (enumeration/clarabel) or 'reference' (cvxpy)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress bar or summary."),
     quality: bool = typer.Option(True, help="Compute the epsilon columns (eps_l1_lo ... eps_linf_hi)."),
@@ -217,7 +218,7 @@ def certify_regions_command(
     if summary.errors or summary.unverified:
         raise typer.Exit(1)
 def sample_command(
-    output: Path = typer.Argument(..., help="Grasp set to write: .parquet or .jsonl."),
+    output: Path = typer.Argument(..., help="Grasp set to write: Parquet if named .parquet or .pq, else JSON Lines."),
     n: int = typer.Option(100_000, "--n", help="Number of grasps."),
     dim: int = typer.Option(2, help="2 (planar) or 3 (spatial)."),
     contacts: int = typer.Option(3, help="Contacts per grasp."),

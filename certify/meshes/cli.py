@@ -117,7 +117,8 @@ def contacts_file(mesh_path: Path, poses_path: Path, output: Path, *, gripper: s
 def contacts_command(
     mesh: Path = typer.Argument(..., help="Object mesh: OBJ, STL, PLY, GLB, OFF (closed, in --units)."),
     poses: Path = typer.Argument(..., help="Poses: JSON Lines, Parquet, or an ACRONYM HDF5 file (needs h5py)."),
-    output: Path = typer.Option(..., "-o", "--output", help="Grasp set for 'qualgrasp certify': .jsonl or .parquet."),
+    output: Path = typer.Option(..., "-o", "--output", help="Grasp set for 'qualgrasp certify': Parquet if "
+                                "named .parquet or .pq, else JSON Lines."),
     gripper: str = typer.Option("franka_panda", help="Built-in gripper (" + ", ".join(builtin_grippers())
                                 + ") or a gripper file (.toml, .json)."),
     convention: str = typer.Option("qualgrasp", help="Pose convention: " + ", ".join(CONVENTIONS) + "."),
@@ -170,7 +171,8 @@ def contacts_command(
 
 def sample_poses_command(
     mesh: Path = typer.Argument(..., help="Object mesh: OBJ, STL, PLY, GLB, OFF (closed, in --units)."),
-    output: Path = typer.Option(..., "-o", "--output", help="Pose file to write: .jsonl or .parquet."),
+    output: Path = typer.Option(..., "-o", "--output",
+                                help="Pose file to write: Parquet if named .parquet or .pq, else JSON Lines."),
     gripper: str = typer.Option("franka_panda", help="Built-in parallel-jaw gripper or a gripper file."),
     n: int = typer.Option(100, "-n", "--n", help="Number of poses."),
     mu: float = typer.Option(None, help="Friction coefficient of the antipodal test (default: the gripper's)."),
