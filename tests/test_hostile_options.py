@@ -9,6 +9,7 @@ re-checks, wrongly."""
 
 import json
 
+import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 from typer.testing import CliRunner
@@ -178,3 +179,36 @@ def test_verify_states_which_rows_it_re_checked_against_their_grasps(tmp_path):
     code, out = _verify(src, src)
     assert code == 1 and out[-1].startswith("0 certified rows and 0 error rows re-checked against their grasps, "
                                             "61 failed; 61 of the failed rows")
+
+
+def test_parquet_and_json_lines_state_the_same_errors_of_the_same_values(tmp_path):
+    """A null inside a vector is not a number (it was reported as NaN from Parquet), and an
+    infinite or null coordinate of ``center`` is shown as given (Parquet said ``got null``): the
+    same grasps as JSON Lines and as Parquet give the same error rows, and each file's results
+    verify against the other's grasps."""
+    contact = lambda p, n: {"p": p, "n": n, "model": "point", "mu": 0.5}  # noqa: E731
+    pair = [contact([0.0, 1.0], [0.0, -1.0]), contact([0.0, -1.0], [0.0, 1.0])]
+    grasps = [{"id": "p-null", "contacts": [contact([None, 1.0], [0.0, -1.0]), pair[1]], "center": None},
+              {"id": "n-null", "contacts": [contact([0.0, 1.0], [0.0, None]), pair[1]], "center": None},
+              {"id": "c-inf", "contacts": pair, "center": [float("inf"), 0.0]},
+              {"id": "c-null", "contacts": pair, "center": [None, 0.0]},
+              {"id": "c-long", "contacts": pair, "center": [0.0, 0.0, 0.0, 1.0]},
+              {"id": "fine", "contacts": pair, "center": [0.0, 0.5]}]
+    paths = {"jsonl": tmp_path / "g.jsonl", "parquet": tmp_path / "g.parquet"}
+    paths["jsonl"].write_text("".join(json.dumps(g) + "\n" for g in grasps))
+    pq.write_table(pa.Table.from_pylist(grasps), paths["parquet"])
+    rows = {}
+    for fmt, path in paths.items():
+        out = tmp_path / f"r-{fmt}.jsonl"
+        runner.invoke(app, ["certify", str(path), "-o", str(out), "-q", "--no-quality", "--workers", "1"])
+        rows[fmt] = list(read_results(out))
+    assert [r["error"] for r in rows["parquet"]] == [r["error"] for r in rows["jsonl"]]
+    errors = [r["error"] for r in rows["jsonl"]]
+    assert "contacts[0].p: expected 2 (planar) or 3 (spatial) finite numbers, got [null, 1.0]" in errors[0]
+    assert "contacts[0].n: expected 2 (planar) or 3 (spatial) finite numbers, got [0.0, null]" in errors[1]
+    assert "got [Infinity, 0.0]" in errors[2] and "got [null, 0.0]" in errors[3]
+    assert "center: expected 2 or 3 finite numbers, got [0.0, 0.0, 0.0, 1.0]" in errors[4]
+    assert errors[5] is None and rows["parquet"][5]["status"] == "closure"
+    for fmt, other in (("jsonl", "parquet"), ("parquet", "jsonl")):
+        code, out = _verify(tmp_path / f"r-{fmt}.jsonl", paths[other])
+        assert code == 0, out

@@ -654,7 +654,8 @@ def grasp_rules(data: GraspData, checked: Checked) -> CheckedGrasps:
     with np.errstate(invalid="ignore"):
         finite = _by_column(np.logical_and, np.abs(data.center) <= MAX_LENGTH)  # False for NaN and infinities too
         fail(given & ~finite, lambda i: f"center: NaN or infinite coordinate, or one beyond {MAX_LENGTH:g}: "
-                                        f"expected {dim[i]} finite numbers, got {show(data.raw.get((i, 'center')))}")
+                                        f"expected {dim[i]} finite numbers, got "
+                                        f"{show(data.raw.get((i, 'center'), list(data.center[i, :data.clen[i]])))}")
         L = data.length
         fail(data.length_given & ~((L >= MIN_LENGTH) & (L <= MAX_GRASP_LENGTH)),
              lambda i: f"length: length must be > 0 (at least {MIN_LENGTH:g}), finite and <= "

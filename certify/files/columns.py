@@ -207,7 +207,8 @@ def _floats(arr: pa.Array) -> np.ndarray | None:
 
 def _vectors(arr: pa.Array, n: int):
     """Rows of a list of numbers as an (n, 3) array (zero-padded) and their lengths (-1 where
-    the list is null, 4 for any longer list); None when ``arr`` is not a list of numbers."""
+    the list is null, 4 for any longer list and for one holding a null: not a vector of numbers,
+    as the JSON reader has it); None when ``arr`` is not a list of numbers."""
     lists = _lists(arr)
     if lists is None:
         return None
@@ -225,7 +226,11 @@ def _vectors(arr: pa.Array, n: int):
         cols = np.arange(len(values)) - np.repeat(offsets[:-1], lengths)
         keep = np.repeat(good, lengths)
         out[rows[keep], cols[keep]] = values[keep]
-    return out, np.where(valid, np.minimum(lengths, 4), -1)
+    lengths = np.minimum(lengths, 4)
+    if flat.null_count:  # a null inside a list is not a number (its NaN would be reported instead)
+        holes = np.repeat(np.arange(n), np.diff(offsets))[~np.asarray(flat.is_valid(), dtype=bool)]
+        lengths[holes] = 4
+    return out, np.where(valid, lengths, -1)
 
 
 def _strings(arr: pa.Array) -> pa.Array | None:
@@ -357,8 +362,10 @@ def grasp_columns(table: pa.Table) -> GraspColumns:
                         f"center: expected 2 (planar) or 3 (spatial) finite numbers, got a {col.type} value")
         else:
             data.center, data.clen = got
-            for i in np.flatnonzero(np.isin(data.clen, (0, 1, 4))):
-                data.errors[i] = data.errors[i] or "center: expected 2 (planar) or 3 (spatial) finite numbers"
+            col = table.column("center")
+            for i in np.flatnonzero(np.isin(data.clen, (0, 1, 4))):  # worded as the JSON reader words it
+                data.errors[i] = data.errors[i] or (f"center: expected 2 or 3 finite numbers, got "
+                                                    f"{show(col[i].as_py())}")
     if "length" in names:
         col = table.column("length").combine_chunks()
         values = _floats(col)
