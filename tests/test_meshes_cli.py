@@ -1,6 +1,7 @@
 """qualgrasp contacts and qualgrasp sample-poses (qualgrasp.certify.meshes.cli), end to end:
 their output is a grasp set that certify certifies; every pose is a row or an error row."""
 
+import errno
 import json
 
 import numpy as np
@@ -13,6 +14,7 @@ trimesh = pytest.importorskip("trimesh")
 
 from qualgrasp.certify.batch import certify_file
 from qualgrasp.certify.files import read_results
+from qualgrasp.certify.meshes import cli as mesh_cli
 from qualgrasp.certify.meshes.cli import register
 
 app = typer.Typer()
@@ -175,3 +177,32 @@ def test_readme_example_runs_as_written_and_says_what_it_gives(tmp_path, monkeyp
     closure = re.search(r"\((\d+) in closure", section)
     results = list(read_results(tmp_path / "results.jsonl"))
     assert len(results) == 20 and sum(r["status"] == "closure" for r in results) == int(closure[1])
+
+
+def test_a_failed_write_leaves_the_output_as_it_was(tmp_path, box, monkeypatch):
+    """sample-poses and contacts write through a temporary renamed at the end, as every command:
+    a write that fails midway (here a full disk) ends in one line, exit 2, and the file named as
+    the output keeps what it held, with no partial or temporary file beside it."""
+    poses = tmp_path / "poses.jsonl"
+    assert runner.invoke(app, ["sample-poses", str(box), "--units", "mm", "-n", "6", "-o", str(poses)]).exit_code == 0
+    out = tmp_path / "out.jsonl"
+    out.write_text("kept\n")
+    written = []
+
+    class FullDisk:
+        @staticmethod
+        def dumps(row, **kwargs):
+            written.append(row)
+            if len(written) == 3:
+                raise OSError(errno.ENOSPC, "No space left on device")
+            return json.dumps(row, **kwargs)
+
+    monkeypatch.setattr(mesh_cli, "json", FullDisk)
+    for args in (["sample-poses", str(box), "--units", "mm", "-n", "6", "-o", str(out)],
+                 ["contacts", str(box), str(poses), "--units", "mm", "-o", str(out)]):
+        written.clear()
+        res = runner.invoke(app, args)
+        assert res.exit_code == 2, res.output
+        assert "disk is full" in res.output and len(res.output.strip().splitlines()) == 1, res.output
+        assert out.read_text() == "kept\n"
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["box.stl", "out.jsonl", "poses.jsonl"]

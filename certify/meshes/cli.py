@@ -21,6 +21,7 @@ from rich.markup import escape
 from ..batch.chunk import RowFailure
 from ..cli.options import OptionError, number_in, output_file
 from ..errors import CertifyError
+from ..files.outputs import atomic_output
 from ..files.reader import grasps_table, is_parquet
 from .contacts import RESOLUTION, TOLERANCE
 from .errors import PoseError
@@ -52,21 +53,24 @@ class ContactsSummary:
     repairs: tuple = ()
 
 
-def write_rows(path: Path, rows: list[dict], grasps: bool) -> None:
+def write_rows(path: Path, rows: list[dict], grasps: bool, flag: str = "--output", *, reads=()) -> None:
     """Write rows as JSON Lines, or Parquet by extension (grasp rows: certify's grasp schema plus
-    the extra columns)."""
-    if not is_parquet(path):
-        with path.open("w", encoding="utf-8") as fh:
-            for row in rows:
-                fh.write(json.dumps(row, allow_nan=False) + "\n")
-        return
-    if not grasps:
-        pq.write_table(pa.Table.from_pylist(rows), path)
-        return
-    table = grasps_table(rows)
-    for key in dict.fromkeys(k for r in rows for k in r if k not in table.column_names):
-        table = table.append_column(key, pa.array([r.get(key) for r in rows]))
-    pq.write_table(table, path)
+    the extra columns), through a temporary renamed over ``path`` at the end, under its lock
+    (:func:`~qualgrasp.certify.files.outputs.atomic_output`: a failed write leaves no partial
+    file and raises its one-line error naming ``flag``; ``reads`` are never overwritten)."""
+    with atomic_output(path, flag, reads=reads) as tmp:
+        if not is_parquet(path):
+            with tmp.open("w", encoding="utf-8") as fh:
+                for row in rows:
+                    fh.write(json.dumps(row, allow_nan=False) + "\n")
+            return
+        if not grasps:
+            pq.write_table(pa.Table.from_pylist(rows), tmp)
+            return
+        table = grasps_table(rows)
+        for key in dict.fromkeys(k for r in rows for k in r if k not in table.column_names):
+            table = table.append_column(key, pa.array([r.get(key) for r in rows]))
+        pq.write_table(table, tmp)
 
 
 def contacts_file(mesh_path: Path, poses_path: Path, output: Path, *, gripper: str = "franka_panda",
@@ -109,8 +113,8 @@ def contacts_file(mesh_path: Path, poses_path: Path, output: Path, *, gripper: s
             rows.append(row)
     summary.grasps = len(rows)
     summary.errors = Counter(b["reason"] for b in bad)
-    write_rows(output, rows, grasps=True)
-    write_rows(errors, bad, grasps=False)
+    write_rows(output, rows, True, "--output", reads=(mesh_path, poses_path))
+    write_rows(errors, bad, False, "--errors", reads=(mesh_path, poses_path, output))
     return summary
 
 
@@ -198,7 +202,10 @@ def sample_poses_command(
     except (CertifyError, ImportError, PoseError) as err:
         _fail(str(err))
     rows = [{"id": i, "pose": p.T.tolist(), "width": p.width} for i, p in enumerate(poses)]
-    write_rows(out, rows, grasps=False)
+    try:
+        write_rows(out, rows, False, "--output", reads=(mesh,))
+    except CertifyError as err:
+        _fail(str(err))
     console.print(f"wrote {len(rows)} poses to {out}" + (f" (asked for {n}: the sampler found no more)"
                                                         if len(rows) < n else ""))
 
