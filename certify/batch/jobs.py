@@ -53,7 +53,8 @@ class Summary:
     (the id the results row states, the reason naming its line); ``missing`` counts the grasps
     that have no results row (a results file may hold a subset: not a failure); ``unpaired``
     counts the rows that failed before any re-check, having no grasp to be re-checked against
-    (unreadable, stating no usable line, or a line that is no grasp of the file), and
+    (unreadable, stating no usable line or a line that is no grasp of the file, or repeating
+    another row's line), and
     ``unpaired_errors`` those of them stating status ``error``."""
 
     rows: int = 0

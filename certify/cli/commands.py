@@ -165,26 +165,27 @@ def verify_command(
         fail(str(err))
     for gid, reason in summary.failures:
         typer.echo(printable(f"{gid}\t{reason}"))
-    console.print(_verify_line(summary), soft_wrap=True)
+    console.print(_verify_line(summary, regions is not None), soft_wrap=True)
     if summary.failures:
         raise typer.Exit(1)
 
 
-def _verify_line(summary) -> str:
-    """What a verification proved, in one line: the rows re-checked against their grasps
-    (certified rows and error rows), those that failed, the rows without a grasp to re-check
-    against (failed, not re-checked) and the grasps without a row (a subset: no failure)."""
-    unpaired = getattr(summary, "unpaired", 0)
-    rechecked = summary.rows - unpaired
-    errors = summary.errors - getattr(summary, "unpaired_errors", 0)
-    missing = getattr(summary, "missing", 0)
-    line = (f"{rechecked - errors} certified rows and {errors} error rows re-checked against their grasps, "
+def _verify_line(summary, regions: bool = False) -> str:
+    """What a verification proved, in one line: the rows re-checked against their grasps (region
+    tuples) (certified rows and error rows), those that failed, the rows without a grasp (tuple)
+    to re-check against (failed, not re-checked) and the grasps without a row (a subset: no
+    failure)."""
+    rechecked = summary.rows - summary.unpaired
+    errors = summary.errors - summary.unpaired_errors
+    what = "region tuples" if regions else "grasps"
+    line = (f"{rechecked - errors} certified rows and {errors} error rows re-checked against their {what}, "
             f"{len(summary.failures)} failed")
-    if unpaired:
-        line += (f"; {unpaired} of the failed rows were re-checked against no grasp (unreadable, or stating no "
-                 f"line of the grasp file)")
-    if missing:
-        line += f"; {missing} of the {summary.grasps} grasps have no results row (a subset: not a failure)"
+    if summary.unpaired:
+        why = ("unreadable, or stating another line than its tuple's" if regions else
+               "unreadable, stating no line of the grasp file, or repeating another row's line")
+        line += f"; {summary.unpaired} of the failed rows were re-checked against no {what[:-1]} ({why})"
+    if getattr(summary, "missing", 0):  # grasp sets only: a results file may hold a subset
+        line += f"; {summary.missing} of the {summary.grasps} grasps have no results row (a subset: not a failure)"
     return line
 
 

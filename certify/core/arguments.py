@@ -80,8 +80,8 @@ def number_in(value: float, name: str, low: float, high: float, *, unit: str = "
     if not ok:
         bounds = [f"{'>' if low_open else '>='} {low:g}"] if math.isfinite(low) else []
         bounds += [f"{'<' if high_open else '<='} {high:g}"] if math.isfinite(high) else []  # no "<= inf"
-        rule = "".join(f" {part}" for part in (" and ".join(bounds), unit) if part)
-        raise error(f"{name} must be a finite number{rule}, got {value:g}")
+        rule = " and ".join(bounds) + (f" {unit}" if bounds and unit else f"of {unit}" if unit else "")
+        raise error(f"{name} must be a finite number{' ' * bool(rule)}{rule}, got {value:g}")
     return value
 
 

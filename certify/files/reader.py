@@ -9,9 +9,9 @@ Parquet files hold the same schema as the JSON Lines files of :mod:`qualgrasp.ce
 * results: the columns of :data:`qualgrasp.certify.files.results.COLUMNS`, with ``certificate`` a
   struct ``{force, form}`` of certificate structs.
 
-An input file's format is recognised by its content (Parquet's magic number, else JSON Lines
-when most of its first lines are JSON objects; anything else is refused with a one-line reason;
-only regular files are read); a results file's by its extension
+An input file's format is recognised by its content (Parquet's magic number, else JSON Lines,
+unless its first lines show binary data or one JSON document, which is refused with a one-line
+reason (:func:`input_format`); only regular files are read); a results file's by its extension
 (``.parquet`` / ``.pq`` for Parquet, anything else for JSON Lines). Both are read in chunks of a
 fixed number of grasps, so memory stays bounded whatever the file's size, and a chunk's
 boundaries do not depend on how the file was written (needed to resume an interrupted run).
@@ -93,8 +93,10 @@ def input_format(path: str | Path) -> str:
 
     JSON Lines is decided on the lines of the first :data:`SNIFF_BYTES` as a whole: a file whose
     lines are mostly JSON objects is JSON Lines, and each bad line (a NUL byte, a JSON array) is
-    an error row of its own; only a file that is not mostly JSON objects is refused, with the
-    reason.
+    an error row of its own; a file that is not mostly JSON objects is refused, with the reason,
+    when it holds binary data (NUL bytes) or one JSON document or array, and is otherwise read
+    line by line, each line that is not a grasp an error row (a CSV file, a log, a file damaged
+    throughout).
 
     Raises
     ------
@@ -129,11 +131,13 @@ def input_format(path: str | Path) -> str:
 
 
 def _not_lines(head: bytes, complete: bool) -> str | None:
-    """Why the start of a file is not JSON Lines, or None when it is: at least half of its complete
-    non-blank lines must be JSON objects (a file whose first line is longer than the sample is
-    judged by that line's start). A file with more than half is JSON Lines whatever its other
-    lines hold; with fewer, it is not (a CSV file, a log); with exactly half, unless it holds NUL
-    bytes or its first line opens a JSON document spread over lines."""
+    """Why the start of a file is not JSON Lines, or None when it is. A file of which more than
+    half of the complete non-blank lines are JSON objects is JSON Lines, whatever its other lines
+    hold (each is an error row). Otherwise it is refused when it holds a NUL byte (binary data) or
+    its first line opens a JSON document spread over lines or a JSON array of grasps, and read as
+    JSON Lines with bad lines when not (a CSV file or a log: one error row per line, as a damaged
+    JSON Lines file, every line of which may be bad, is read). A file whose first line is longer
+    than the sample is judged by that line's start."""
     text = head[3:] if head.startswith(b"\xef\xbb\xbf") else head
     lines = text.replace(b"\r\n", b"\n").replace(b"\r", b"\n").split(b"\n")
     if not complete:
@@ -151,10 +155,7 @@ def _not_lines(head: bytes, complete: bool) -> str | None:
         return "one JSON document spread over many lines (a JSON array or pretty-printed JSON); write one grasp per line"
     if first.startswith(b"[") and b'"contacts"' in first:
         return "a JSON array of grasps; write one grasp per line"
-    if 2 * objects >= len(lines):
-        return None  # JSON Lines with bad lines: each is an error row
-    return (f"{objects} of its first {len(lines)} non-blank lines "
-            f"{'is a JSON object' if objects == 1 else 'are JSON objects'} (at least half must be)")
+    return None  # JSON Lines with bad lines: each is an error row
 
 
 def _check_parquet(path: Path) -> None:

@@ -73,13 +73,17 @@ def read_region_lines(path: str | Path) -> Iterator[tuple[int, Any]]:
 class RegionSummary:
     """Counts of a region-set run: ``rows``, ``statuses`` (rows per status), ``unverified``
     (rows whose evidence failed its own re-check), ``failures`` (``(id, reason)`` of a
-    verification run) and ``seconds``."""
+    verification run), ``seconds``; and, of a verification run, ``unpaired``, the rows that
+    failed with no tuple to be re-checked against (unreadable, or stating another line than
+    their tuple's), ``unpaired_errors`` those of them stating status ``error``."""
 
     rows: int = 0
     statuses: dict[str, int] = field(default_factory=dict)
     unverified: int = 0
     failures: list[tuple[Any, str]] = field(default_factory=list)
     seconds: float = 0.0
+    unpaired: int = 0
+    unpaired_errors: int = 0
 
     @property
     def errors(self) -> int:
@@ -213,6 +217,9 @@ def verify_region_file(results: str | Path, regions: str | Path) -> RegionSummar
         summary.rows += 1
         status = row.get("status") if isinstance(row, dict) else None
         summary.statuses[str(status)] = summary.statuses.get(str(status), 0) + 1
+        if not isinstance(row, dict) or "_bad" in row or row.get("line") != number:  # no tuple to re-check against
+            summary.unpaired += 1
+            summary.unpaired_errors += status == "error"
         if not isinstance(row, dict) or "_bad" in row:
             summary.failures.append((None, row.get("_bad", "not a JSON object") if isinstance(row, dict)
                                      else f"results row for line {number}: not a JSON object"))
