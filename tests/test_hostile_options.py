@@ -19,7 +19,7 @@ from qualgrasp.certify.cli.options import MAX_WORKERS
 from qualgrasp.certify.core.arguments import number_in
 from qualgrasp.certify.core.validation import MIN_NORMAL
 from qualgrasp.certify.errors import ArgumentError
-from qualgrasp.certify.files import read_results
+from qualgrasp.certify.files import grasp_columns, read_results
 from qualgrasp.cli import app
 
 runner = CliRunner()
@@ -232,3 +232,43 @@ def test_verify_regions_states_which_rows_it_re_checked_against_their_tuples(tmp
 def _verify_regions(results, regions):
     result = runner.invoke(app, ["verify", str(results), "--regions", str(regions)])
     return result.exit_code, result.output.strip().splitlines()
+
+
+def test_arrow_null_lists_that_still_cover_values_are_read_as_null():
+    """Arrow allows a null list whose offsets still cover values (in-memory producers make them;
+    Parquet does not keep them): its values are not the next row's (they raised an IndexError,
+    or a broadcast error for ``center``)."""
+    good = [{"p": [0.0, 1.0], "n": [0.0, -1.0], "mu": 0.5}, {"p": [0.0, -1.0], "n": [0.0, 1.0], "mu": 0.5}]
+    hidden = [{"p": [5.0, 1.0], "n": [0.0, -1.0], "mu": 0.5}] * 2
+    flat = pa.array([good, hidden, good]).flatten()
+    contacts = pa.ListArray.from_arrays(pa.array([0, 2, 4, 6], pa.int32()), flat, mask=pa.array([False, True, False]))
+    center = pa.ListArray.from_arrays(pa.array([0, 2, 4, 6], pa.int32()), pa.array([9.0, 9.0, 0.0, 0.5, 0.0, 0.25]),
+                                      mask=pa.array([True, False, False]))
+    cols = grasp_columns(pa.table({"id": ["a", "b", "c"], "contacts": contacts, "center": center}))
+    assert [cols.message(i) is None for i in range(3)] == [True, False, True]
+    assert "contacts: missing" in cols.message(1)
+    a, c = cols.grasps([0, 2])
+    assert [x.p for x in a.contacts] == [x.p for x in c.contacts] == [(0.0, 1.0), (0.0, -1.0)]
+    assert tuple(c.center) == (0.0, 0.25) and tuple(a.center) == (0.0, 0.0)  # a: no center given, the contacts'
+
+
+def test_refused_integers_from_parquet_are_shown_as_given(tmp_path):
+    """Integer coordinates beyond the bound are shown as the integers given, from Parquet's
+    integer lists as from JSON Lines (they were shown as floats)."""
+    far = 2_000_000_000_000
+    grasps = [{"id": "p-far", "contacts": [{"p": [far, 1], "n": [0, -1]}, {"p": [0, -1], "n": [0, 1]}],
+               "center": None},
+              {"id": "c-far", "contacts": [{"p": [0, 1], "n": [0, -1]}, {"p": [0, -1], "n": [0, 1]}],
+               "center": [far, 0]}]
+    paths = {"jsonl": tmp_path / "g.jsonl", "parquet": tmp_path / "g.parquet"}
+    paths["jsonl"].write_text("".join(json.dumps(g) + "\n" for g in grasps))
+    table = pa.Table.from_pylist(grasps)
+    assert pa.types.is_integer(table.schema.field("center").type.value_type)
+    pq.write_table(table, paths["parquet"])
+    errors = {}
+    for fmt, path in paths.items():
+        out = tmp_path / f"r-{fmt}.jsonl"
+        runner.invoke(app, ["certify", str(path), "-o", str(out), "-q", "--no-quality", "--workers", "1"])
+        errors[fmt] = [r["error"] for r in read_results(out)]
+    assert errors["parquet"] == errors["jsonl"]
+    assert f"got [{far}, 1]" in errors["jsonl"][0] and f"got [{far}, 0]" in errors["jsonl"][1]

@@ -28,6 +28,7 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from .. import models as registry
+from ..models import MAX_LENGTH
 from ..core.grasp import Grasp, grasps_from_checked
 from .reader import READ_ERROR
 from ..core.validation import (ABSENT, MAX_CONTACTS, TOP_LEVEL, UNKNOWN, CheckedGrasps, ContactData, GraspData, check_grasps,
@@ -188,6 +189,8 @@ def _lists(arr: pa.Array):
         return offsets, flat, valid
     if pa.types.is_list(arr.type) or pa.types.is_large_list(arr.type):
         offsets = np.asarray(arr.offsets, dtype=np.int64)
+        if not valid.all():  # flatten() skips a null list's values, which its offsets may still cover
+            return np.concatenate([[0], np.cumsum(np.where(valid, np.diff(offsets), 0))]), arr.flatten(), valid
         return offsets - offsets[0], arr.flatten(), valid
     return None
 
@@ -233,6 +236,14 @@ def _vectors(arr: pa.Array, n: int):
     return out, np.where(valid, lengths, -1)
 
 
+def _keep_refused(raw: dict, key: str, col, vec: np.ndarray, lengths: np.ndarray) -> None:
+    """Record in ``raw`` (by ``(row, key)``) the values as given of the rows of ``col`` whose
+    numbers the value rules refuse (NaN, infinite or beyond :data:`~qualgrasp.certify.models.MAX_LENGTH`),
+    so that their messages show them as the JSON reader does (integers as integers)."""
+    for j in np.flatnonzero((lengths >= 1) & ~(np.abs(vec) <= MAX_LENGTH).all(axis=1)):
+        raw[(int(j), key)] = col[int(j)].as_py()
+
+
 def _strings(arr: pa.Array) -> pa.Array | None:
     """A string array (dictionary-decoded, large strings cast), None when not strings."""
     if pa.types.is_dictionary(arr.type):
@@ -276,6 +287,7 @@ def _arrow_contacts(flat: pa.Array) -> ContactData:
                         f"{fields[key].type} value")
             continue
         vec, lengths = got
+        _keep_refused(data.raw, key, fields[key], vec, lengths)
         if key == "p":
             data.p, data.plen = vec, lengths
         else:
@@ -363,6 +375,7 @@ def grasp_columns(table: pa.Table) -> GraspColumns:
         else:
             data.center, data.clen = got
             col = table.column("center")
+            _keep_refused(data.raw, "center", col, data.center, data.clen)
             for i in np.flatnonzero(np.isin(data.clen, (0, 1, 4))):  # worded as the JSON reader words it
                 data.errors[i] = data.errors[i] or (f"center: expected 2 or 3 finite numbers, got "
                                                     f"{show(col[i].as_py())}")
