@@ -20,9 +20,9 @@ The **degenerate planar** rows time the batch path, without and with
 quality, on a degenerate planar set (``qualgrasp sample --degenerate mixed``: normals through one
 point, repeated or collinear contacts) and on a generic set of the same size, model and contact
 count, in the same run; their ratio is the degenerate set's time per grasp as a multiple of the
-generic set's. The batch path, and the per-grasp routes of the quality and degenerate rows, are
-timed on a second pass over their grasps: the first loads every kernel and solver they reach, as a
-worker's first chunk does. Speeds are single-process; ``qualgrasp certify --workers N`` runs N
+generic set's. Every route is timed on a second pass over its grasps: the first loads every
+kernel and solver they reach (and builds cvxpy's problems), as a worker's first chunk does. Speeds
+are single-process; ``qualgrasp certify --workers N`` runs N
 such processes, and ``qualgrasp bench`` times this table in a process whose memory allocator
 is set as theirs (:func:`qualgrasp.certify.batch.engine.tune_allocator`).
 
@@ -102,12 +102,10 @@ class BenchRow:
         return 1e6 * self.seconds / self.grasps
 
 
-def _time(fn, items, progress=None) -> float:
+def _time(fn, items) -> float:
     start = time.perf_counter()
     for item in items:
         fn(item)
-        if progress:
-            progress()
     return time.perf_counter() - start
 
 
@@ -196,21 +194,19 @@ def run_bench(n: int = 20000, seed: int = 0, reference_n: int = 300,
             few = grasps[:reference_n]
             t_batch = _batch_seconds(grasps) / len(grasps)
             routes = [("qualgrasp batch (force + form, certified)", len(grasps), t_batch * len(grasps))]
-            tick = lambda: bar.advance(task)
             solvers = [("per-grasp fast route", make_solver("fast"), grasps[: max(reference_n, n // 10)]),
                        ("clarabel direct", make_solver("clarabel"), few)]
             if models.get(kwargs["model"]).generators(kwargs["dim"]) is not None:  # a polyhedral cone: an LP
                 solvers.append(("scipy linprog (HiGHS)", make_solver("linprog"), few))
             solvers += [("cvxpy + Parameters (reference)", make_solver("reference"), few),
                         ("cvxpy rebuilt per grasp", make_solver("reference-rebuilt"), few)]
-            for name, solver, items in solvers:
-                force_closure(grasps[0], solver=solver)  # build structure outside the timing
-                routes.append((name, len(items),
-                               _time(lambda g: force_closure(g, solver=solver), items, tick)))
+            for name, solver, items in solvers:  # each timed on a second pass, as the batch path
+                routes.append((name, len(items), _warm_seconds(lambda g: force_closure(g, solver=solver), items)))
+                bar.advance(task)
             fast = make_solver("fast")
             pairs = [(g, force_closure(g, solver=fast)) for g in few]
             routes.append(("exact verify (rationals, no solver)", len(pairs),
-                           _time(lambda gv: verify(gv[0], gv[1].certificate), pairs, tick)))
+                           _warm_seconds(lambda gv: verify(gv[0], gv[1].certificate), pairs)))
             for route, count, seconds in routes:
                 rows.append(BenchRow(kind, route, count, seconds, (seconds / count) / t_batch))
             bar.remove_task(task)

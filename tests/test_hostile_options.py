@@ -14,6 +14,7 @@ import pyarrow.parquet as pq
 import pytest
 from typer.testing import CliRunner
 
+from qualgrasp.certify import models
 from qualgrasp.certify.batch.samples import RANGES, parameter_ranges, random_grasp_table
 from qualgrasp.certify.cli.options import MAX_WORKERS
 from qualgrasp.certify.core.arguments import number_in
@@ -99,6 +100,8 @@ def test_sample_draws_every_built_in_models_parameters(tmp_path, suffix):
     radius = random_grasp_table(0, 20, dim=3, model="patch").column("contacts").combine_chunks().flatten()
     values = radius.field("radius").to_numpy()
     assert ((values >= RANGES["radius"][0]) & (values <= RANGES["radius"][1])).all()
+    for model in models.names():  # a built-in model added without a range fails here
+        assert set(parameter_ranges(model)) == {par.name for par in models.get(model).params}
 
 
 def test_a_model_parameter_without_a_range_is_named(tmp_path, monkeypatch):
