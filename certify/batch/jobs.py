@@ -54,8 +54,7 @@ class Summary:
     that have no results row (a results file may hold a subset: not a failure); ``unpaired``
     counts the rows that failed before any re-check, having no grasp to be re-checked against
     (unreadable, stating no usable line or a line that is no grasp of the file, or repeating
-    another row's line), and
-    ``unpaired_errors`` those of them stating status ``error``."""
+    another row's line), and ``unpaired_errors`` those of them stating status ``error``."""
 
     rows: int = 0
     statuses: dict[str, int] = field(default_factory=dict)
