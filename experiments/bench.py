@@ -131,10 +131,7 @@ def _batch_seconds(grasps, quality: bool = False, table=None) -> float:
     def slow(idx):
         return [certify_grasp(grasps[i], quality=quality).row(line=lines[i]) for i in idx]
 
-    certify_table(table, lines, options, slow=slow)
-    start = time.perf_counter()
-    certify_table(table, lines, options, slow=slow)
-    return time.perf_counter() - start
+    return _warm_seconds(lambda _: certify_table(table, lines, options, slow=slow), (table,))
 
 
 def _quality_rows(n: int, seed: int, reference_n: int) -> list[BenchRow]:

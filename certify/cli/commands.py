@@ -88,8 +88,7 @@ def certify_command(
         fail(f"--eps-gap must be a fraction between 0 and 1 (relative gap hi - lo <= gap * hi), got {eps_gap}")
     if eps_budget < 1:
         fail(f"--eps-budget must be at least 1 direction cell, got {eps_budget}")
-    if not 0 <= workers <= MAX_WORKERS:
-        fail(f"--workers must be 0 (all cores) or a number of processes up to {MAX_WORKERS}, got {workers}")
+    _check_workers(workers)
     if not (eps_time >= 0 and math.isfinite(eps_time)):  # NaN fails both
         fail(f"--eps-time must be a finite number of seconds >= 0 (0: no time limit), got {eps_time}")
     if chunk_size is not None and chunk_size < 1:
@@ -153,8 +152,7 @@ def verify_command(
     """
     if (grasps is None) == (regions is None):
         fail("give exactly one of --grasps and --regions")
-    if not 0 <= workers <= MAX_WORKERS:
-        fail(f"--workers must be 0 (all cores) or a number of processes up to {MAX_WORKERS}, got {workers}")
+    _check_workers(workers)
     try:
         if regions is not None:
             summary = verify_region_file(results, regions)
@@ -168,6 +166,12 @@ def verify_command(
     console.print(_verify_line(summary, regions is not None), soft_wrap=True)
     if summary.failures:
         raise typer.Exit(1)
+
+
+def _check_workers(workers: int) -> None:
+    """Refuse a ``--workers`` count below 0 or above :data:`~qualgrasp.certify.cli.options.MAX_WORKERS`."""
+    if not 0 <= workers <= MAX_WORKERS:
+        fail(f"--workers must be 0 (all cores) or a number of processes up to {MAX_WORKERS}, got {workers}")
 
 
 def _verify_line(summary, regions: bool = False) -> str:

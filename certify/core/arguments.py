@@ -80,8 +80,9 @@ def number_in(value: float, name: str, low: float, high: float, *, unit: str = "
     if not ok:
         bounds = [f"{'>' if low_open else '>='} {low:g}"] if math.isfinite(low) else []
         bounds += [f"{'<' if high_open else '<='} {high:g}"] if math.isfinite(high) else []  # no "<= inf"
-        rule = " and ".join(bounds) + (f" {unit}" if bounds and unit else f"of {unit}" if unit else "")
-        raise error(f"{name} must be a finite number{' ' * bool(rule)}{rule}, got {value:g}")
+        words = [" and ".join(bounds)] if bounds else []
+        words += ([unit] if bounds else [f"of {unit}"]) if unit else []
+        raise error(" ".join([f"{name} must be a finite number", *words]) + f", got {value:g}")
     return value
 
 

@@ -237,9 +237,10 @@ def _vectors(arr: pa.Array, n: int):
 
 
 def _keep_refused(raw: dict, key: str, col, vec: np.ndarray, lengths: np.ndarray) -> None:
-    """Record in ``raw`` (by ``(row, key)``) the values as given of the rows of ``col`` whose
-    numbers the value rules refuse (NaN, infinite or beyond :data:`~qualgrasp.certify.models.MAX_LENGTH`),
-    so that their messages show them as the JSON reader does (integers as integers)."""
+    """Record in ``raw`` (by ``(row, key)``) the values as given of the rows of ``col`` holding a
+    NaN, an infinity or a number beyond :data:`~qualgrasp.certify.models.MAX_LENGTH` (what the
+    value rules refuse, of a normal the first two), so that their messages show them as the JSON
+    reader does (integers as integers)."""
     for j in np.flatnonzero((lengths >= 1) & ~(np.abs(vec) <= MAX_LENGTH).all(axis=1)):
         raw[(int(j), key)] = col[int(j)].as_py()
 
@@ -367,14 +368,13 @@ def grasp_columns(table: pa.Table) -> GraspColumns:
         contacts = ContactData.empty(0)
         contacts.errors = np.full(0, None, dtype=object)
     if "center" in names:
-        got = _vectors(table.column("center").combine_chunks(), n)
+        col = table.column("center")
+        got = _vectors(col.combine_chunks(), n)
         if got is None:
-            col = table.column("center")
             _type_error(data, np.asarray(col.is_valid(), bool),
                         f"center: expected 2 (planar) or 3 (spatial) finite numbers, got a {col.type} value")
         else:
             data.center, data.clen = got
-            col = table.column("center")
             _keep_refused(data.raw, "center", col, data.center, data.clen)
             for i in np.flatnonzero(np.isin(data.clen, (0, 1, 4))):  # worded as the JSON reader words it
                 data.errors[i] = data.errors[i] or (f"center: expected 2 or 3 finite numbers, got "

@@ -217,15 +217,14 @@ def verify_region_file(results: str | Path, regions: str | Path) -> RegionSummar
         summary.rows += 1
         status = row.get("status") if isinstance(row, dict) else None
         summary.statuses[str(status)] = summary.statuses.get(str(status), 0) + 1
-        if not isinstance(row, dict) or "_bad" in row or row.get("line") != number:  # no tuple to re-check against
+        unreadable = not isinstance(row, dict) or "_bad" in row
+        if unreadable or row.get("line") != number:  # no tuple to re-check it against
             summary.unpaired += 1
             summary.unpaired_errors += status == "error"
-        if not isinstance(row, dict) or "_bad" in row:
-            summary.failures.append((None, row.get("_bad", "not a JSON object") if isinstance(row, dict)
-                                     else f"results row for line {number}: not a JSON object"))
-            continue
-        if row.get("line") != number:
-            summary.failures.append((row.get("id"), f"results row is for line {row.get('line')}, tuple is line {number}"))
+            summary.failures.append(
+                (None, row.get("_bad", "not a JSON object") if isinstance(row, dict)
+                 else f"results row for line {number}: not a JSON object") if unreadable
+                else (row.get("id"), f"results row is for line {row.get('line')}, tuple is line {number}"))
             continue
         if isinstance(item, tuple):
             if status != "error":
